@@ -1,0 +1,44 @@
+//! `rtgi`: the command line of the rtgi ray tracer.
+//!
+//! The whole program lives in this library so that the end-to-end tests can
+//! build the same command as a binary of their own and run it as a process.
+
+mod cli;
+mod default_scene;
+mod render_cmd;
+
+use std::process::ExitCode;
+
+use clap::Parser;
+
+/// Runs the command line with the process's arguments; returns the exit code.
+pub fn main() -> ExitCode {
+    let cli = match cli::Cli::try_parse() {
+        Ok(cli) => cli,
+        Err(e) => return cli::report_parse_error(e),
+    };
+    let result = match cli.command {
+        cli::Command::Render(args) => render_cmd::run(&args),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("error: {}", one_line(&e));
+            ExitCode::FAILURE
+        }
+    }
+}
+
+/// An error and its causes on one line, leaving out causes that the
+/// messages before them already quote (library errors name their cause).
+fn one_line(error: &anyhow::Error) -> String {
+    let mut line = error.to_string();
+    for cause in error.chain().skip(1) {
+        let cause = cause.to_string();
+        if !line.contains(&cause) {
+            line.push_str(": ");
+            line.push_str(&cause);
+        }
+    }
+    line.replace('\n', " ")
+}

@@ -1,0 +1,82 @@
+//! Closest-hit and any-hit ray queries over a set of triangles.
+//!
+//! This crate knows nothing about files, materials or shading: it is given
+//! triangle corner positions, in an order of the caller's choosing, and
+//! answers which triangle a ray hits first ([`Accel::intersect`]) or whether
+//! it hits any ([`Accel::occluded`]). Hits name the triangle by its index in
+//! that input order and carry the barycentric coordinates `(beta, gamma)` of
+//! the hit point, so that the caller can interpolate its own vertex data:
+//! `p = (1 - beta - gamma) * v0 + beta * v1 + gamma * v2`.
+//!
+//! ```
+//! use rtgi_accel::{Accel, AccelKind, BuildParams};
+//! use rtgi_math::{Ray, Vec3};
+//!
+//! let triangles = [[Vec3::new(-1.0, -1.0, 0.0), Vec3::new(1.0, -1.0, 0.0), Vec3::new(0.0, 1.0, 0.0)]];
+//! let accel = AccelKind::Linear.build(&triangles, &BuildParams::default());
+//! let ray = Ray::new(Vec3::new(0.0, 0.0, -2.0), Vec3::Z);
+//! let hit = accel.intersect(&ray).expect("the ray points at the triangle");
+//! assert_eq!((hit.t, hit.triangle), (2.0, 0));
+//! assert!(accel.occluded(&ray));
+//! ```
+
+mod counters;
+mod kind;
+mod linear;
+mod triangle;
+
+pub use counters::{Counter, NoCounter, TraversalCounters};
+pub use kind::{AccelKind, BuildParams, UnknownAccel};
+pub use linear::LinearScan;
+pub use triangle::{TriangleHit, intersect_triangle};
+
+use rtgi_math::Ray;
+use serde::Serialize;
+
+/// The closest hit of a ray: its distance `t` along the ray, the index of
+/// the triangle in the order the structure was built from, and the
+/// barycentric coordinates of the hit point on that triangle.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Hit {
+    pub t: f32,
+    pub triangle: u32,
+    pub beta: f32,
+    pub gamma: f32,
+}
+
+/// What a build produced and what it cost; every structure reports one.
+#[derive(Clone, Debug, Default, PartialEq, Serialize)]
+pub struct BuildStats {
+    /// Name of the variant, as [`AccelKind::name`] gives it.
+    pub variant: String,
+    pub triangles: usize,
+    pub build_ms: f64,
+    pub nodes: usize,
+    pub leaves: usize,
+    pub depth: usize,
+    pub memory_bytes: usize,
+}
+
+/// A ray query structure over triangles.
+///
+/// The trait is object safe so that the variant can be chosen at run time
+/// (`Box<dyn Accel>`); implementations keep their hot loops generic over a
+/// [`Counter`], so counting nodes and triangle tests costs nothing when the
+/// uncounted methods are used.
+pub trait Accel: Send + Sync + std::fmt::Debug {
+    /// The closest hit in `[ray.t_min, ray.t_max]`, or `None`.
+    /// At equal `t`, the triangle with the lower index wins.
+    fn intersect(&self, ray: &Ray) -> Option<Hit>;
+
+    /// Whether anything is hit in `[ray.t_min, ray.t_max]`; stops at the first hit found.
+    fn occluded(&self, ray: &Ray) -> bool;
+
+    /// [`Accel::intersect`], adding the work done to `counters`.
+    fn intersect_counted(&self, ray: &Ray, counters: &mut TraversalCounters) -> Option<Hit>;
+
+    /// [`Accel::occluded`], adding the work done to `counters`.
+    fn occluded_counted(&self, ray: &Ray, counters: &mut TraversalCounters) -> bool;
+
+    /// The statistics of the build.
+    fn build_stats(&self) -> &BuildStats;
+}

@@ -1,0 +1,86 @@
+use std::time::Instant;
+
+use rtgi_math::{Ray, Vec3};
+
+use crate::{Accel, BuildStats, Counter, Hit, NoCounter, TraversalCounters, intersect_triangle};
+
+/// The reference structure: every ray is tested against every triangle, in
+/// index order, O(n) per ray. Slow, simple, and the answer every other
+/// structure must reproduce.
+#[derive(Debug)]
+pub struct LinearScan {
+    triangles: Vec<[Vec3; 3]>,
+    stats: BuildStats,
+}
+
+impl LinearScan {
+    pub fn new(triangles: &[[Vec3; 3]]) -> Self {
+        let start = Instant::now();
+        let triangles = triangles.to_vec();
+        let stats = BuildStats {
+            variant: "linear".into(),
+            triangles: triangles.len(),
+            build_ms: start.elapsed().as_secs_f64() * 1e3,
+            memory_bytes: std::mem::size_of_val(triangles.as_slice()),
+            ..BuildStats::default()
+        };
+        Self { triangles, stats }
+    }
+
+    fn closest<C: Counter>(&self, ray: &Ray, counter: &mut C) -> Option<Hit> {
+        if !ray.is_valid() {
+            return None;
+        }
+        let mut closest: Option<Hit> = None;
+        let mut t_max = ray.t_max;
+        counter.triangles_tested(self.triangles.len() as u32);
+        for (index, triangle) in self.triangles.iter().enumerate() {
+            // Strictly closer only: at equal t the lower index, found first, stays.
+            if let Some(h) = intersect_triangle(ray.origin, ray.direction, ray.t_min, t_max, triangle) {
+                if closest.is_none_or(|c| h.t < c.t) {
+                    t_max = h.t;
+                    closest = Some(Hit { t: h.t, triangle: index as u32, beta: h.beta, gamma: h.gamma });
+                }
+            }
+        }
+        closest
+    }
+
+    fn any<C: Counter>(&self, ray: &Ray, counter: &mut C) -> bool {
+        if !ray.is_valid() {
+            return false;
+        }
+        for (index, triangle) in self.triangles.iter().enumerate() {
+            if intersect_triangle(ray.origin, ray.direction, ray.t_min, ray.t_max, triangle).is_some() {
+                counter.triangles_tested(index as u32 + 1);
+                return true;
+            }
+        }
+        counter.triangles_tested(self.triangles.len() as u32);
+        false
+    }
+}
+
+impl Accel for LinearScan {
+    fn intersect(&self, ray: &Ray) -> Option<Hit> {
+        self.closest(ray, &mut NoCounter)
+    }
+
+    fn occluded(&self, ray: &Ray) -> bool {
+        self.any(ray, &mut NoCounter)
+    }
+
+    fn intersect_counted(&self, ray: &Ray, counters: &mut TraversalCounters) -> Option<Hit> {
+        counters.rays += 1;
+        self.closest(ray, counters)
+    }
+
+    fn occluded_counted(&self, ray: &Ray, counters: &mut TraversalCounters) -> bool {
+        counters.rays += 1;
+        self.any(ray, counters)
+    }
+
+    fn build_stats(&self) -> &BuildStats {
+        &self.stats
+    }
+}

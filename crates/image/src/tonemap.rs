@@ -1,0 +1,128 @@
+use std::fmt;
+use std::str::FromStr;
+
+use rtgi_math::Vec3;
+
+/// How linear radiance becomes a displayable value in `[0, 1]`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ToneOperator {
+    /// Clip at 1: faithful for albedo-like images whose values are already in `[0, 1]`.
+    Clamp,
+    /// `c / (1 + c)` per channel (Reinhard et al. 2002, the simple global operator).
+    Reinhard,
+    /// Narkowicz's fit of the ACES filmic curve (2015): a gentle shoulder for bright lights.
+    Aces,
+}
+
+impl ToneOperator {
+    pub const ALL: &'static [ToneOperator] = &[ToneOperator::Clamp, ToneOperator::Reinhard, ToneOperator::Aces];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            ToneOperator::Clamp => "clamp",
+            ToneOperator::Reinhard => "reinhard",
+            ToneOperator::Aces => "aces",
+        }
+    }
+
+    #[inline]
+    fn map(self, c: f32) -> f32 {
+        let c = c.max(0.0);
+        match self {
+            ToneOperator::Clamp => c.min(1.0),
+            ToneOperator::Reinhard => c / (1.0 + c),
+            ToneOperator::Aces => {
+                let (a, b, cc, d, e) = (2.51, 0.03, 2.43, 0.59, 0.14);
+                ((c * (a * c + b)) / (c * (cc * c + d) + e)).clamp(0.0, 1.0)
+            }
+        }
+    }
+}
+
+impl fmt::Display for ToneOperator {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl FromStr for ToneOperator {
+    type Err = String;
+
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        Self::ALL.iter().copied().find(|o| o.name() == s).ok_or_else(|| {
+            let names: Vec<_> = Self::ALL.iter().map(|o| o.name()).collect();
+            format!("unknown tone map '{s}' (expected one of: {})", names.join(", "))
+        })
+    }
+}
+
+/// Exposure followed by a tone operator; used for 8-bit output only.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ToneMap {
+    /// Exposure in stops: values are multiplied by `2^exposure` first.
+    pub exposure: f32,
+    pub operator: ToneOperator,
+}
+
+impl Default for ToneMap {
+    fn default() -> Self {
+        Self { exposure: 0.0, operator: ToneOperator::Clamp }
+    }
+}
+
+impl ToneMap {
+    /// Maps linear radiance to linear display values in `[0, 1]`; NaN becomes 0.
+    #[inline]
+    pub fn apply(&self, radiance: Vec3) -> Vec3 {
+        let scaled = radiance * self.exposure.exp2();
+        let channel = |c: f32| {
+            if c.is_nan() { 0.0 } else { self.operator.map(c) }
+        };
+        Vec3::new(channel(scaled.x), channel(scaled.y), channel(scaled.z))
+    }
+}
+
+/// The sRGB transfer function (IEC 61966-2-1), for values in `[0, 1]`.
+#[inline]
+pub fn linear_to_srgb(c: f32) -> f32 {
+    let c = c.clamp(0.0, 1.0);
+    if c <= 0.003_130_8 { 12.92 * c } else { 1.055 * c.powf(1.0 / 2.4) - 0.055 }
+}
+
+/// The inverse of [`linear_to_srgb`].
+#[inline]
+pub fn srgb_to_linear(c: f32) -> f32 {
+    if c <= 0.040_45 { c / 12.92 } else { ((c + 0.055) / 1.055).powf(2.4) }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn srgb_round_trip_and_endpoints() {
+        assert_eq!(linear_to_srgb(0.0), 0.0);
+        assert!((linear_to_srgb(1.0) - 1.0).abs() < 1e-6);
+        assert!((linear_to_srgb(0.214_041) - 0.5).abs() < 1e-4);
+        for i in 0..=100 {
+            let c = i as f32 / 100.0;
+            assert!((srgb_to_linear(linear_to_srgb(c)) - c).abs() < 1e-5);
+        }
+    }
+
+    #[test]
+    fn operators_are_monotonic_and_bounded() {
+        for op in ToneOperator::ALL {
+            let tm = ToneMap { exposure: 0.0, operator: *op };
+            let mut last = -1.0;
+            for i in 0..200 {
+                let v = tm.apply(Vec3::splat(i as f32 * 0.1)).x;
+                assert!((0.0..=1.0).contains(&v) && v >= last, "{op}: {v} after {last}");
+                last = v;
+            }
+        }
+        let tm = ToneMap { exposure: 1.0, operator: ToneOperator::Clamp };
+        assert_eq!(tm.apply(Vec3::splat(0.25)), Vec3::splat(0.5));
+        assert_eq!(tm.apply(Vec3::new(f32::NAN, -1.0, 9.0)), Vec3::new(0.0, 0.0, 1.0));
+    }
+}

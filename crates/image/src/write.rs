@@ -1,0 +1,198 @@
+use std::fs::{self, File};
+use std::io::{BufWriter, Write};
+use std::path::{Path, PathBuf};
+
+use crate::{HdrImage, ToneMap};
+
+/// What can go wrong writing an image; every variant names the file.
+#[derive(Debug, thiserror::Error)]
+pub enum ImageError {
+    #[error("{path}: unsupported image format (use a .png or .exr file name)")]
+    UnsupportedFormat { path: PathBuf },
+    #[error("{path}: cannot write: {source}")]
+    Io { path: PathBuf, source: std::io::Error },
+    #[error("{path}: cannot encode: {message}")]
+    Encode { path: PathBuf, message: String },
+    #[error("{path}: cannot read image: {message}")]
+    Read { path: PathBuf, message: String },
+}
+
+/// The file formats images are written in.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum OutputFormat {
+    /// OpenEXR, linear 32-bit float RGB.
+    Exr,
+    /// PNG, 8-bit sRGB after exposure and tone mapping.
+    Png,
+}
+
+impl OutputFormat {
+    /// The format a path's extension asks for (case-insensitive).
+    pub fn from_path(path: &Path) -> Result<Self, ImageError> {
+        let extension = path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase);
+        match extension.as_deref() {
+            Some("exr") => Ok(OutputFormat::Exr),
+            Some("png") => Ok(OutputFormat::Png),
+            _ => Err(ImageError::UnsupportedFormat { path: path.to_owned() }),
+        }
+    }
+}
+
+impl HdrImage {
+    /// Writes the image in the format of `path`'s extension, atomically: the
+    /// data goes to a temporary file beside `path`, which is renamed over
+    /// `path` only once complete.
+    pub fn write(&self, path: &Path, tone_map: &ToneMap) -> Result<(), ImageError> {
+        let format = OutputFormat::from_path(path)?;
+        let temporary = temporary_path(path);
+        let result = match format {
+            OutputFormat::Png => self.write_png(&temporary, tone_map),
+            OutputFormat::Exr => self.write_exr(&temporary),
+        }
+        .map_err(|e| relabel(e, path));
+        let result = result.and_then(|()| {
+            fs::rename(&temporary, path).map_err(|source| ImageError::Io { path: path.to_owned(), source })
+        });
+        if result.is_err() {
+            let _ = fs::remove_file(&temporary);
+        }
+        result
+    }
+
+    fn write_png(&self, path: &Path, tone_map: &ToneMap) -> Result<(), ImageError> {
+        use image::ImageEncoder;
+        let bytes = self.to_srgb8(tone_map);
+        let file = File::create(path).map_err(|source| ImageError::Io { path: path.to_owned(), source })?;
+        let mut writer = BufWriter::new(file);
+        image::codecs::png::PngEncoder::new(&mut writer)
+            .write_image(&bytes, self.width, self.height, image::ExtendedColorType::Rgb8)
+            .map_err(|e| ImageError::Encode { path: path.to_owned(), message: e.to_string() })?;
+        writer
+            .into_inner()
+            .map_err(|e| e.into_error())
+            .and_then(|f| f.sync_all())
+            .map_err(|source| ImageError::Io { path: path.to_owned(), source })
+    }
+
+    fn write_exr(&self, path: &Path) -> Result<(), ImageError> {
+        let width = self.width as usize;
+        exr::prelude::write_rgb_file(path, width, self.height as usize, |x, y| {
+            let p = self.pixels[y * width + x];
+            (p.x, p.y, p.z)
+        })
+        .map_err(|e| match e {
+            exr::error::Error::Io(source) => ImageError::Io { path: path.to_owned(), source },
+            other => ImageError::Encode { path: path.to_owned(), message: other.to_string() },
+        })
+    }
+
+    /// Reads an OpenEXR file's RGB channels (alpha ignored) as linear floats.
+    pub fn read_exr(path: &Path) -> Result<HdrImage, ImageError> {
+        use exr::prelude::*;
+        let read_error = |e: exr::error::Error| ImageError::Read { path: path.to_owned(), message: e.to_string() };
+        let image = read_first_rgba_layer_from_file(
+            path,
+            |resolution, _| HdrImage::new(resolution.width() as u32, resolution.height() as u32),
+            |image: &mut HdrImage, position, (r, g, b, _a): (f32, f32, f32, f32)| {
+                image.set(position.x() as u32, position.y() as u32, rtgi_math::Vec3::new(r, g, b));
+            },
+        )
+        .map_err(read_error)?;
+        Ok(image.layer_data.channel_data.pixels)
+    }
+}
+
+/// A name beside `path` that no other writer uses at the same time.
+fn temporary_path(path: &Path) -> PathBuf {
+    let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
+    path.with_file_name(format!(".{name}.{}.partial", std::process::id()))
+}
+
+/// Errors from the temporary file are reported under the name the user gave.
+fn relabel(error: ImageError, path: &Path) -> ImageError {
+    let path = path.to_owned();
+    match error {
+        ImageError::Io { source, .. } => ImageError::Io { path, source },
+        ImageError::Encode { message, .. } => ImageError::Encode { path, message },
+        other => other,
+    }
+}
+
+/// Checks before a long render that `path` names a supported format in a
+/// writable folder, by creating and removing a temporary file there.
+pub fn check_writable(path: &Path) -> Result<OutputFormat, ImageError> {
+    let format = OutputFormat::from_path(path)?;
+    if path.is_dir() {
+        return Err(ImageError::Io {
+            path: path.to_owned(),
+            source: std::io::Error::new(std::io::ErrorKind::IsADirectory, "is a directory"),
+        });
+    }
+    let probe = temporary_path(path);
+    let created = File::create(&probe).and_then(|mut f| f.write_all(b""));
+    let _ = fs::remove_file(&probe);
+    created.map_err(|source| ImageError::Io { path: path.to_owned(), source })?;
+    Ok(format)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use rtgi_math::Vec3;
+
+    fn scratch(name: &str) -> PathBuf {
+        let dir = std::env::temp_dir().join(format!("rtgi-image-test-{}", std::process::id()));
+        fs::create_dir_all(&dir).unwrap();
+        dir.join(name)
+    }
+
+    fn gradient() -> HdrImage {
+        let mut image = HdrImage::new(7, 3);
+        for y in 0..3 {
+            for x in 0..7 {
+                image.set(x, y, Vec3::new(x as f32 * 0.5, y as f32, 100.0));
+            }
+        }
+        image
+    }
+
+    #[test]
+    fn exr_round_trips_exactly() {
+        let path = scratch("round.exr");
+        let image = gradient();
+        image.write(&path, &ToneMap::default()).unwrap();
+        assert_eq!(HdrImage::read_exr(&path).unwrap(), image);
+    }
+
+    #[test]
+    fn png_is_written_with_srgb_values() {
+        let path = scratch("gradient.png");
+        gradient().write(&path, &ToneMap::default()).unwrap();
+        let decoded = image::open(&path).unwrap().to_rgb8();
+        assert_eq!(decoded.dimensions(), (7, 3));
+        assert_eq!(decoded.get_pixel(0, 0).0, [0, 0, 255]);
+        assert_eq!(decoded.get_pixel(2, 1).0, [255, 255, 255]);
+        assert_eq!(decoded.get_pixel(1, 2).0[0], 188); // sRGB(0.5) = 0.735
+    }
+
+    #[test]
+    fn unknown_extension_and_missing_folder_are_errors() {
+        let image = gradient();
+        let err = image.write(&scratch("x.bmp"), &ToneMap::default()).unwrap_err();
+        assert!(err.to_string().contains("x.bmp"), "{err}");
+        let missing = scratch("no-such-folder").join("x.png");
+        assert!(check_writable(&missing).is_err());
+        assert!(image.write(&missing, &ToneMap::default()).is_err());
+        assert!(!missing.exists());
+    }
+
+    #[test]
+    fn failed_write_keeps_the_old_file() {
+        let path = scratch("keep.png");
+        gradient().write(&path, &ToneMap::default()).unwrap();
+        let before = fs::read(&path).unwrap();
+        // A zero-sized image cannot be encoded as PNG; the earlier file must survive.
+        assert!(HdrImage::new(0, 0).write(&path, &ToneMap::default()).is_err());
+        assert_eq!(fs::read(&path).unwrap(), before);
+    }
+}

@@ -1,0 +1,67 @@
+use glam::Vec3;
+
+/// An orthonormal frame: three unit vectors `x`, `y`, `z` at right angles.
+///
+/// Shading code works in the local frame of a surface, where the normal is
+/// `z`, so that cosines are plain `z` components.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Frame {
+    pub x: Vec3,
+    pub y: Vec3,
+    pub z: Vec3,
+}
+
+impl Frame {
+    /// A frame whose `z` is the given unit vector, with `x` and `y` chosen
+    /// continuously and without a branch on a near-parallel axis (Duff et al.,
+    /// "Building an Orthonormal Basis, Revisited", JCGT 2017).
+    #[inline]
+    pub fn from_z(z: Vec3) -> Self {
+        let sign = 1.0f32.copysign(z.z);
+        let a = -1.0 / (sign + z.z);
+        let b = z.x * z.y * a;
+        let x = Vec3::new(1.0 + sign * z.x * z.x * a, sign * b, -sign * z.x);
+        let y = Vec3::new(b, sign + z.y * z.y * a, -z.y);
+        Self { x, y, z }
+    }
+
+    #[inline]
+    pub fn to_local(&self, v: Vec3) -> Vec3 {
+        Vec3::new(v.dot(self.x), v.dot(self.y), v.dot(self.z))
+    }
+
+    #[inline]
+    pub fn to_world(&self, v: Vec3) -> Vec3 {
+        v.x * self.x + v.y * self.y + v.z * self.z
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use proptest::prelude::*;
+
+    proptest! {
+        #[test]
+        fn frame_is_orthonormal(x in -1.0f32..1.0, y in -1.0f32..1.0, z in -1.0f32..1.0) {
+            let v = Vec3::new(x, y, z);
+            prop_assume!(v.length() > 1e-3);
+            let f = Frame::from_z(v.normalize());
+            prop_assert!((f.x.length() - 1.0).abs() < 1e-5);
+            prop_assert!((f.y.length() - 1.0).abs() < 1e-5);
+            prop_assert!(f.x.dot(f.y).abs() < 1e-5);
+            prop_assert!(f.x.dot(f.z).abs() < 1e-5);
+            prop_assert!(f.y.dot(f.z).abs() < 1e-5);
+            // Right-handed, so that local-to-world keeps orientation.
+            prop_assert!((f.x.cross(f.y) - f.z).length() < 1e-5);
+            let w = Vec3::new(0.3, -0.2, 0.9);
+            prop_assert!((f.to_world(f.to_local(w)) - w).length() < 1e-5);
+        }
+    }
+
+    #[test]
+    fn frame_of_negative_z() {
+        let f = Frame::from_z(-Vec3::Z);
+        assert!((f.x.cross(f.y) - f.z).length() < 1e-6);
+    }
+}

@@ -1,0 +1,29 @@
+//! The bottom layer of rtgi: rays, axis-aligned boxes, orthonormal frames and
+//! a deterministic random number generator.
+//!
+//! [`glam`] is re-exported so that every crate of the workspace, and every
+//! user of it, sees one version of the vector types.
+//!
+//! ```
+//! use rtgi_math::{Aabb, Ray, Vec3};
+//!
+//! let unit_box = Aabb::new(Vec3::ZERO, Vec3::ONE);
+//! let ray = Ray::new(Vec3::new(0.5, 0.5, -1.0), Vec3::Z);
+//! let (t_enter, t_exit) = unit_box.intersect(&ray.with_inverse()).unwrap();
+//! assert_eq!(t_enter, 1.0);
+//! assert!(t_exit >= 2.0);
+//! ```
+
+mod aabb;
+mod float;
+mod frame;
+mod ray;
+mod rng;
+
+pub use aabb::Aabb;
+pub use float::{gamma, next_float_down, next_float_up};
+pub use frame::Frame;
+pub use glam;
+pub use glam::{Mat3, Mat4, UVec2, Vec2, Vec3, Vec3A, Vec4, vec2, vec3};
+pub use ray::{Ray, RayWithInverse};
+pub use rng::{Rng, hash_u64};

@@ -1,0 +1,172 @@
+//! Ray casting and shading: from a scene, an acceleration structure and a
+//! camera to an HDR image.
+//!
+//! Rendering is parallel over square tiles with rayon. Every sample draws
+//! its random numbers from a generator seeded by (seed, pixel, sample), and
+//! each pixel sums its samples in sample order, so the image is
+//! bit-identical whatever the number of threads.
+//!
+//! ```no_run
+//! use rtgi_accel::{AccelKind, BuildParams};
+//! use rtgi_render::{RenderSettings, render};
+//! use rtgi_scene::{Camera, Scene};
+//!
+//! let scene = Scene::load("scenes/cornell-box.toml".as_ref())?;
+//! let accel = AccelKind::Linear.build(&scene.triangle_positions(), &BuildParams::default());
+//! let settings = RenderSettings { width: 256, height: 256, ..RenderSettings::default() };
+//! let camera = scene.cameras[0];
+//! let (image, stats) = render(&scene, accel.as_ref(), &camera, &settings, &|_| {});
+//! println!("{} rays in {:.1} ms", stats.rays, stats.render_ms);
+//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! ```
+
+mod camera;
+mod framing;
+mod sampler;
+mod shade;
+
+pub use camera::CameraRays;
+pub use framing::frame_scene;
+pub use sampler::PixelSampler;
+pub use shade::{shade_primary, shading_normal};
+
+use std::time::Instant;
+
+use rayon::prelude::*;
+use rtgi_accel::Accel;
+use rtgi_image::HdrImage;
+use rtgi_math::{Rng, Vec3};
+use rtgi_scene::{Camera, Scene};
+use serde::Serialize;
+
+/// Side of the square tiles that threads take one at a time.
+pub const TILE_SIZE: u32 = 16;
+
+/// What to render and how.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RenderSettings {
+    pub width: u32,
+    pub height: u32,
+    /// Samples per pixel.
+    pub samples_per_pixel: u32,
+    pub sampler: PixelSampler,
+    pub seed: u64,
+    /// Radiance of rays that hit nothing.
+    pub background: Vec3,
+}
+
+impl Default for RenderSettings {
+    fn default() -> Self {
+        Self {
+            width: 512,
+            height: 512,
+            samples_per_pixel: 1,
+            sampler: PixelSampler::Center,
+            seed: 0,
+            background: Vec3::new(0.05, 0.05, 0.06),
+        }
+    }
+}
+
+/// What a render did and how long it took.
+#[derive(Clone, Debug, Default, PartialEq, Serialize)]
+pub struct RenderStats {
+    pub width: u32,
+    pub height: u32,
+    pub samples_per_pixel: u32,
+    /// Rays traced, of all kinds.
+    pub rays: u64,
+    pub render_ms: f64,
+}
+
+impl RenderStats {
+    pub fn rays_per_second(&self) -> f64 {
+        self.rays as f64 / (self.render_ms * 1e-3).max(1e-9)
+    }
+}
+
+/// The rectangles that make up an image, in row-major order.
+fn tiles(width: u32, height: u32) -> Vec<(u32, u32, u32, u32)> {
+    let mut tiles = Vec::new();
+    for y0 in (0..height).step_by(TILE_SIZE as usize) {
+        for x0 in (0..width).step_by(TILE_SIZE as usize) {
+            tiles.push((x0, y0, (x0 + TILE_SIZE).min(width), (y0 + TILE_SIZE).min(height)));
+        }
+    }
+    tiles
+}
+
+/// Renders the primary-hit view: each pixel averages its samples' shaded
+/// closest hits, or the background.
+///
+/// `progress` is called from the worker threads with the number of pixels
+/// finished since its last call; it must be cheap.
+pub fn render<A: Accel + ?Sized>(
+    scene: &Scene,
+    accel: &A,
+    camera: &Camera,
+    settings: &RenderSettings,
+    progress: &(dyn Fn(u64) + Sync),
+) -> (HdrImage, RenderStats) {
+    let start = Instant::now();
+    let (width, height) = (settings.width, settings.height);
+    let rays = CameraRays::new(camera, width, height);
+    let spp = settings.samples_per_pixel.max(1);
+    let tile_pixels: Vec<Vec<Vec3>> = tiles(width, height)
+        .into_par_iter()
+        .map(|(x0, y0, x1, y1)| {
+            let mut pixels = Vec::with_capacity(((x1 - x0) * (y1 - y0)) as usize);
+            for y in y0..y1 {
+                for x in x0..x1 {
+                    let pixel_index = y as u64 * width as u64 + x as u64;
+                    let mut sum = Vec3::ZERO;
+                    for sample in 0..spp {
+                        let mut rng = Rng::for_sample(settings.seed, pixel_index, sample as u64);
+                        let ray = rays.ray(x, y, settings.sampler.offset(&mut rng));
+                        sum += match accel.intersect(&ray) {
+                            Some(hit) => shade_primary(scene, &ray, &hit),
+                            None => settings.background,
+                        };
+                    }
+                    pixels.push(sum / spp as f32);
+                }
+            }
+            progress(pixels.len() as u64);
+            pixels
+        })
+        .collect();
+
+    let mut image = HdrImage::new(width, height);
+    for ((x0, y0, x1, _), pixels) in tiles(width, height).into_iter().zip(tile_pixels) {
+        let tile_width = (x1 - x0) as usize;
+        for (i, value) in pixels.into_iter().enumerate() {
+            image.set(x0 + (i % tile_width) as u32, y0 + (i / tile_width) as u32, value);
+        }
+    }
+    let stats = RenderStats {
+        width,
+        height,
+        samples_per_pixel: spp,
+        rays: width as u64 * height as u64 * spp as u64,
+        render_ms: start.elapsed().as_secs_f64() * 1e3,
+    };
+    (image, stats)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn tiles_cover_the_image_once() {
+        let mut covered = vec![0u8; 37 * 21];
+        for (x0, y0, x1, y1) in tiles(37, 21) {
+            for y in y0..y1 {
+                for x in x0..x1 {
+                    covered[(y * 37 + x) as usize] += 1;
+                }
+            }
+        }
+        assert!(covered.iter().all(|&c| c == 1));
+    }
+}

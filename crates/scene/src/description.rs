@@ -1,0 +1,133 @@
+//! A small TOML scene description: the meshes to merge and a camera.
+//!
+//! ```toml
+//! # Paths are relative to this file.
+//! [[mesh]]
+//! file = "cornell-box/cornell-box.obj"
+//!
+//! [camera]
+//! position = [278.0, 273.0, -800.0]
+//! look_at = [278.0, 273.0, 0.0]      # or: direction = [0.0, 0.0, 1.0]
+//! up = [0.0, 1.0, 0.0]
+//! vertical_fov_degrees = 39.3
+//! aspect = 1.0                       # optional: width / height
+//! ```
+
+use std::path::Path;
+
+use rtgi_math::Vec3;
+use serde::Deserialize;
+
+use crate::{Camera, Scene, SceneError};
+
+/// The parsed contents of a scene description file.
+#[derive(Clone, Debug, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct Description {
+    #[serde(default)]
+    pub mesh: Vec<MeshEntry>,
+    pub camera: Option<CameraEntry>,
+}
+
+#[derive(Clone, Debug, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct MeshEntry {
+    /// A mesh file, relative to the description.
+    pub file: String,
+}
+
+#[derive(Clone, Debug, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct CameraEntry {
+    pub position: [f32; 3],
+    pub look_at: Option<[f32; 3]>,
+    pub direction: Option<[f32; 3]>,
+    #[serde(default = "default_up")]
+    pub up: [f32; 3],
+    pub vertical_fov_degrees: f32,
+    pub aspect: Option<f32>,
+}
+
+fn default_up() -> [f32; 3] {
+    [0.0, 1.0, 0.0]
+}
+
+impl Description {
+    /// Parses description text; `path` is only used in messages.
+    pub fn parse(text: &str, path: &Path) -> Result<Self, SceneError> {
+        let error = |message: String| SceneError::Description { path: path.to_owned(), message };
+        let description: Description = toml::from_str(text).map_err(|e| error(e.message().to_owned()))?;
+        if let Some(c) = &description.camera {
+            c.to_camera().map_err(error)?;
+        }
+        Ok(description)
+    }
+
+    /// The camera, if the description has one.
+    pub fn camera(&self) -> Option<Camera> {
+        self.camera.as_ref().and_then(|c| c.to_camera().ok())
+    }
+}
+
+impl CameraEntry {
+    fn to_camera(&self) -> Result<Camera, String> {
+        let position = Vec3::from(self.position);
+        let direction = match (self.look_at, self.direction) {
+            (Some(target), None) => Vec3::from(target) - position,
+            (None, Some(direction)) => Vec3::from(direction),
+            _ => return Err("camera needs exactly one of 'look_at' and 'direction'".into()),
+        };
+        let camera = Camera {
+            position,
+            direction,
+            up: Vec3::from(self.up),
+            vertical_fov: self.vertical_fov_degrees.to_radians(),
+            aspect: self.aspect,
+        };
+        if !camera.is_valid() || self.aspect.is_some_and(|a| !(a > 0.0 && a.is_finite())) {
+            return Err("camera is degenerate (zero direction, direction parallel to up, \
+                        field of view outside (0, 180) degrees, or a non-positive aspect)"
+                .into());
+        }
+        Ok(camera)
+    }
+}
+
+/// Loads a description and every mesh it lists, merged in the listed order.
+pub(crate) fn load(path: &Path) -> Result<Scene, SceneError> {
+    let text = std::fs::read_to_string(path).map_err(|source| SceneError::Io { path: path.to_owned(), source })?;
+    let description = Description::parse(&text, path)?;
+    let folder = path.parent().unwrap_or(Path::new("."));
+    let mut scene = Scene::default();
+    for mesh in &description.mesh {
+        scene.append(Scene::load(&folder.join(&mesh.file))?);
+    }
+    scene.cameras.splice(0..0, description.camera());
+    Ok(scene)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn camera_from_look_at_or_direction() {
+        let text = "[camera]\nposition = [0, 1, 2]\nlook_at = [0, 1, 0]\nvertical_fov_degrees = 90\n";
+        let d = Description::parse(text, Path::new("a.toml")).unwrap();
+        let c = d.camera().unwrap();
+        assert_eq!(c.direction, Vec3::new(0.0, 0.0, -2.0));
+        assert_eq!(c.up, Vec3::Y);
+        assert!((c.vertical_fov - std::f32::consts::FRAC_PI_2).abs() < 1e-6);
+    }
+
+    #[test]
+    fn bad_descriptions_name_the_file() {
+        let both = "[camera]\nposition=[0,0,0]\nlook_at=[1,0,0]\ndirection=[1,0,0]\nvertical_fov_degrees=40\n";
+        for text in ["[[mesh]]\nfile = 3\n", "colour = 1\n", both, "[camera]\nposition=[0,0,0]\n"] {
+            let err = Description::parse(text, Path::new("bad.toml")).unwrap_err();
+            assert!(err.to_string().starts_with("bad.toml: "), "{err}");
+        }
+        let parallel = "[camera]\nposition=[0,0,0]\ndirection=[0,2,0]\nvertical_fov_degrees=40\n";
+        assert!(Description::parse(parallel, Path::new("p.toml")).is_err());
+    }
+}

@@ -1,0 +1,148 @@
+//! The scene model of rtgi and its importers.
+//!
+//! A [`Scene`] is every mesh of a file merged into one set of triangles.
+//! Each [`Triangle`] names its three [`Vertex`]es (position, normal, texture
+//! coordinates) and its [`Material`]; triangles keep the order of the file,
+//! so a triangle can be named by its index (an OBJ polygon becomes a fan of
+//! triangles, in order). Textures are decoded at load time.
+//!
+//! Importers: Wavefront OBJ with MTL materials (through `tobj`), and a small
+//! TOML scene description that lists meshes and a camera (see
+//! [`description`]).
+//!
+//! ```no_run
+//! let scene = rtgi_scene::Scene::load("scenes/cornell-box.toml".as_ref())?;
+//! println!("{} triangles, {} materials", scene.triangles.len(), scene.materials.len());
+//! for warning in &scene.warnings {
+//!     eprintln!("warning: {warning}");
+//! }
+//! # Ok::<(), rtgi_scene::SceneError>(())
+//! ```
+
+mod camera;
+pub mod description;
+mod material;
+mod mesh;
+pub mod obj;
+mod resolve;
+mod texture;
+
+pub use camera::Camera;
+pub use material::Material;
+pub use mesh::MeshBuilder;
+pub use resolve::resolve_case_insensitive;
+pub use texture::{ColorEncoding, Texture, TextureId};
+
+use std::path::{Path, PathBuf};
+
+use rtgi_math::{Aabb, Vec2, Vec3};
+
+/// A vertex as triangles reference it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Vertex {
+    pub position: Vec3,
+    /// Unit shading normal (computed from the faces where the file has none).
+    pub normal: Vec3,
+    /// Texture coordinates with the origin at the top left of the image (OBJ's
+    /// bottom-left `v` is flipped on import).
+    pub uv: Vec2,
+}
+
+/// A triangle: indices into [`Scene::vertices`] and [`Scene::materials`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Triangle {
+    pub vertices: [u32; 3],
+    pub material: u32,
+}
+
+/// Everything a renderer needs to know about a scene.
+#[derive(Clone, Debug, Default)]
+pub struct Scene {
+    pub vertices: Vec<Vertex>,
+    pub triangles: Vec<Triangle>,
+    pub materials: Vec<Material>,
+    pub textures: Vec<Texture>,
+    pub cameras: Vec<Camera>,
+    /// Problems that did not stop the import (a missing texture, an unknown material).
+    pub warnings: Vec<String>,
+}
+
+/// Why a scene could not be loaded; every variant names the file.
+#[derive(Debug, thiserror::Error)]
+pub enum SceneError {
+    #[error("{path}: cannot read: {source}")]
+    Io { path: PathBuf, source: std::io::Error },
+    #[error("{path}: not a valid OBJ file: {message}")]
+    Obj { path: PathBuf, message: String },
+    #[error("{path}: not a valid scene description: {message}")]
+    Description { path: PathBuf, message: String },
+    #[error("{path}: unsupported scene format (expected .obj or .toml)")]
+    UnsupportedFormat { path: PathBuf },
+}
+
+impl Scene {
+    /// Loads a scene, choosing the importer by the file's extension.
+    pub fn load(path: &Path) -> Result<Scene, SceneError> {
+        if !path.is_file() {
+            let source = if path.exists() {
+                std::io::Error::new(std::io::ErrorKind::InvalidInput, "not a file")
+            } else {
+                std::io::Error::new(std::io::ErrorKind::NotFound, "no such file")
+            };
+            return Err(SceneError::Io { path: path.to_owned(), source });
+        }
+        let extension = path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase);
+        match extension.as_deref() {
+            Some("obj") => obj::load(path),
+            Some("toml") => description::load(path),
+            _ => Err(SceneError::UnsupportedFormat { path: path.to_owned() }),
+        }
+    }
+
+    /// The corner positions of every triangle, in triangle order: what an
+    /// acceleration structure is built from.
+    pub fn triangle_positions(&self) -> Vec<[Vec3; 3]> {
+        self.triangles.iter().map(|t| t.vertices.map(|v| self.vertices[v as usize].position)).collect()
+    }
+
+    /// The box around all finite vertex positions used by triangles.
+    pub fn bounds(&self) -> Aabb {
+        self.triangles
+            .iter()
+            .flat_map(|t| t.vertices)
+            .map(|v| self.vertices[v as usize].position)
+            .filter(|p| p.is_finite())
+            .fold(Aabb::EMPTY, |b, p| b.grow(p))
+    }
+
+    /// Appends `other`, renumbering its vertices, materials and textures.
+    pub fn append(&mut self, other: Scene) {
+        let vertex_base = self.vertices.len() as u32;
+        let material_base = self.materials.len() as u32;
+        let texture_base = self.textures.len() as u32;
+        self.vertices.extend(other.vertices);
+        self.triangles.extend(
+            other.triangles.into_iter().map(|t| Triangle {
+                vertices: t.vertices.map(|v| v + vertex_base),
+                material: t.material + material_base,
+            }),
+        );
+        self.materials.extend(other.materials.into_iter().map(|mut m| {
+            m.offset_textures(texture_base);
+            m
+        }));
+        self.textures.extend(other.textures);
+        self.cameras.extend(other.cameras);
+        self.warnings.extend(other.warnings);
+    }
+
+    /// Interpolates a vertex attribute at barycentric coordinates `(beta, gamma)`.
+    #[inline]
+    pub fn interpolate<T>(&self, triangle: &Triangle, beta: f32, gamma: f32, attribute: impl Fn(&Vertex) -> T) -> T
+    where
+        T: std::ops::Mul<f32, Output = T> + std::ops::Add<Output = T>,
+    {
+        let [a, b, c] = triangle.vertices.map(|v| attribute(&self.vertices[v as usize]));
+        a * (1.0 - beta - gamma) + b * beta + c * gamma
+    }
+}

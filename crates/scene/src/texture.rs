@@ -1,0 +1,171 @@
+use std::path::Path;
+use std::sync::LazyLock;
+
+use rtgi_math::{Vec2, Vec4};
+
+/// Index of a texture in [`Scene::textures`](crate::Scene::textures).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct TextureId(pub u32);
+
+/// How a texture's 8-bit values map to linear values.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ColorEncoding {
+    /// Colours (base colour, emission): sRGB-encoded.
+    Srgb,
+    /// Data (normals, roughness): stored linearly.
+    Linear,
+}
+
+/// An 8-bit RGBA image, sampled with bilinear filtering and repeat wrapping.
+///
+/// Texels are kept as bytes (a quarter of the memory of floats) and decoded
+/// through a table on lookup.
+#[derive(Clone, PartialEq)]
+pub struct Texture {
+    /// Where the texture came from, for messages.
+    pub name: String,
+    width: u32,
+    height: u32,
+    texels: Vec<[u8; 4]>,
+    encoding: ColorEncoding,
+}
+
+impl std::fmt::Debug for Texture {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Texture")
+            .field("name", &self.name)
+            .field("width", &self.width)
+            .field("height", &self.height)
+            .field("encoding", &self.encoding)
+            .finish_non_exhaustive()
+    }
+}
+
+static SRGB_TO_LINEAR: LazyLock<[f32; 256]> = LazyLock::new(|| {
+    std::array::from_fn(|i| {
+        let c = i as f32 / 255.0;
+        if c <= 0.040_45 { c / 12.92 } else { ((c + 0.055) / 1.055).powf(2.4) }
+    })
+});
+
+impl Texture {
+    /// A texture from RGBA bytes, row by row from the top; `None` if the sizes disagree or are zero.
+    pub fn from_rgba8(
+        name: impl Into<String>,
+        width: u32,
+        height: u32,
+        texels: Vec<[u8; 4]>,
+        encoding: ColorEncoding,
+    ) -> Option<Self> {
+        (width > 0 && height > 0 && texels.len() == width as usize * height as usize).then(|| Self {
+            name: name.into(),
+            width,
+            height,
+            texels,
+            encoding,
+        })
+    }
+
+    /// Decodes a PNG or JPEG file.
+    pub fn load(path: &Path, encoding: ColorEncoding) -> Result<Self, String> {
+        let decoded = image::open(path).map_err(|e| format!("{}: {e}", path.display()))?.to_rgba8();
+        let (width, height) = decoded.dimensions();
+        let texels = decoded.pixels().map(|p| p.0).collect();
+        Self::from_rgba8(path.display().to_string(), width, height, texels, encoding)
+            .ok_or_else(|| format!("{}: empty image", path.display()))
+    }
+
+    /// A magenta and black checkerboard that stands in for a texture that
+    /// could not be loaded: impossible to mistake for real content.
+    pub fn missing(name: impl Into<String>) -> Self {
+        let texels = (0..64).map(|i| if (i % 8 + i / 8) % 2 == 0 { [255, 0, 255, 255] } else { [0, 0, 0, 255] });
+        Self { name: name.into(), width: 8, height: 8, texels: texels.collect(), encoding: ColorEncoding::Srgb }
+    }
+
+    pub fn width(&self) -> u32 {
+        self.width
+    }
+
+    pub fn height(&self) -> u32 {
+        self.height
+    }
+
+    pub fn encoding(&self) -> ColorEncoding {
+        self.encoding
+    }
+
+    /// Whether any texel is less than fully opaque.
+    pub fn has_alpha(&self) -> bool {
+        self.texels.iter().any(|t| t[3] < 255)
+    }
+
+    #[inline]
+    fn texel(&self, x: u32, y: u32) -> Vec4 {
+        let [r, g, b, a] = self.texels[(y * self.width + x) as usize];
+        let alpha = a as f32 * (1.0 / 255.0);
+        match self.encoding {
+            ColorEncoding::Srgb => {
+                let table = &*SRGB_TO_LINEAR;
+                Vec4::new(table[r as usize], table[g as usize], table[b as usize], alpha)
+            }
+            ColorEncoding::Linear => Vec4::new(r as f32, g as f32, b as f32, a as f32) * (1.0 / 255.0),
+        }
+    }
+
+    /// The linear value at `uv` (origin top left, one repeat per unit), bilinearly filtered.
+    pub fn sample(&self, uv: Vec2) -> Vec4 {
+        if !uv.is_finite() {
+            return self.texel(0, 0);
+        }
+        // Texel centres sit at half-integer positions.
+        let x = uv.x * self.width as f32 - 0.5;
+        let y = uv.y * self.height as f32 - 0.5;
+        let (x0, y0) = (x.floor(), y.floor());
+        let (fx, fy) = (x - x0, y - y0);
+        let wrap = |i: f32, n: u32| (i as i64).rem_euclid(n as i64) as u32;
+        let (xa, xb) = (wrap(x0, self.width), wrap(x0 + 1.0, self.width));
+        let (ya, yb) = (wrap(y0, self.height), wrap(y0 + 1.0, self.height));
+        let top = self.texel(xa, ya) * (1.0 - fx) + self.texel(xb, ya) * fx;
+        let bottom = self.texel(xa, yb) * (1.0 - fx) + self.texel(xb, yb) * fx;
+        top * (1.0 - fy) + bottom * fy
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn two_by_one() -> Texture {
+        Texture::from_rgba8("t", 2, 1, vec![[0, 0, 0, 255], [255, 255, 255, 255]], ColorEncoding::Linear).unwrap()
+    }
+
+    #[test]
+    fn texel_centres_are_exact_and_between_is_linear() {
+        let t = two_by_one();
+        assert_eq!(t.sample(Vec2::new(0.25, 0.5)).x, 0.0);
+        assert_eq!(t.sample(Vec2::new(0.75, 0.5)).x, 1.0);
+        assert!((t.sample(Vec2::new(0.5, 0.5)).x - 0.5).abs() < 1e-6);
+    }
+
+    #[test]
+    fn coordinates_repeat() {
+        let t = two_by_one();
+        assert_eq!(t.sample(Vec2::new(1.25, 7.5)), t.sample(Vec2::new(0.25, 0.5)));
+        assert_eq!(t.sample(Vec2::new(-0.75, -3.5)), t.sample(Vec2::new(0.25, 0.5)));
+    }
+
+    #[test]
+    fn srgb_texels_are_decoded() {
+        let t = Texture::from_rgba8("s", 1, 1, vec![[188, 0, 255, 128]], ColorEncoding::Srgb).unwrap();
+        let v = t.sample(Vec2::new(0.5, 0.5));
+        assert!((v.x - 0.5029).abs() < 1e-3, "{v}");
+        assert_eq!(v.z, 1.0);
+        assert!((v.w - 128.0 / 255.0).abs() < 1e-6);
+    }
+
+    #[test]
+    fn wrong_sizes_are_refused() {
+        assert!(Texture::from_rgba8("x", 2, 2, vec![[0; 4]; 3], ColorEncoding::Linear).is_none());
+        assert!(Texture::from_rgba8("x", 0, 0, vec![], ColorEncoding::Linear).is_none());
+    }
+}

@@ -1,0 +1,74 @@
+//! Helpers shared by the end-to-end tests: finding the shared scenes,
+//! running the CLI, scratch folders.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+/// The environment variable that points the tests at another copy of the shared scenes.
+pub const SCENES_VARIABLE: &str = "RTGI_SCENES";
+
+/// The workspace's root folder.
+pub fn workspace_root() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).parent().expect("tests/ sits inside the workspace").to_path_buf()
+}
+
+/// The folder of shared third-party scenes: `$RTGI_SCENES`, or
+/// `../shared/scenes` beside the workspace.
+pub fn shared_scenes() -> PathBuf {
+    std::env::var_os(SCENES_VARIABLE)
+        .map(PathBuf::from)
+        .unwrap_or_else(|| workspace_root().join("..").join("shared").join("scenes"))
+}
+
+/// The path of a shared scene file, or `None` after saying why the calling
+/// test skips.
+pub fn shared_scene(relative: &str) -> Option<PathBuf> {
+    let path = shared_scenes().join(relative);
+    if path.is_file() {
+        Some(path)
+    } else {
+        eprintln!(
+            "skipping: shared scene {} not found (set {SCENES_VARIABLE} to the folder of shared scenes)",
+            path.display()
+        );
+        None
+    }
+}
+
+/// A fresh empty folder for one test's files.
+pub fn scratch_dir(test: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("rtgi-tests-{}-{test}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).expect("cannot create a scratch folder");
+    dir
+}
+
+/// What a run of the CLI did.
+#[derive(Debug)]
+pub struct Run {
+    pub success: bool,
+    pub code: Option<i32>,
+    pub stdout: String,
+    pub stderr: String,
+}
+
+impl From<Output> for Run {
+    fn from(o: Output) -> Self {
+        Run {
+            success: o.status.success(),
+            code: o.status.code(),
+            stdout: String::from_utf8_lossy(&o.stdout).into_owned(),
+            stderr: String::from_utf8_lossy(&o.stderr).into_owned(),
+        }
+    }
+}
+
+/// Runs the `rtgi` command (the binary at `program`) with `args` in the workspace root.
+pub fn run_cli(program: &str, args: &[&str]) -> Run {
+    Command::new(program)
+        .args(args)
+        .current_dir(workspace_root())
+        .output()
+        .expect("cannot start the rtgi binary")
+        .into()
+}
