@@ -2,7 +2,7 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 use clap::{Args, Parser, Subcommand};
-use rtgi_accel::AccelKind;
+use rtgi_accel::{AccelKind, BuildParams};
 use rtgi_image::ToneOperator;
 use rtgi_math::Vec3;
 use rtgi_render::PixelSampler;
@@ -55,9 +55,8 @@ pub(crate) struct RenderArgs {
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1024))]
     pub(crate) threads: Option<u32>,
 
-    /// Acceleration structure
-    #[arg(long, default_value = "linear")]
-    pub(crate) accel: AccelKind,
+    #[command(flatten)]
+    pub(crate) accel: AccelArgs,
 
     #[command(flatten)]
     pub(crate) camera: CameraArgs,
@@ -73,6 +72,41 @@ pub(crate) struct RenderArgs {
     /// Radiance of rays that hit nothing, as R,G,B
     #[arg(long, value_parser = parse_vec3, default_value = "0.05,0.05,0.06")]
     pub(crate) background: Vec3,
+}
+
+/// The acceleration structure and its build parameters.
+#[derive(Debug, Args)]
+pub(crate) struct AccelArgs {
+    /// Acceleration structure: linear, object-median, spatial-median, sah, sah-sweep
+    #[arg(long, default_value = "sah")]
+    pub(crate) accel: AccelKind,
+
+    /// Most triangles in a BVH leaf
+    #[arg(long, default_value_t = BuildParams::default().max_leaf_size as u32, value_parser = clap::value_parser!(u32).range(1..=255))]
+    pub(crate) leaf_size: u32,
+
+    /// Bins per axis of the binned SAH build
+    #[arg(long, default_value_t = BuildParams::default().sah_bins as u32, value_parser = clap::value_parser!(u32).range(2..=256))]
+    pub(crate) sah_bins: u32,
+
+    /// Cost of a BVH traversal step relative to a ray/triangle test, for the SAH
+    #[arg(long, default_value_t = BuildParams::default().traversal_cost)]
+    pub(crate) traversal_cost: f32,
+}
+
+impl AccelArgs {
+    pub(crate) fn params(&self) -> BuildParams {
+        BuildParams {
+            max_leaf_size: self.leaf_size as usize,
+            sah_bins: self.sah_bins as usize,
+            traversal_cost: self.traversal_cost,
+        }
+    }
+
+    /// Builds the chosen structure over the scene's triangles.
+    pub(crate) fn build(&self, scene: &rtgi_scene::Scene) -> Box<dyn rtgi_accel::Accel> {
+        self.accel.build(&scene.triangle_positions(), &self.params())
+    }
 }
 
 /// Camera options; any given override the scene's camera (or the automatic framing).

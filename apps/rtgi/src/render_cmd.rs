@@ -3,7 +3,7 @@ use std::time::Instant;
 
 use anyhow::{Context, Result, bail};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
-use rtgi_accel::{Accel, BuildParams};
+use rtgi_accel::Accel;
 use rtgi_image::{ToneMap, check_writable};
 use rtgi_render::{PixelSampler, RenderSettings, frame_scene, render};
 use rtgi_scene::{Camera, Scene};
@@ -43,7 +43,7 @@ pub(crate) fn run(args: &RenderArgs) -> Result<()> {
     }
     let pool = pool.build().context("cannot start worker threads")?;
 
-    let accel = pool.install(|| args.accel.build(&scene.triangle_positions(), &BuildParams::default()));
+    let accel = pool.install(|| args.accel.build(&scene));
     let camera = choose_camera(&scene, accel.as_ref(), &args.camera, args.width as f32 / args.height as f32)?;
     let (image, stats) = pool.install(|| {
         let bar = progress_bar(args.width as u64 * args.height as u64);

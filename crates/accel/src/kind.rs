@@ -3,25 +3,37 @@ use std::str::FromStr;
 
 use rtgi_math::Vec3;
 
-use crate::{Accel, LinearScan};
+use crate::{Accel, Bvh, LinearScan, SplitMethod};
 
 /// The acceleration structures this crate offers, selectable by name.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum AccelKind {
     /// Test every triangle: O(n) per ray.
     Linear,
+    /// BVH split at the median primitive along the longest axis.
+    ObjectMedian,
+    /// BVH split at the middle of the longest axis.
+    SpatialMedian,
+    /// BVH split by the binned surface area heuristic.
+    Sah,
+    /// BVH split by the surface area heuristic over all centroid positions.
+    SahSweep,
 }
 
 /// Parameters of a build; structures ignore those that do not apply to them.
 #[derive(Clone, Debug, PartialEq)]
 pub struct BuildParams {
-    /// Most triangles in a leaf.
+    /// Most triangles in a leaf (a leaf may hold fewer when the SAH says so).
     pub max_leaf_size: usize,
+    /// Bins per axis of the binned SAH build (2 to 256).
+    pub sah_bins: usize,
+    /// Cost of a traversal step relative to one ray/triangle test, for the SAH.
+    pub traversal_cost: f32,
 }
 
 impl Default for BuildParams {
     fn default() -> Self {
-        Self { max_leaf_size: 4 }
+        Self { max_leaf_size: 4, sah_bins: 16, traversal_cost: 1.0 }
     }
 }
 
@@ -35,20 +47,59 @@ pub struct UnknownAccel {
 
 impl AccelKind {
     /// Every variant, in the order tables list them.
-    pub const ALL: &'static [AccelKind] = &[AccelKind::Linear];
+    pub const ALL: &'static [AccelKind] =
+        &[AccelKind::Linear, AccelKind::ObjectMedian, AccelKind::SpatialMedian, AccelKind::Sah, AccelKind::SahSweep];
 
     /// The name used on command lines and in tables.
     pub fn name(self) -> &'static str {
+        match self.split_method() {
+            Some(method) => method.name(),
+            None => "linear",
+        }
+    }
+
+    /// The BVH split method of this variant; `None` for the linear scan.
+    pub fn split_method(self) -> Option<SplitMethod> {
         match self {
-            AccelKind::Linear => "linear",
+            AccelKind::Linear => None,
+            AccelKind::ObjectMedian => Some(SplitMethod::ObjectMedian),
+            AccelKind::SpatialMedian => Some(SplitMethod::SpatialMedian),
+            AccelKind::Sah => Some(SplitMethod::BinnedSah),
+            AccelKind::SahSweep => Some(SplitMethod::SweepSah),
         }
     }
 
     /// Builds this structure over `triangles`; hits name triangles by their index here.
-    pub fn build(self, triangles: &[[Vec3; 3]], _params: &BuildParams) -> Box<dyn Accel> {
-        match self {
-            AccelKind::Linear => Box::new(LinearScan::new(triangles)),
+    pub fn build(self, triangles: &[[Vec3; 3]], params: &BuildParams) -> Box<dyn Accel> {
+        match self.split_method() {
+            None => Box::new(LinearScan::new(triangles)),
+            Some(method) => Box::new(Bvh::new(triangles, method, params)),
         }
+    }
+}
+
+impl AccelKind {
+    /// Every variant with a spread of build parameters (leaf sizes 1, 3 and
+    /// 8; for the binned SAH also 2 and 32 bins): the configurations that
+    /// tests run each case over, so that a new variant is tested as soon as
+    /// it is added to [`AccelKind::ALL`].
+    pub fn all_configurations() -> Vec<(AccelKind, BuildParams)> {
+        let mut configurations = Vec::new();
+        for &kind in Self::ALL {
+            if kind.split_method().is_none() {
+                configurations.push((kind, BuildParams::default()));
+                continue;
+            }
+            for max_leaf_size in [1, 3, 8] {
+                configurations.push((kind, BuildParams { max_leaf_size, ..BuildParams::default() }));
+            }
+            if kind == AccelKind::Sah {
+                for sah_bins in [2, 32] {
+                    configurations.push((kind, BuildParams { sah_bins, ..BuildParams::default() }));
+                }
+            }
+        }
+        configurations
     }
 }
 

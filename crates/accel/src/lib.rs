@@ -20,11 +20,14 @@
 //! assert!(accel.occluded(&ray));
 //! ```
 
+mod boxa;
+mod bvh;
 mod counters;
 mod kind;
 mod linear;
 mod triangle;
 
+pub use bvh::{Bvh, BvhNode, SplitMethod};
 pub use counters::{Counter, NoCounter, TraversalCounters};
 pub use kind::{AccelKind, BuildParams, UnknownAccel};
 pub use linear::LinearScan;
@@ -49,11 +52,22 @@ pub struct Hit {
 pub struct BuildStats {
     /// Name of the variant, as [`AccelKind::name`] gives it.
     pub variant: String,
+    /// Triangles given to the build.
     pub triangles: usize,
+    /// Triangles left out because they can never be hit (zero area, or a
+    /// NaN or infinite coordinate).
+    pub excluded_triangles: usize,
     pub build_ms: f64,
     pub nodes: usize,
     pub leaves: usize,
+    /// Edges on the longest path from the root to a leaf.
     pub depth: usize,
+    /// `leaf_size_histogram[k]` leaves hold `k` triangles.
+    pub leaf_size_histogram: Vec<usize>,
+    /// The tree's SAH cost in units of one triangle test, with the build's
+    /// traversal cost: the quality number of a tree (lower is better).
+    pub sah_cost: f32,
+    /// Bytes of nodes, triangles and index tables.
     pub memory_bytes: usize,
 }
 

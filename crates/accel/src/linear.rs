@@ -20,6 +20,7 @@ impl LinearScan {
         let stats = BuildStats {
             variant: "linear".into(),
             triangles: triangles.len(),
+            excluded_triangles: triangles.iter().filter(|t| !crate::bvh::is_hittable(t)).count(),
             build_ms: start.elapsed().as_secs_f64() * 1e3,
             memory_bytes: std::mem::size_of_val(triangles.as_slice()),
             ..BuildStats::default()

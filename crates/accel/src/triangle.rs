@@ -1,4 +1,4 @@
-use rtgi_math::Vec3;
+use rtgi_math::{Vec3, Vec3A};
 
 /// Where a ray hits a triangle: distance and barycentric coordinates.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -18,6 +18,18 @@ pub struct TriangleHit {
 /// are never hit.
 #[inline]
 pub fn intersect_triangle(origin: Vec3, direction: Vec3, t_min: f32, t_max: f32, v: &[Vec3; 3]) -> Option<TriangleHit> {
+    moller_trumbore(origin.into(), direction.into(), t_min, t_max, &v.map(Vec3A::from))
+}
+
+/// [`intersect_triangle`] on SIMD vectors, as the structures store them.
+#[inline(always)]
+pub(crate) fn moller_trumbore(
+    origin: Vec3A,
+    direction: Vec3A,
+    t_min: f32,
+    t_max: f32,
+    v: &[Vec3A; 3],
+) -> Option<TriangleHit> {
     let edge1 = v[1] - v[0];
     let edge2 = v[2] - v[0];
     let p = direction.cross(edge2);

@@ -24,6 +24,6 @@ pub use aabb::Aabb;
 pub use float::{gamma, next_float_down, next_float_up};
 pub use frame::Frame;
 pub use glam;
-pub use glam::{Mat3, Mat4, UVec2, Vec2, Vec3, Vec3A, Vec4, vec2, vec3};
+pub use glam::{BVec3A, Mat3, Mat4, Vec2, Vec3, Vec3A, Vec4, vec2, vec3};
 pub use ray::{Ray, RayWithInverse};
 pub use rng::{Rng, hash_u64};

@@ -1,0 +1,287 @@
+//! Top-down construction, shared by every split method.
+//!
+//! The builder sees only one box per primitive: it never looks at
+//! triangles. It works on an array of [`PrimRef`]s (a box and the index of
+//! its primitive) that split functions reorder in place, so every pass over
+//! a node's primitives reads memory sequentially. A node over `n` primitives
+//! owns `2n - 1` slots of a scratch array (enough for any subtree over them),
+//! so the two subtrees of a node get disjoint halves of its slots and are
+//! built in parallel without locks. A final pass lays the used slots out
+//! compactly with siblings side by side, and measures the tree.
+
+use rtgi_math::{Vec3, Vec3A, Vec4};
+
+use rayon::prelude::*;
+
+use super::{BvhNode, median, sah};
+use crate::BuildParams;
+use crate::boxa::BoxA;
+
+/// How a node's primitives are divided between its two children.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SplitMethod {
+    /// Equal counts: sort by centroid along the longest axis, split at the median.
+    ObjectMedian,
+    /// Split the longest axis of the node's box at its middle.
+    SpatialMedian,
+    /// Surface area heuristic evaluated at the borders of `BuildParams::sah_bins` bins per axis.
+    BinnedSah,
+    /// Surface area heuristic evaluated between every pair of neighbouring centroids on all three axes.
+    SweepSah,
+}
+
+impl SplitMethod {
+    pub fn name(self) -> &'static str {
+        match self {
+            SplitMethod::ObjectMedian => "object-median",
+            SplitMethod::SpatialMedian => "spatial-median",
+            SplitMethod::BinnedSah => "sah",
+            SplitMethod::SweepSah => "sah-sweep",
+        }
+    }
+}
+
+/// Below this depth the chosen method splits; deeper, the object median
+/// does, which halves the count at every level. Together these bound the
+/// depth by 64 + 32, within the traversal's fixed stack of
+/// `traverse::STACK_SIZE` entries.
+pub(crate) const HEURISTIC_DEPTH_LIMIT: usize = 64;
+
+/// Subtrees over at least this many primitives are built in parallel.
+const PARALLEL_THRESHOLD: usize = 2048;
+
+/// A primitive as the builder sees it: its box, with the primitive's index
+/// in the fourth lane of `min` (stored with bit 30 set, so that the lane is
+/// a normal float and never slows the box arithmetic that also runs on it).
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct PrimRef {
+    min_index: Vec4,
+    max: Vec4,
+}
+
+const INDEX_BIAS: u32 = 1 << 30;
+
+impl PrimRef {
+    fn new(bounds: BoxA, index: u32) -> Self {
+        Self { min_index: bounds.min.extend(f32::from_bits(index | INDEX_BIAS)), max: bounds.max.extend(0.0) }
+    }
+
+    #[inline(always)]
+    pub(crate) fn index(&self) -> u32 {
+        self.min_index.w.to_bits() & !INDEX_BIAS
+    }
+
+    #[inline(always)]
+    pub(crate) fn bounds(&self) -> BoxA {
+        BoxA { min: Vec3A::from_vec4(self.min_index), max: Vec3A::from_vec4(self.max) }
+    }
+
+    /// Twice the centroid: the builder compares centroids only with each
+    /// other, so the halving is left out.
+    #[inline(always)]
+    pub(crate) fn centroid2(&self) -> Vec3A {
+        Vec3A::from_vec4(self.min_index + self.max)
+    }
+}
+
+/// What [`build`] hands back: the flattened nodes and the primitive order.
+pub(crate) struct Tree {
+    pub(crate) nodes: Vec<BvhNode>,
+    /// Primitive indices (into the builder's input) in leaf order.
+    pub(crate) order: Vec<u32>,
+    pub(crate) leaves: usize,
+    pub(crate) depth: usize,
+    pub(crate) leaf_size_histogram: Vec<usize>,
+    pub(crate) sah_cost: f32,
+}
+
+/// Read-only inputs of every recursion step.
+pub(crate) struct Context {
+    pub(crate) method: SplitMethod,
+    pub(crate) max_leaf_size: usize,
+    pub(crate) sah_bins: usize,
+    pub(crate) traversal_cost: f32,
+}
+
+/// A node before layout, 32 bytes: leaves have `count > 0` and their
+/// primitives start at `link`; an interior node's left child is in the next
+/// slot and its right child in slot `link`.
+#[derive(Clone, Copy, Debug, Default)]
+struct Slot {
+    min: Vec3,
+    link: u32,
+    max: Vec3,
+    count: u32,
+}
+
+impl Slot {
+    fn new(bounds: BoxA, link: u32, count: u32) -> Self {
+        Slot { min: bounds.min.into(), link, max: bounds.max.into(), count }
+    }
+
+    fn bounds(&self) -> BoxA {
+        BoxA { min: self.min.into(), max: self.max.into() }
+    }
+}
+
+/// Bounds of a range of primitives and of their (doubled) centroids.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct RangeBounds {
+    pub(crate) bounds: BoxA,
+    pub(crate) centroids: BoxA,
+}
+
+impl RangeBounds {
+    pub(crate) const EMPTY: RangeBounds = RangeBounds { bounds: BoxA::EMPTY, centroids: BoxA::EMPTY };
+
+    #[inline(always)]
+    pub(crate) fn add(&mut self, prim: &PrimRef) {
+        self.bounds = self.bounds.union(prim.bounds());
+        self.centroids = self.centroids.grow(prim.centroid2());
+    }
+
+    fn union(self, other: RangeBounds) -> RangeBounds {
+        RangeBounds { bounds: self.bounds.union(other.bounds), centroids: self.centroids.union(other.centroids) }
+    }
+
+    /// The bounds of a range of primitives; in parallel for long ranges.
+    pub(crate) fn of(prims: &[PrimRef]) -> Self {
+        const CHUNK: usize = 16 * 1024;
+        let of_chunk = |chunk: &[PrimRef]| {
+            let mut r = RangeBounds::EMPTY;
+            for prim in chunk {
+                r.add(prim);
+            }
+            r
+        };
+        if prims.len() <= CHUNK {
+            return of_chunk(prims);
+        }
+        prims.par_chunks(CHUNK).map(of_chunk).reduce(|| RangeBounds::EMPTY, RangeBounds::union)
+    }
+}
+
+/// A split of a node's range: the first `left_count` primitives (after the
+/// split function reordered them) go to the left child.
+pub(crate) struct Split {
+    pub(crate) left_count: usize,
+    pub(crate) left: RangeBounds,
+    pub(crate) right: RangeBounds,
+}
+
+impl Split {
+    /// A split whose children's bounds are measured afresh.
+    pub(crate) fn measured(prims: &[PrimRef], left_count: usize) -> Split {
+        let (left, right) = prims.split_at(left_count);
+        Split { left_count, left: RangeBounds::of(left), right: RangeBounds::of(right) }
+    }
+}
+
+pub(crate) fn build(boxes: &[BoxA], method: SplitMethod, params: &BuildParams) -> Tree {
+    let n = boxes.len();
+    if n == 0 {
+        return Tree {
+            nodes: Vec::new(),
+            order: Vec::new(),
+            leaves: 0,
+            depth: 0,
+            leaf_size_histogram: vec![],
+            sah_cost: 0.0,
+        };
+    }
+    let ctx = Context {
+        method,
+        max_leaf_size: params.max_leaf_size.max(1),
+        sah_bins: params.sah_bins.clamp(2, 256),
+        traversal_cost: params.traversal_cost.max(0.0),
+    };
+    let mut prims: Vec<PrimRef> = boxes.par_iter().enumerate().map(|(i, b)| PrimRef::new(*b, i as u32)).collect();
+    let mut slots = vec![Slot::default(); 2 * n - 1];
+    let root = RangeBounds::of(&prims);
+    build_node(&ctx, &mut prims, 0, &mut slots, 0, 0, root);
+    let order = prims.iter().map(PrimRef::index).collect();
+    layout(&slots, order, params.traversal_cost)
+}
+
+/// Builds the subtree over `prims` (which start at position `first` of the
+/// final order) into `slots`, whose first element is at `slot_base`.
+fn build_node(
+    ctx: &Context,
+    prims: &mut [PrimRef],
+    first: u32,
+    slots: &mut [Slot],
+    slot_base: u32,
+    depth: usize,
+    range: RangeBounds,
+) {
+    let n = prims.len();
+    let split = if n <= 1 {
+        None
+    } else if depth >= HEURISTIC_DEPTH_LIMIT {
+        Some(median::object_median(prims, &range))
+    } else {
+        match ctx.method {
+            SplitMethod::ObjectMedian => (n > ctx.max_leaf_size).then(|| median::object_median(prims, &range)),
+            SplitMethod::SpatialMedian => (n > ctx.max_leaf_size).then(|| median::spatial_median(prims, &range)),
+            SplitMethod::BinnedSah => sah::binned(ctx, prims, &range),
+            SplitMethod::SweepSah => sah::sweep(ctx, prims, &range),
+        }
+    };
+    let (this, rest) = slots.split_first_mut().expect("a subtree over n primitives has 2n - 1 slots");
+    let Some(Split { left_count, left: left_range, right: right_range }) = split else {
+        *this = Slot::new(range.bounds, first, n as u32);
+        return;
+    };
+    debug_assert!(left_count > 0 && left_count < n);
+    let (left_slots, right_slots) = rest.split_at_mut(2 * left_count - 1);
+    let right_slot = slot_base + 2 * left_count as u32;
+    *this = Slot::new(range.bounds, right_slot, 0);
+    let (left_prims, right_prims) = prims.split_at_mut(left_count);
+    let right_first = first + left_count as u32;
+    let mut build_left = || build_node(ctx, left_prims, first, left_slots, slot_base + 1, depth + 1, left_range);
+    let mut build_right = || build_node(ctx, right_prims, right_first, right_slots, right_slot, depth + 1, right_range);
+    if n >= PARALLEL_THRESHOLD {
+        rayon::join(build_left, build_right);
+    } else {
+        build_left();
+        build_right();
+    }
+}
+
+/// Lays the used slots out depth-first with siblings adjacent, and measures
+/// the tree: depth, leaves, leaf sizes and SAH cost (intersection cost 1,
+/// traversal cost as given, relative to the root's area).
+fn layout(slots: &[Slot], order: Vec<u32>, traversal_cost: f32) -> Tree {
+    let root_area = slots[0].bounds().half_area();
+    let mut nodes = vec![BvhNode::default()];
+    let mut leaves = 0;
+    let mut depth = 0;
+    let mut histogram = Vec::new();
+    let mut cost = 0.0f64;
+    let mut stack = vec![(0u32, 0u32, 0usize)];
+    while let Some((slot_index, node_index, node_depth)) = stack.pop() {
+        let slot = &slots[slot_index as usize];
+        depth = depth.max(node_depth);
+        let relative_area = if root_area > 0.0 { (slot.bounds().half_area() / root_area) as f64 } else { 1.0 };
+        let (min, max) = (slot.min, slot.max);
+        let node = if slot.count > 0 {
+            leaves += 1;
+            if histogram.len() <= slot.count as usize {
+                histogram.resize(slot.count as usize + 1, 0);
+            }
+            histogram[slot.count as usize] += 1;
+            cost += relative_area * slot.count as f64;
+            BvhNode::new(min, max, slot.link, slot.count)
+        } else {
+            let children = nodes.len() as u32;
+            nodes.push(BvhNode::default());
+            nodes.push(BvhNode::default());
+            cost += relative_area * traversal_cost as f64;
+            stack.push((slot.link, children + 1, node_depth + 1));
+            stack.push((slot_index + 1, children, node_depth + 1));
+            BvhNode::new(min, max, children, 0)
+        };
+        nodes[node_index as usize] = node;
+    }
+    Tree { nodes, order, leaves, depth, leaf_size_histogram: histogram, sah_cost: cost as f32 }
+}

@@ -1,0 +1,313 @@
+//! A binary bounding volume hierarchy over triangles.
+//!
+//! Built top-down ([`build`](self::build)) with one of four split methods
+//! (object median, spatial median, binned SAH, full-sweep SAH), then laid out
+//! as a flat array of 32-byte nodes in which the two children of a node are
+//! neighbours, and traversed front to back with an explicit stack
+//! ([`traverse`](self::traverse)). Triangles are copied into leaf order so
+//! that a leaf's triangles are contiguous in memory.
+
+mod build;
+mod median;
+mod sah;
+mod traverse;
+mod validate;
+
+pub use build::SplitMethod;
+
+use std::time::Instant;
+
+use rayon::prelude::*;
+use rtgi_math::{Aabb, Vec3, Vec3A, Vec4};
+
+use crate::boxa::BoxA;
+use crate::{Accel, BuildParams, BuildStats, Hit, NoCounter, TraversalCounters};
+
+/// A node of the flattened tree: its box, and either the index of its first
+/// child (the second follows it) or, for a leaf, the range of its triangles
+/// in leaf order.
+///
+/// Stored as two 16-byte vectors (32 bytes a node, two to a cache line) so
+/// that traversal loads each corner of the box with one instruction; the
+/// fourth lanes carry the index and the triangle count. They are stored with
+/// bit 30 set, which keeps the lanes normal floating-point numbers (never
+/// subnormal), so the box arithmetic that also runs on them is never slowed
+/// by subnormal operands.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[repr(C)]
+pub struct BvhNode {
+    min_first: Vec4,
+    max_count: Vec4,
+}
+
+/// Set in the packed index lanes; see [`BvhNode`].
+const LANE_BIAS: u32 = 1 << 30;
+
+impl BvhNode {
+    /// The largest index or count a node can hold.
+    pub const MAX_INDEX: u32 = LANE_BIAS - 1;
+
+    /// A node with the given box; `count > 0` makes it a leaf over triangles
+    /// `first..first + count`, `count == 0` an interior node whose children
+    /// are `first` and `first + 1`.
+    pub fn new(min: Vec3, max: Vec3, first: u32, count: u32) -> Self {
+        assert!(first <= Self::MAX_INDEX && count <= Self::MAX_INDEX, "node index out of range");
+        Self {
+            min_first: min.extend(f32::from_bits(first | LANE_BIAS)),
+            max_count: max.extend(f32::from_bits(count | LANE_BIAS)),
+        }
+    }
+
+    /// First child (interior nodes) or first triangle in leaf order (leaves).
+    #[inline(always)]
+    pub fn first(&self) -> u32 {
+        self.min_first.w.to_bits() & !LANE_BIAS
+    }
+
+    /// Number of triangles; 0 for interior nodes.
+    #[inline(always)]
+    pub fn count(&self) -> u32 {
+        self.max_count.w.to_bits() & !LANE_BIAS
+    }
+
+    #[inline(always)]
+    pub fn is_leaf(&self) -> bool {
+        self.count() > 0
+    }
+
+    pub fn min(&self) -> Vec3 {
+        self.min_first.truncate()
+    }
+
+    pub fn max(&self) -> Vec3 {
+        self.max_count.truncate()
+    }
+
+    pub fn bounds(&self) -> Aabb {
+        Aabb::new(self.min(), self.max())
+    }
+
+    /// The box corners as SIMD vectors; their fourth lanes hold the packed fields.
+    #[inline(always)]
+    pub(crate) fn corners(&self) -> (Vec3A, Vec3A) {
+        (Vec3A::from_vec4(self.min_first), Vec3A::from_vec4(self.max_count))
+    }
+}
+
+/// A bounding volume hierarchy over triangles.
+#[derive(Debug)]
+pub struct Bvh {
+    nodes: Vec<BvhNode>,
+    /// Triangle corners in leaf order.
+    triangles: Vec<[Vec3A; 3]>,
+    /// For each triangle in leaf order, its index in the input.
+    triangle_ids: Vec<u32>,
+    stats: BuildStats,
+}
+
+impl Bvh {
+    /// Builds a hierarchy over `triangles` with the given split method.
+    ///
+    /// Triangles with a non-finite coordinate or zero area are left out of
+    /// the tree (they can never be hit) and counted in
+    /// [`BuildStats::excluded_triangles`].
+    pub fn new(triangles: &[[Vec3; 3]], method: SplitMethod, params: &BuildParams) -> Self {
+        let start = Instant::now();
+        let all_hittable = triangles.par_iter().all(is_hittable);
+        let (boxes, ids): (Vec<BoxA>, Vec<u32>) = if all_hittable {
+            (triangles.par_iter().map(BoxA::from_triangle).collect(), (0..triangles.len() as u32).collect())
+        } else {
+            triangles
+                .par_iter()
+                .enumerate()
+                .filter(|(_, t)| is_hittable(t))
+                .map(|(i, t)| (BoxA::from_triangle(t), i as u32))
+                .unzip()
+        };
+        let tree = build::build(&boxes, method, params);
+        let triangle_ids: Vec<u32> = tree.order.par_iter().map(|&p| ids[p as usize]).collect();
+        let leaf_triangles = triangle_ids.par_iter().map(|&i| triangles[i as usize].map(Vec3A::from)).collect();
+        let build_ms = start.elapsed().as_secs_f64() * 1e3;
+
+        let stats = BuildStats {
+            variant: method.name().to_owned(),
+            triangles: triangles.len(),
+            excluded_triangles: triangles.len() - ids.len(),
+            build_ms,
+            nodes: tree.nodes.len(),
+            leaves: tree.leaves,
+            depth: tree.depth,
+            leaf_size_histogram: tree.leaf_size_histogram,
+            sah_cost: tree.sah_cost,
+            memory_bytes: std::mem::size_of_val(tree.nodes.as_slice())
+                + std::mem::size_of::<[Vec3A; 3]>() * triangle_ids.len()
+                + std::mem::size_of_val(triangle_ids.as_slice()),
+        };
+        Self { nodes: tree.nodes, triangles: leaf_triangles, triangle_ids, stats }
+    }
+
+    /// The flattened nodes; the root is node 0 (absent for an empty tree).
+    pub fn nodes(&self) -> &[BvhNode] {
+        &self.nodes
+    }
+
+    /// The input indices of the triangles of a leaf.
+    pub fn leaf_triangles(&self, leaf: &BvhNode) -> &[u32] {
+        &self.triangle_ids[leaf.first() as usize..(leaf.first() + leaf.count()) as usize]
+    }
+
+    /// The boxes of all nodes at the given depths (the root is depth 0); a
+    /// leaf shallower than a requested depth is not repeated below itself.
+    pub fn boxes_at_depths(&self, depths: &[usize]) -> Vec<(usize, Aabb)> {
+        let mut boxes = Vec::new();
+        let mut stack = Vec::new();
+        if !self.nodes.is_empty() {
+            stack.push((0usize, 0usize));
+        }
+        while let Some((index, depth)) = stack.pop() {
+            let node = &self.nodes[index];
+            if depths.contains(&depth) {
+                boxes.push((depth, node.bounds()));
+            }
+            if !node.is_leaf() {
+                stack.push((node.first() as usize + 1, depth + 1));
+                stack.push((node.first() as usize, depth + 1));
+            }
+        }
+        boxes.sort_by_key(|(depth, _)| *depth);
+        boxes
+    }
+}
+
+/// Whether a triangle can ever be hit: finite corners and a non-zero area.
+pub(crate) fn is_hittable(t: &[Vec3; 3]) -> bool {
+    t.iter().all(|v| v.is_finite()) && (t[1] - t[0]).cross(t[2] - t[0]) != Vec3::ZERO
+}
+
+impl Accel for Bvh {
+    fn intersect(&self, ray: &rtgi_math::Ray) -> Option<Hit> {
+        self.closest(ray, &mut NoCounter)
+    }
+
+    fn occluded(&self, ray: &rtgi_math::Ray) -> bool {
+        self.any(ray, &mut NoCounter)
+    }
+
+    fn intersect_counted(&self, ray: &rtgi_math::Ray, counters: &mut TraversalCounters) -> Option<Hit> {
+        counters.rays += 1;
+        self.closest(ray, counters)
+    }
+
+    fn occluded_counted(&self, ray: &rtgi_math::Ray, counters: &mut TraversalCounters) -> bool {
+        counters.rays += 1;
+        self.any(ray, counters)
+    }
+
+    fn build_stats(&self) -> &BuildStats {
+        &self.stats
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::AccelKind;
+    use rtgi_math::{Ray, Rng};
+
+    fn random_soup(count: usize, seed: u64) -> Vec<[Vec3; 3]> {
+        let mut rng = Rng::new(seed, 0);
+        let mut point = |scale: f32| Vec3::new(rng.next_f32(), rng.next_f32(), rng.next_f32()) * scale;
+        (0..count)
+            .map(|_| {
+                let base = point(10.0);
+                [base, base + point(1.0), base + point(1.0)]
+            })
+            .collect()
+    }
+
+    fn every_bvh(triangles: &[[Vec3; 3]]) -> Vec<(String, Bvh)> {
+        AccelKind::all_configurations()
+            .into_iter()
+            .filter_map(|(kind, params)| {
+                let method = kind.split_method()?;
+                Some((format!("{kind} {params:?}"), Bvh::new(triangles, method, &params)))
+            })
+            .collect()
+    }
+
+    #[test]
+    fn trees_are_valid_and_agree_with_the_linear_scan() {
+        let triangles = random_soup(3000, 1);
+        let linear = crate::LinearScan::new(&triangles);
+        let mut rng = Rng::new(2, 0);
+        let rays: Vec<Ray> = (0..500)
+            .map(|_| {
+                let o = Vec3::new(rng.next_f32(), rng.next_f32(), rng.next_f32()) * 14.0 - 2.0;
+                let d = Vec3::new(rng.next_f32(), rng.next_f32(), rng.next_f32()) - 0.5;
+                Ray::new(o, d)
+            })
+            .collect();
+        for (name, bvh) in every_bvh(&triangles) {
+            bvh.validate().unwrap_or_else(|e| panic!("{name}: {e}"));
+            assert_eq!(bvh.stats.excluded_triangles, 0);
+            let max_leaf = bvh.stats.leaf_size_histogram.len() - 1;
+            assert!(max_leaf <= 8, "{name}: leaf of {max_leaf}");
+            for ray in &rays {
+                assert_eq!(bvh.intersect(ray), linear.intersect(ray), "{name}");
+                assert_eq!(bvh.occluded(ray), linear.occluded(ray), "{name}");
+            }
+        }
+    }
+
+    #[test]
+    fn identical_centroids_build_shallow_trees_with_small_leaves() {
+        // 70,000 copies of one triangle: no heuristic can separate them.
+        let triangle = [Vec3::ZERO, Vec3::X, Vec3::Y];
+        let triangles = vec![triangle; 70_000];
+        for (name, bvh) in every_bvh(&triangles) {
+            bvh.validate().unwrap_or_else(|e| panic!("{name}: {e}"));
+            assert!(bvh.stats.depth <= 20, "{name}: depth {}", bvh.stats.depth);
+            assert!(bvh.stats.leaf_size_histogram.len() <= 9, "{name}");
+            let hit = bvh.intersect(&Ray::new(Vec3::new(0.2, 0.2, 1.0), -Vec3::Z)).unwrap();
+            assert_eq!((hit.t, hit.triangle), (1.0, 0), "{name}: the lowest index wins the tie");
+        }
+    }
+
+    #[test]
+    fn spatial_median_survives_one_sided_and_geometric_distributions() {
+        // One huge triangle and a cluster of tiny ones at one end: the middle of
+        // the node's box has every centroid on one side.
+        let mut triangles = vec![[Vec3::ZERO, Vec3::new(1000.0, 0.0, 0.0), Vec3::new(0.0, 1000.0, 0.0)]];
+        // Centroids at 2^-k: each middle split peels off one triangle.
+        for k in 0..120 {
+            let x = 2f32.powi(-k);
+            triangles.push([Vec3::new(x, 0.0, 0.0), Vec3::new(x, 1e-3, 0.0), Vec3::new(x, 0.0, 1e-3)]);
+        }
+        let bvh =
+            Bvh::new(&triangles, SplitMethod::SpatialMedian, &BuildParams { max_leaf_size: 1, ..Default::default() });
+        bvh.validate().unwrap();
+        assert!(bvh.stats.depth < super::traverse::STACK_SIZE, "depth {}", bvh.stats.depth);
+        assert_eq!(bvh.stats.leaves, triangles.len());
+    }
+
+    #[test]
+    fn empty_single_and_unhittable_inputs() {
+        let empty = Bvh::new(&[], SplitMethod::BinnedSah, &BuildParams::default());
+        empty.validate().unwrap();
+        assert!(empty.intersect(&Ray::new(Vec3::ZERO, Vec3::X)).is_none());
+        let one = Bvh::new(&[[Vec3::ZERO, Vec3::X, Vec3::Y]], SplitMethod::BinnedSah, &BuildParams::default());
+        one.validate().unwrap();
+        assert_eq!(one.intersect(&Ray::new(Vec3::new(0.1, 0.1, -1.0), Vec3::Z)).map(|h| h.t), Some(1.0));
+        let bad = [
+            [Vec3::ZERO, Vec3::X, 2.0 * Vec3::X],
+            [Vec3::ZERO, Vec3::ZERO, Vec3::Y],
+            [Vec3::new(f32::NAN, 0.0, 0.0), Vec3::X, Vec3::Y],
+            [Vec3::new(f32::INFINITY, 0.0, 0.0), Vec3::X, Vec3::Y],
+            [Vec3::ZERO, Vec3::X, Vec3::Y],
+        ];
+        let bvh = Bvh::new(&bad, SplitMethod::BinnedSah, &BuildParams::default());
+        bvh.validate().unwrap();
+        assert_eq!(bvh.stats.excluded_triangles, 4);
+        assert_eq!(bvh.intersect(&Ray::new(Vec3::new(0.1, 0.1, -1.0), Vec3::Z)).map(|h| h.triangle), Some(4));
+    }
+}

@@ -1,0 +1,250 @@
+//! Splits by the surface area heuristic (Goldsmith and Salmon 1987;
+//! MacDonald and Booth 1990): the expected cost of a split is
+//! `C_trav + (A_L N_L + A_R N_R) / A` in units of one triangle test, where
+//! `A` are surface areas and `N` primitive counts; a leaf costs `N`.
+
+use rtgi_math::Vec3A;
+
+use super::build::{Context, PrimRef, RangeBounds, Split};
+use super::median::{by_centroid, object_median};
+use crate::boxa::BoxA;
+
+/// Decides between the best split found (its summed `A · N` over both
+/// sides, `f32::INFINITY` when there is none) and a leaf. `None` means leaf;
+/// otherwise the caller performs its split. Ranges larger than the maximum
+/// leaf size are always split.
+fn split_pays(ctx: &Context, count: usize, range: &RangeBounds, best_area_count: f32) -> bool {
+    let must_split = count > ctx.max_leaf_size;
+    if !best_area_count.is_finite() {
+        return must_split;
+    }
+    let node_area = range.bounds.half_area();
+    let split_cost = if node_area > 0.0 {
+        ctx.traversal_cost + best_area_count / node_area
+    } else {
+        ctx.traversal_cost + count as f32
+    };
+    must_split || split_cost < count as f32
+}
+
+/// Bins a node's primitives fall into, per axis.
+#[derive(Clone, Copy)]
+struct Bin {
+    bounds: BoxA,
+    count: u32,
+}
+
+impl Bin {
+    const EMPTY: Bin = Bin { bounds: BoxA::EMPTY, count: 0 };
+}
+
+/// Most bins kept on the stack (and binned in parallel); more use the heap.
+const STACK_BINS: usize = 32;
+
+/// Ranges at least this long are binned in parallel chunks.
+const PARALLEL_BINNING: usize = 32 * 1024;
+
+/// Maps centroids to bins along each axis.
+#[derive(Clone, Copy)]
+struct Binning {
+    origin: Vec3A,
+    scale: Vec3A,
+    last: u32,
+}
+
+/// 1.5 · 2^23: added to a float in [-0.5, 2^22), it leaves the nearest
+/// integer in the low mantissa bits, a float-to-integer conversion in one
+/// addition (Hecker's trick) instead of Rust's saturating `as` casts.
+const ROUNDING_MAGIC: f32 = 12_582_912.0;
+
+impl Binning {
+    /// The bins of a (doubled) centroid along the three axes. Bin `k` holds
+    /// positions in `[k, k + 1)` of the scaled axis, up to ties at the
+    /// borders, which both this and [`Binning::bin`] resolve alike.
+    #[inline(always)]
+    fn bins(&self, centroid: Vec3A) -> [u32; 3] {
+        let shifted = (centroid - self.origin) * self.scale + Vec3A::splat(ROUNDING_MAGIC - 0.5);
+        shifted.to_array().map(|f| (f.to_bits() - ROUNDING_MAGIC.to_bits()).min(self.last))
+    }
+
+    #[inline(always)]
+    fn bin(&self, centroid: Vec3A, axis: usize) -> u32 {
+        let shifted = (centroid[axis] - self.origin[axis]) * self.scale[axis] + (ROUNDING_MAGIC - 0.5);
+        (shifted.to_bits() - ROUNDING_MAGIC.to_bits()).min(self.last)
+    }
+}
+
+/// Binned SAH (Wald, "On fast Construction of SAH-based Bounding Volume
+/// Hierarchies", 2007): centroids are sorted into `sah_bins` equal bins per
+/// axis (fewer for ranges shorter than that), and splits are evaluated only
+/// at bin borders. The children's bounds are gathered while partitioning,
+/// so no extra pass measures them.
+pub(crate) fn binned(ctx: &Context, prims: &mut [PrimRef], range: &RangeBounds) -> Option<Split> {
+    let bins = ctx.sah_bins.min(prims.len()).max(2);
+    // Bin arrays live on the stack, sized to a power of two at least the bin
+    // count, so that short ranges do not initialise arrays they do not use.
+    match bins.next_power_of_two() {
+        2 => binned_on_stack::<2>(ctx, prims, range, bins),
+        4 => binned_on_stack::<4>(ctx, prims, range, bins),
+        8 => binned_on_stack::<8>(ctx, prims, range, bins),
+        16 => binned_on_stack::<16>(ctx, prims, range, bins),
+        32 => binned_on_stack::<32>(ctx, prims, range, bins),
+        _ => {
+            let mut storage: Vec<Vec<Bin>> = vec![vec![Bin::EMPTY; bins]; 3];
+            let [x, y, z] = &mut storage[..] else { unreachable!("three axes") };
+            binned_core(ctx, prims, range, bins, [&mut x[..], &mut y[..], &mut z[..]])
+        }
+    }
+}
+
+fn binned_on_stack<const N: usize>(
+    ctx: &Context,
+    prims: &mut [PrimRef],
+    range: &RangeBounds,
+    bins: usize,
+) -> Option<Split> {
+    let mut storage = [[Bin::EMPTY; N]; 3];
+    let [x, y, z] = &mut storage;
+    binned_core(ctx, prims, range, bins, [&mut x[..bins], &mut y[..bins], &mut z[..bins]])
+}
+
+fn binned_core(
+    ctx: &Context,
+    prims: &mut [PrimRef],
+    range: &RangeBounds,
+    bins: usize,
+    mut per_axis: [&mut [Bin]; 3],
+) -> Option<Split> {
+    let count = prims.len();
+    let origin = range.centroids.min;
+    let extent = range.centroids.max - origin;
+    // Slightly less than bins / extent, so that the largest centroid lands in the last bin.
+    let usable = extent.cmpgt(Vec3A::ZERO) & extent.is_finite_mask();
+    let scale = Vec3A::select(usable, Vec3A::splat(bins as f32 * (1.0 - 1e-6)) / extent, Vec3A::ZERO);
+    let binning = Binning { origin, scale, last: bins as u32 - 1 };
+
+    let fill = |chunk: &[PrimRef], per_axis: &mut [&mut [Bin]; 3]| {
+        for prim in chunk {
+            let bounds = prim.bounds();
+            let slots = binning.bins(prim.centroid2());
+            for axis in 0..3 {
+                let bin = &mut per_axis[axis][slots[axis] as usize];
+                bin.bounds = bin.bounds.union(bounds);
+                bin.count += 1;
+            }
+        }
+    };
+    if count >= PARALLEL_BINNING && bins <= STACK_BINS {
+        use rayon::prelude::*;
+        let partial = prims
+            .par_chunks(PARALLEL_BINNING / 4)
+            .map(|chunk| {
+                let mut local = [[Bin::EMPTY; STACK_BINS]; 3];
+                let [x, y, z] = &mut local;
+                fill(chunk, &mut [&mut x[..bins], &mut y[..bins], &mut z[..bins]]);
+                local
+            })
+            .collect::<Vec<_>>();
+        for local in partial {
+            for axis in 0..3 {
+                for (bin, other) in per_axis[axis].iter_mut().zip(&local[axis]) {
+                    bin.bounds = bin.bounds.union(other.bounds);
+                    bin.count += other.count;
+                }
+            }
+        }
+    } else {
+        fill(prims, &mut per_axis);
+    }
+
+    // best = (sum of A·N over both sides, axis, last bin of the left side)
+    let mut best = (f32::INFINITY, 0, 0);
+    let mut right_cost = [0.0f32; STACK_BINS];
+    let mut right_cost_heap = Vec::new();
+    let right_cost: &mut [f32] = if bins <= STACK_BINS {
+        &mut right_cost[..bins]
+    } else {
+        right_cost_heap.resize(bins, 0.0);
+        &mut right_cost_heap
+    };
+    for axis in (0..3).filter(|&a| usable.test(a)) {
+        let axis_bins = &per_axis[axis];
+        let (mut acc, mut n) = (BoxA::EMPTY, 0u32);
+        for k in (1..bins).rev() {
+            acc = acc.union(axis_bins[k].bounds);
+            n += axis_bins[k].count;
+            right_cost[k] = acc.half_area() * n as f32;
+        }
+        let (mut acc, mut n) = (BoxA::EMPTY, 0u32);
+        for k in 0..bins - 1 {
+            acc = acc.union(axis_bins[k].bounds);
+            n += axis_bins[k].count;
+            if n == 0 || n as usize == count {
+                continue;
+            }
+            let cost = acc.half_area() * n as f32 + right_cost[k + 1];
+            if cost < best.0 {
+                best = (cost, axis, k);
+            }
+        }
+    }
+
+    if !split_pays(ctx, count, range, best.0) {
+        return None;
+    }
+    if !best.0.is_finite() {
+        // All centroids coincide (or no border separates them): equal counts.
+        return Some(object_median(prims, range));
+    }
+    let (_, axis, last_left_bin) = best;
+    let last_left_bin = last_left_bin as u32;
+    // Branch-free partition: which side a primitive goes to is as good as
+    // random near the root, where a branch on it would mispredict half the time.
+    let mut sides = [RangeBounds::EMPTY; 2];
+    let mut left_count = 0;
+    for i in 0..count {
+        let prim = prims[i];
+        let goes_left = binning.bin(prim.centroid2(), axis) <= last_left_bin;
+        prims[i] = prims[left_count];
+        prims[left_count] = prim;
+        left_count += goes_left as usize;
+        sides[goes_left as usize].add(&prim);
+    }
+    let [right, left] = sides;
+    Some(Split { left_count, left, right })
+}
+
+/// Full-sweep SAH: every split between neighbouring centroids on every axis
+/// is evaluated exactly. Slow (three sorts per node), and the reference for
+/// the quality of the binned build.
+pub(crate) fn sweep(ctx: &Context, prims: &mut [PrimRef], range: &RangeBounds) -> Option<Split> {
+    let count = prims.len();
+    let mut best = (f32::INFINITY, 0, 0);
+    let mut sorted: [Vec<PrimRef>; 3] = [prims.to_vec(), prims.to_vec(), prims.to_vec()];
+    let mut right_cost = vec![0.0f32; count];
+    for (axis, order) in sorted.iter_mut().enumerate() {
+        order.sort_unstable_by(by_centroid(axis));
+        let mut acc = BoxA::EMPTY;
+        for k in (1..count).rev() {
+            acc = acc.union(order[k].bounds());
+            right_cost[k] = acc.half_area() * (count - k) as f32;
+        }
+        let mut acc = BoxA::EMPTY;
+        for k in 0..count - 1 {
+            acc = acc.union(order[k].bounds());
+            let cost = acc.half_area() * (k + 1) as f32 + right_cost[k + 1];
+            // Equal costs (coincident boxes) go to the most even split, so
+            // that such ranges halve instead of peeling one primitive a level.
+            let imbalance = |left: usize| left.abs_diff(count - left);
+            if cost < best.0 || (cost == best.0 && imbalance(k + 1) < imbalance(best.2)) {
+                best = (cost, axis, k + 1);
+            }
+        }
+    }
+    if !split_pays(ctx, count, range, best.0) {
+        return None;
+    }
+    let (_, axis, left_count) = best;
+    prims.copy_from_slice(&sorted[axis]);
+    Some(Split::measured(prims, left_count))
+}

@@ -1,0 +1,80 @@
+//! Batches of rays for benchmarks and experiments.
+
+use rtgi_math::{Ray, Rng, Vec2, Vec3};
+use rtgi_scene::{Camera, Scene};
+
+use crate::CameraRays;
+
+/// One ray through the centre of every pixel, row by row from the top.
+pub fn primary_rays(camera: &Camera, width: u32, height: u32) -> Vec<Ray> {
+    let rays = CameraRays::new(camera, width, height);
+    (0..height).flat_map(|y| (0..width).map(move |x| (x, y))).map(|(x, y)| rays.ray(x, y, Vec2::splat(0.5))).collect()
+}
+
+/// Incoherent rays: origins uniformly distributed over the scene's surfaces
+/// (triangles chosen in proportion to their area), directions uniform on the
+/// sphere. The same seed gives the same rays. Each origin is lifted off its
+/// surface along the geometric normal by a relative 1e-4 of the scene's
+/// size, so that rays do not start inside the surface they leave (this batch
+/// measures traversal, not self-intersection).
+pub fn surface_rays(scene: &Scene, count: usize, seed: u64) -> Vec<Ray> {
+    let triangles = scene.triangle_positions();
+    let areas: Vec<f64> = triangles.iter().map(|t| 0.5 * (t[1] - t[0]).cross(t[2] - t[0]).length() as f64).collect();
+    let mut cumulative = Vec::with_capacity(areas.len());
+    let mut total = 0.0;
+    for a in &areas {
+        total += if a.is_finite() { *a } else { 0.0 };
+        cumulative.push(total);
+    }
+    if total <= 0.0 {
+        return Vec::new();
+    }
+    let lift = 1e-4 * scene.bounds().extent().length();
+    let mut rng = Rng::new(seed, 0x5eed);
+    (0..count)
+        .map(|_| {
+            let pick = rng.next_f32() as f64 * total;
+            let index = cumulative.partition_point(|&c| c <= pick).min(triangles.len() - 1);
+            let [a, b, c] = triangles[index];
+            let (mut u, mut v) = (rng.next_f32(), rng.next_f32());
+            if u + v > 1.0 {
+                (u, v) = (1.0 - u, 1.0 - v);
+            }
+            let point = a + u * (b - a) + v * (c - a);
+            let direction = uniform_sphere(rng.next_f32(), rng.next_f32());
+            let normal = (b - a).cross(c - a).normalize_or_zero();
+            let side = if normal.dot(direction) >= 0.0 { 1.0 } else { -1.0 };
+            Ray::new(point + side * lift * normal, direction)
+        })
+        .collect()
+}
+
+/// Rays with origins uniform in the scene's bounding box and directions
+/// uniform on the sphere: the incoherent batch of the peer measurements in
+/// `../shared/notes/peers.md`.
+pub fn box_rays(scene: &Scene, count: usize, seed: u64) -> Vec<Ray> {
+    let bounds = scene.bounds();
+    let mut rng = Rng::new(seed, 0xb0c5);
+    (0..count)
+        .map(|_| {
+            let t = Vec3::new(rng.next_f32(), rng.next_f32(), rng.next_f32());
+            let origin = bounds.min + t * bounds.extent();
+            Ray::new(origin, uniform_sphere(rng.next_f32(), rng.next_f32()))
+        })
+        .collect()
+}
+
+/// A direction uniformly distributed on the unit sphere from two uniform numbers.
+pub fn uniform_sphere(u: f32, v: f32) -> Vec3 {
+    let z = 1.0 - 2.0 * u;
+    let r = (1.0 - z * z).max(0.0).sqrt();
+    let phi = 2.0 * std::f32::consts::PI * v;
+    Vec3::new(r * phi.cos(), r * phi.sin(), z)
+}
+
+/// The camera of the peer measurements: looking at the bounding sphere's
+/// centre along -Z with a 40 degree vertical field of view, at the distance
+/// where the sphere just fills the view.
+pub fn bounding_sphere_camera(scene: &Scene) -> Camera {
+    Camera::framing(&scene.bounds(), 40f32.to_radians(), 1.0)
+}
