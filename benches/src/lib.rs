@@ -42,19 +42,8 @@ pub fn primary_rays(scene: &Scene, width: u32, height: u32) -> Vec<Ray> {
 }
 
 /// Million rays per second of `trace` over `rays` on a pool of `threads`
-/// threads: the median of `repeats` runs, after one warm-up run. Rays go to
-/// the threads in chunks of 1024, in order.
+/// threads: the median of `repeats` runs (see [`rtgi_render::rays::throughput`]).
 pub fn mrays_per_second(rays: &[Ray], threads: usize, repeats: usize, trace: impl Fn(&Ray) -> bool + Sync) -> f64 {
-    use rayon::prelude::*;
     let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().expect("cannot start threads");
-    let run = || {
-        let start = std::time::Instant::now();
-        let hits: usize = pool.install(|| rays.par_chunks(1024).map(|c| c.iter().filter(|r| trace(r)).count()).sum());
-        std::hint::black_box(hits);
-        start.elapsed().as_secs_f64()
-    };
-    run();
-    let mut seconds: Vec<f64> = (0..repeats.max(1)).map(|_| run()).collect();
-    seconds.sort_by(f64::total_cmp);
-    rays.len() as f64 / seconds[seconds.len() / 2] * 1e-6
+    rtgi_render::rays::throughput(rays, &pool, repeats, trace)
 }

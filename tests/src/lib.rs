@@ -72,3 +72,19 @@ pub fn run_cli(program: &str, args: &[&str]) -> Run {
         .expect("cannot start the rtgi binary")
         .into()
 }
+
+/// Runs `check` on every acceleration structure variant with a spread of
+/// build parameters ([`AccelKind::all_configurations`]), built over
+/// `triangles`; the label names the variant and its parameters. A new
+/// variant is tested by every caller as soon as it is added to
+/// [`AccelKind::ALL`].
+///
+/// [`AccelKind::all_configurations`]: rtgi_accel::AccelKind::all_configurations
+/// [`AccelKind::ALL`]: rtgi_accel::AccelKind::ALL
+pub fn for_every_variant(triangles: &[[rtgi_math::Vec3; 3]], mut check: impl FnMut(&str, &dyn rtgi_accel::Accel)) {
+    for (kind, params) in rtgi_accel::AccelKind::all_configurations() {
+        let accel = kind.build(triangles, &params);
+        let label = format!("{kind} (leaf {}, bins {})", params.max_leaf_size, params.sah_bins);
+        check(&label, accel.as_ref());
+    }
+}

@@ -22,6 +22,160 @@ pub(crate) struct Cli {
 pub(crate) enum Command {
     /// Render a scene to an image (.png or .exr)
     Render(RenderArgs),
+    /// Trace a batch of rays from a binary file and write their hits
+    Trace(TraceArgs),
+    /// Measure build time, tree quality and ray throughput of acceleration structures
+    Bench(BenchArgs),
+    /// Export the boxes of chosen BVH levels as an OBJ file, to look at the tree
+    BvhBoxes(BvhBoxesArgs),
+    /// Render the traversal cost (BVH nodes visited per pixel) as a heat map
+    Heatmap(HeatmapArgs),
+}
+
+/// `rtgi bvh-boxes`: the boxes of some levels of a BVH as a wireframe-able mesh.
+#[derive(Debug, Args)]
+pub(crate) struct BvhBoxesArgs {
+    /// Scene file (.obj or .toml); the built-in Cornell box when omitted
+    pub(crate) scene: Option<PathBuf>,
+
+    /// OBJ file to write; each level becomes a group named level_N
+    #[arg(short, long)]
+    pub(crate) output: PathBuf,
+
+    /// Depths to export, separated by commas (the root is 0)
+    #[arg(long, default_value = "0,1,2,3", value_delimiter = ',')]
+    pub(crate) levels: Vec<usize>,
+
+    #[command(flatten)]
+    pub(crate) accel: AccelArgs,
+}
+
+/// `rtgi heatmap`: nodes visited per pixel, in false colour.
+#[derive(Debug, Args)]
+pub(crate) struct HeatmapArgs {
+    /// Scene file (.obj or .toml); the built-in Cornell box when omitted
+    pub(crate) scene: Option<PathBuf>,
+
+    /// Output image (.png for the false-colour map, .exr for the raw counts)
+    #[arg(short, long)]
+    pub(crate) output: PathBuf,
+
+    #[arg(long, default_value_t = 512, value_parser = clap::value_parser!(u32).range(1..=MAX_IMAGE_SIDE as i64))]
+    pub(crate) width: u32,
+
+    #[arg(long, default_value_t = 512, value_parser = clap::value_parser!(u32).range(1..=MAX_IMAGE_SIDE as i64))]
+    pub(crate) height: u32,
+
+    /// Count that maps to the top of the colour scale [default: the image's maximum]
+    #[arg(long)]
+    pub(crate) scale: Option<f32>,
+
+    /// Count triangle tests instead of nodes visited
+    #[arg(long)]
+    pub(crate) triangles: bool,
+
+    #[command(flatten)]
+    pub(crate) accel: AccelArgs,
+
+    #[command(flatten)]
+    pub(crate) camera: CameraArgs,
+
+    /// Worker threads [default: one per core]
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1024))]
+    pub(crate) threads: Option<u32>,
+}
+
+/// `rtgi bench`: what each acceleration structure costs and gives, side by side.
+#[derive(Debug, Args)]
+pub(crate) struct BenchArgs {
+    /// Scene file (.obj or .toml); the built-in Cornell box when omitted
+    pub(crate) scene: Option<PathBuf>,
+
+    /// Structures to measure: 'all', or names separated by commas
+    #[arg(long, default_value = "all", value_parser = parse_accel_list)]
+    pub(crate) accel: AccelList,
+
+    #[command(flatten)]
+    pub(crate) build: BuildArgs,
+
+    /// Width of the primary-ray batch (one ray per pixel of the scene's camera)
+    #[arg(long, default_value_t = 1024, value_parser = clap::value_parser!(u32).range(1..=MAX_IMAGE_SIDE as i64))]
+    pub(crate) width: u32,
+
+    /// Height of the primary-ray batch
+    #[arg(long, default_value_t = 1024, value_parser = clap::value_parser!(u32).range(1..=MAX_IMAGE_SIDE as i64))]
+    pub(crate) height: u32,
+
+    /// Incoherent rays: from random points on the surfaces in random directions
+    #[arg(long, default_value_t = 1_000_000, value_parser = clap::value_parser!(u32).range(1..=100_000_000))]
+    pub(crate) rays: u32,
+
+    /// Seed of the incoherent rays
+    #[arg(long, default_value_t = 1)]
+    pub(crate) seed: u64,
+
+    /// Timed runs per measurement; the median is reported
+    #[arg(long, default_value_t = 5, value_parser = clap::value_parser!(u32).range(1..=1000))]
+    pub(crate) repeats: u32,
+
+    /// Rays per batch that the linear scan is timed on (an evenly spaced subset)
+    #[arg(long, default_value_t = 2048, value_parser = clap::value_parser!(u32).range(1..=100_000_000))]
+    pub(crate) linear_rays: u32,
+
+    /// Worker threads of the multi-threaded measurements [default: one per core]
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1024))]
+    pub(crate) threads: Option<u32>,
+
+    /// Also write the results as JSON to this file
+    #[arg(long)]
+    pub(crate) json: Option<PathBuf>,
+}
+
+/// A list of acceleration structures chosen on the command line.
+#[derive(Clone, Debug)]
+pub(crate) struct AccelList(pub(crate) Vec<AccelKind>);
+
+fn parse_accel_list(text: &str) -> Result<AccelList, String> {
+    if text == "all" {
+        return Ok(AccelList(AccelKind::ALL.to_vec()));
+    }
+    text.split(',')
+        .map(|name| name.trim().parse::<AccelKind>().map_err(|e| e.to_string()))
+        .collect::<Result<_, _>>()
+        .map(AccelList)
+}
+
+/// `rtgi trace`: rays in, hits out, for tests and comparisons with other ray tracers.
+///
+/// Files are little-endian without a header. A ray is 8 × f32: origin x y z,
+/// direction x y z, t_min, t_max. A hit is 16 bytes: t (f32; +inf for a
+/// miss), triangle (u32; 0xFFFFFFFF for a miss), beta (f32), gamma (f32).
+/// With --any-hit, triangle is 0 when the ray is occluded and 0xFFFFFFFF when
+/// not, and t, beta and gamma are 0. Triangles are numbered in file order
+/// (an OBJ polygon becomes a fan of triangles, in order).
+#[derive(Debug, Args)]
+pub(crate) struct TraceArgs {
+    /// Scene file (.obj or .toml)
+    pub(crate) scene: PathBuf,
+
+    /// Binary file of rays (32 bytes each)
+    #[arg(long)]
+    pub(crate) rays: PathBuf,
+
+    /// Binary file of hits to write (16 bytes each)
+    #[arg(long)]
+    pub(crate) out: PathBuf,
+
+    /// Answer whether each ray is occluded (any hit) instead of its closest hit
+    #[arg(long)]
+    pub(crate) any_hit: bool,
+
+    #[command(flatten)]
+    pub(crate) accel: AccelArgs,
+
+    /// Worker threads [default: one per core]
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1024))]
+    pub(crate) threads: Option<u32>,
 }
 
 #[derive(Debug, Args)]
@@ -81,6 +235,13 @@ pub(crate) struct AccelArgs {
     #[arg(long, default_value = "sah")]
     pub(crate) accel: AccelKind,
 
+    #[command(flatten)]
+    pub(crate) build: BuildArgs,
+}
+
+/// Build parameters of the BVH variants.
+#[derive(Debug, Args)]
+pub(crate) struct BuildArgs {
     /// Most triangles in a BVH leaf
     #[arg(long, default_value_t = BuildParams::default().max_leaf_size as u32, value_parser = clap::value_parser!(u32).range(1..=255))]
     pub(crate) leaf_size: u32,
@@ -94,7 +255,7 @@ pub(crate) struct AccelArgs {
     pub(crate) traversal_cost: f32,
 }
 
-impl AccelArgs {
+impl BuildArgs {
     pub(crate) fn params(&self) -> BuildParams {
         BuildParams {
             max_leaf_size: self.leaf_size as usize,
@@ -102,15 +263,17 @@ impl AccelArgs {
             traversal_cost: self.traversal_cost,
         }
     }
+}
 
+impl AccelArgs {
     /// Builds the chosen structure over the scene's triangles.
     pub(crate) fn build(&self, scene: &rtgi_scene::Scene) -> Box<dyn rtgi_accel::Accel> {
-        self.accel.build(&scene.triangle_positions(), &self.params())
+        self.accel.build(&scene.triangle_positions(), &self.build.params())
     }
 }
 
 /// Camera options; any given override the scene's camera (or the automatic framing).
-#[derive(Debug, Args)]
+#[derive(Debug, Default, Args)]
 pub(crate) struct CameraArgs {
     /// Camera position, as X,Y,Z (it looks at the scene's centre unless --look is given)
     #[arg(long, value_parser = parse_vec3, allow_hyphen_values = true)]

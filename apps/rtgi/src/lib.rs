@@ -3,9 +3,13 @@
 //! The whole program lives in this library so that the end-to-end tests can
 //! build the same command as a binary of their own and run it as a process.
 
+mod bench_cmd;
 mod cli;
+mod common;
+mod debug_cmd;
 mod default_scene;
 mod render_cmd;
+mod trace_cmd;
 
 use std::process::ExitCode;
 
@@ -19,6 +23,10 @@ pub fn main() -> ExitCode {
     };
     let result = match cli.command {
         cli::Command::Render(args) => render_cmd::run(&args),
+        cli::Command::Trace(args) => trace_cmd::run(&args),
+        cli::Command::Bench(args) => bench_cmd::run(&args),
+        cli::Command::BvhBoxes(args) => debug_cmd::boxes(&args),
+        cli::Command::Heatmap(args) => debug_cmd::heatmap(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -39,7 +39,7 @@ impl BoxA {
     #[inline(always)]
     pub(crate) fn half_area(self) -> f32 {
         let e = (self.max - self.min).max(Vec3A::ZERO);
-        e.x * e.y + e.y * e.z + e.z * e.x
+        e.dot(Vec3A::new(e.y, e.z, e.x))
     }
 
     pub(crate) fn to_aabb(self) -> Aabb {

@@ -21,7 +21,7 @@
 mod tonemap;
 mod write;
 
-pub use tonemap::{ToneMap, ToneOperator, linear_to_srgb, srgb_to_linear};
+pub use tonemap::{ToneMap, ToneOperator, heat_colour, linear_to_srgb, srgb_to_linear};
 pub use write::{ImageError, OutputFormat, check_writable};
 
 use rtgi_math::Vec3;

@@ -95,6 +95,28 @@ pub fn srgb_to_linear(c: f32) -> f32 {
     if c <= 0.040_45 { c / 12.92 } else { ((c + 0.055) / 1.055).powf(2.4) }
 }
 
+/// A false-colour scale for `t` in `[0, 1]` (clamped), dark blue through
+/// purple, red and orange to pale yellow: monotonic in lightness, so that it
+/// reads in grey too. Returns linear RGB, ready for an [`HdrImage`](crate::HdrImage)
+/// written with the clamp tone map. The stops approximate matplotlib's
+/// "inferno" map.
+pub fn heat_colour(t: f32) -> Vec3 {
+    const STOPS: [[f32; 3]; 6] = [
+        [0.001, 0.000, 0.014],
+        [0.258, 0.039, 0.406],
+        [0.578, 0.148, 0.404],
+        [0.865, 0.317, 0.226],
+        [0.988, 0.645, 0.040],
+        [0.988, 0.998, 0.645],
+    ];
+    let t = if t.is_nan() { 0.0 } else { t.clamp(0.0, 1.0) };
+    let scaled = t * (STOPS.len() - 1) as f32;
+    let i = (scaled as usize).min(STOPS.len() - 2);
+    let f = scaled - i as f32;
+    let srgb = Vec3::from(STOPS[i]).lerp(Vec3::from(STOPS[i + 1]), f);
+    Vec3::new(srgb_to_linear(srgb.x), srgb_to_linear(srgb.y), srgb_to_linear(srgb.z))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -108,6 +130,19 @@ mod tests {
             let c = i as f32 / 100.0;
             assert!((srgb_to_linear(linear_to_srgb(c)) - c).abs() < 1e-5);
         }
+    }
+
+    #[test]
+    fn heat_colours_get_lighter() {
+        let luminance = |c: Vec3| c.dot(Vec3::new(0.2126, 0.7152, 0.0722));
+        let mut last = -1.0;
+        for i in 0..=50 {
+            let l = luminance(heat_colour(i as f32 / 50.0));
+            assert!(l > last, "{i}: {l} after {last}");
+            last = l;
+        }
+        assert_eq!(heat_colour(-1.0), heat_colour(0.0));
+        assert_eq!(heat_colour(f32::NAN), heat_colour(0.0));
     }
 
     #[test]

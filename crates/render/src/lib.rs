@@ -34,9 +34,9 @@ pub use shade::{shade_primary, shading_normal};
 use std::time::Instant;
 
 use rayon::prelude::*;
-use rtgi_accel::Accel;
+use rtgi_accel::{Accel, TraversalCounters};
 use rtgi_image::HdrImage;
-use rtgi_math::{Rng, Vec3};
+use rtgi_math::{Rng, Vec2, Vec3};
 use rtgi_scene::{Camera, Scene};
 use serde::Serialize;
 
@@ -113,37 +113,19 @@ pub fn render<A: Accel + ?Sized>(
     let (width, height) = (settings.width, settings.height);
     let rays = CameraRays::new(camera, width, height);
     let spp = settings.samples_per_pixel.max(1);
-    let tile_pixels: Vec<Vec<Vec3>> = tiles(width, height)
-        .into_par_iter()
-        .map(|(x0, y0, x1, y1)| {
-            let mut pixels = Vec::with_capacity(((x1 - x0) * (y1 - y0)) as usize);
-            for y in y0..y1 {
-                for x in x0..x1 {
-                    let pixel_index = y as u64 * width as u64 + x as u64;
-                    let mut sum = Vec3::ZERO;
-                    for sample in 0..spp {
-                        let mut rng = Rng::for_sample(settings.seed, pixel_index, sample as u64);
-                        let ray = rays.ray(x, y, settings.sampler.offset(&mut rng));
-                        sum += match accel.intersect(&ray) {
-                            Some(hit) => shade_primary(scene, &ray, &hit),
-                            None => settings.background,
-                        };
-                    }
-                    pixels.push(sum / spp as f32);
-                }
-            }
-            progress(pixels.len() as u64);
-            pixels
-        })
-        .collect();
-
-    let mut image = HdrImage::new(width, height);
-    for ((x0, y0, x1, _), pixels) in tiles(width, height).into_iter().zip(tile_pixels) {
-        let tile_width = (x1 - x0) as usize;
-        for (i, value) in pixels.into_iter().enumerate() {
-            image.set(x0 + (i % tile_width) as u32, y0 + (i / tile_width) as u32, value);
+    let image = render_pixels(width, height, progress, |x, y| {
+        let pixel_index = y as u64 * width as u64 + x as u64;
+        let mut sum = Vec3::ZERO;
+        for sample in 0..spp {
+            let mut rng = Rng::for_sample(settings.seed, pixel_index, sample as u64);
+            let ray = rays.ray(x, y, settings.sampler.offset(&mut rng));
+            sum += match accel.intersect(&ray) {
+                Some(hit) => shade_primary(scene, &ray, &hit),
+                None => settings.background,
+            };
         }
-    }
+        sum / spp as f32
+    });
     let stats = RenderStats {
         width,
         height,
@@ -152,6 +134,59 @@ pub fn render<A: Accel + ?Sized>(
         render_ms: start.elapsed().as_secs_f64() * 1e3,
     };
     (image, stats)
+}
+
+/// Renders what tracing costs: per pixel, the boxes tested (red channel)
+/// and ray/triangle tests (green channel) of the ray through the pixel's
+/// centre, and 1 in blue where it hit something. Parallel and
+/// deterministic like [`render`]; also returns the totals.
+pub fn render_traversal_cost<A: Accel + ?Sized>(
+    accel: &A,
+    camera: &Camera,
+    width: u32,
+    height: u32,
+    progress: &(dyn Fn(u64) + Sync),
+) -> (HdrImage, TraversalCounters) {
+    let rays = CameraRays::new(camera, width, height);
+    let image = render_pixels(width, height, progress, |x, y| {
+        let mut counters = TraversalCounters::default();
+        let hit = accel.intersect_counted(&rays.ray(x, y, Vec2::splat(0.5)), &mut counters);
+        Vec3::new(counters.nodes_visited as f32, counters.triangles_tested as f32, hit.is_some() as u32 as f32)
+    });
+    let mut total = TraversalCounters { rays: width as u64 * height as u64, ..TraversalCounters::default() };
+    for p in image.pixels() {
+        total.nodes_visited += p.x as u64;
+        total.triangles_tested += p.y as u64;
+    }
+    (image, total)
+}
+
+/// Computes every pixel with `pixel(x, y)`, tile by tile in parallel, and
+/// reports finished pixels to `progress`. The value of a pixel depends only
+/// on its coordinates, so the image is the same for any number of threads.
+fn render_pixels(
+    width: u32,
+    height: u32,
+    progress: &(dyn Fn(u64) + Sync),
+    pixel: impl Fn(u32, u32) -> Vec3 + Sync,
+) -> HdrImage {
+    let tile_pixels: Vec<Vec<Vec3>> = tiles(width, height)
+        .into_par_iter()
+        .map(|(x0, y0, x1, y1)| {
+            let pixels: Vec<Vec3> =
+                (y0..y1).flat_map(|y| (x0..x1).map(move |x| (x, y))).map(|(x, y)| pixel(x, y)).collect();
+            progress(pixels.len() as u64);
+            pixels
+        })
+        .collect();
+    let mut image = HdrImage::new(width, height);
+    for ((x0, y0, x1, _), pixels) in tiles(width, height).into_iter().zip(tile_pixels) {
+        let tile_width = (x1 - x0) as usize;
+        for (i, value) in pixels.into_iter().enumerate() {
+            image.set(x0 + (i % tile_width) as u32, y0 + (i / tile_width) as u32, value);
+        }
+    }
+    image
 }
 
 #[cfg(test)]

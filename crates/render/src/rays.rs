@@ -78,3 +78,20 @@ pub fn uniform_sphere(u: f32, v: f32) -> Vec3 {
 pub fn bounding_sphere_camera(scene: &Scene) -> Camera {
     Camera::framing(&scene.bounds(), 40f32.to_radians(), 1.0)
 }
+
+/// Million rays per second of `trace` over `rays`, on `pool`: the median
+/// of `repeats` timed runs after one untimed warm-up run. Rays go to the
+/// threads in chunks of 1024, in order; `trace` returns whether the ray hit.
+pub fn throughput(rays: &[Ray], pool: &rayon::ThreadPool, repeats: usize, trace: impl Fn(&Ray) -> bool + Sync) -> f64 {
+    use rayon::prelude::*;
+    let run = || {
+        let start = std::time::Instant::now();
+        let hits: usize = pool.install(|| rays.par_chunks(1024).map(|c| c.iter().filter(|r| trace(r)).count()).sum());
+        std::hint::black_box(hits);
+        start.elapsed().as_secs_f64()
+    };
+    run();
+    let mut seconds: Vec<f64> = (0..repeats.max(1)).map(|_| run()).collect();
+    seconds.sort_by(f64::total_cmp);
+    rays.len() as f64 / seconds[seconds.len() / 2].max(1e-12) * 1e-6
+}

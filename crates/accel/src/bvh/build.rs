@@ -253,12 +253,16 @@ fn build_node(
 /// traversal cost as given, relative to the root's area).
 fn layout(slots: &[Slot], order: Vec<u32>, traversal_cost: f32) -> Tree {
     let root_area = slots[0].bounds().half_area();
-    let mut nodes = vec![BvhNode::default()];
+    // At most every slot is used; reserving that much only claims address
+    // space, and saves the copies of a growing vector.
+    let mut nodes = Vec::with_capacity(slots.len());
+    nodes.push(BvhNode::default());
     let mut leaves = 0;
     let mut depth = 0;
     let mut histogram = Vec::new();
     let mut cost = 0.0f64;
-    let mut stack = vec![(0u32, 0u32, 0usize)];
+    let mut stack = Vec::with_capacity(2 * super::traverse::STACK_SIZE);
+    stack.push((0u32, 0u32, 0usize));
     while let Some((slot_index, node_index, node_depth)) = stack.pop() {
         let slot = &slots[slot_index as usize];
         depth = depth.max(node_depth);

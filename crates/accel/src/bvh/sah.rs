@@ -67,10 +67,12 @@ impl Binning {
         shifted.to_array().map(|f| (f.to_bits() - ROUNDING_MAGIC.to_bits()).min(self.last))
     }
 
+    /// The bin along one axis; the same arithmetic as [`Binning::bins`], so
+    /// that partitioning agrees with binning exactly.
     #[inline(always)]
     fn bin(&self, centroid: Vec3A, axis: usize) -> u32 {
-        let shifted = (centroid[axis] - self.origin[axis]) * self.scale[axis] + (ROUNDING_MAGIC - 0.5);
-        (shifted.to_bits() - ROUNDING_MAGIC.to_bits()).min(self.last)
+        let shifted = (centroid - self.origin) * self.scale + Vec3A::splat(ROUNDING_MAGIC - 0.5);
+        (shifted.to_array()[axis].to_bits() - ROUNDING_MAGIC.to_bits()).min(self.last)
     }
 }
 
@@ -80,6 +82,9 @@ impl Binning {
 /// at bin borders. The children's bounds are gathered while partitioning,
 /// so no extra pass measures them.
 pub(crate) fn binned(ctx: &Context, prims: &mut [PrimRef], range: &RangeBounds) -> Option<Split> {
+    if prims.len() <= SMALL_RANGE {
+        return small(ctx, prims, range);
+    }
     let bins = ctx.sah_bins.min(prims.len()).max(2);
     // Bin arrays live on the stack, sized to a power of two at least the bin
     // count, so that short ranges do not initialise arrays they do not use.
@@ -212,6 +217,47 @@ fn binned_core(
     }
     let [right, left] = sides;
     Some(Split { left_count, left, right })
+}
+
+/// Ranges this short are split by an exact sweep on the stack: cheaper
+/// than binning them, and exact.
+const SMALL_RANGE: usize = 8;
+
+/// The full sweep of [`sweep`] for at most [`SMALL_RANGE`] primitives,
+/// sorted on the stack. Most nodes of a tree are this small, so this keeps
+/// the per-node overhead of binning (bin arrays to clear, three axes to
+/// evaluate) off the bottom levels.
+fn small(ctx: &Context, prims: &mut [PrimRef], range: &RangeBounds) -> Option<Split> {
+    let count = prims.len();
+    debug_assert!(count <= SMALL_RANGE);
+    let mut best = (f32::INFINITY, 0, 0);
+    let mut sorted = [[prims[0]; SMALL_RANGE]; 3];
+    for (axis, order) in sorted.iter_mut().enumerate() {
+        let order = &mut order[..count];
+        order.copy_from_slice(prims);
+        order.sort_unstable_by(by_centroid(axis));
+        let mut right_cost = [0.0f32; SMALL_RANGE];
+        let mut acc = BoxA::EMPTY;
+        for k in (1..count).rev() {
+            acc = acc.union(order[k].bounds());
+            right_cost[k] = acc.half_area() * (count - k) as f32;
+        }
+        let mut acc = BoxA::EMPTY;
+        for k in 0..count - 1 {
+            acc = acc.union(order[k].bounds());
+            let cost = acc.half_area() * (k + 1) as f32 + right_cost[k + 1];
+            let imbalance = |left: usize| left.abs_diff(count - left);
+            if cost < best.0 || (cost == best.0 && imbalance(k + 1) < imbalance(best.2)) {
+                best = (cost, axis, k + 1);
+            }
+        }
+    }
+    if !split_pays(ctx, count, range, best.0) {
+        return None;
+    }
+    let (_, axis, left_count) = best;
+    prims.copy_from_slice(&sorted[axis][..count]);
+    Some(Split::measured(prims, left_count))
 }
 
 /// Full-sweep SAH: every split between neighbouring centroids on every axis

@@ -1,0 +1,296 @@
+//! `rtgi bench`: build time, tree quality and throughput of every
+//! acceleration structure on one scene, as a table and as JSON.
+
+use std::time::Instant;
+
+use anyhow::Result;
+use rayon::prelude::*;
+use rtgi_accel::{Accel, AccelKind, BuildParams, BuildStats, TraversalCounters};
+use rtgi_math::Ray;
+use rtgi_render::rays::{primary_rays, surface_rays, throughput};
+use serde::Serialize;
+
+use crate::cli::BenchArgs;
+use crate::common::{LoadedScene, check_output_folder, choose_camera, load_scene, thread_pool};
+
+/// Everything one run of `rtgi bench` measured.
+#[derive(Debug, Serialize)]
+struct BenchReport {
+    scene: String,
+    triangles: usize,
+    /// Threads of the multi-threaded measurements.
+    threads: usize,
+    repeats: u32,
+    primary_rays: usize,
+    incoherent_rays: usize,
+    incoherent_seed: u64,
+    params: ParamsReport,
+    variants: Vec<VariantReport>,
+}
+
+#[derive(Debug, Serialize)]
+struct ParamsReport {
+    max_leaf_size: usize,
+    sah_bins: usize,
+    traversal_cost: f32,
+}
+
+#[derive(Debug, Serialize)]
+struct VariantReport {
+    variant: String,
+    /// Median build time on one thread and on all threads.
+    build_ms_1_thread: f64,
+    build_ms_all_threads: f64,
+    stats: BuildStats,
+    primary: BatchReport,
+    incoherent: BatchReport,
+}
+
+#[derive(Debug, Serialize)]
+struct BatchReport {
+    /// Rays timed and counted: the whole batch, or for the linear scan an
+    /// evenly spaced subset of it.
+    rays_timed: usize,
+    mrays_1_thread: f64,
+    mrays_all_threads: f64,
+    hit_fraction: f64,
+    nodes_visited_per_ray: f64,
+    triangles_tested_per_ray: f64,
+    /// Time per ray of the linear scan over time per ray of this variant, all threads.
+    speedup_vs_linear: Option<f64>,
+}
+
+pub(crate) fn run(args: &BenchArgs) -> Result<()> {
+    if let Some(json) = &args.json {
+        check_output_folder(json)?;
+    }
+    let LoadedScene { scene, name, .. } = load_scene(args.scene.as_deref())?;
+    let triangles = scene.triangle_positions();
+    let pool = thread_pool(args.threads)?;
+    let single = thread_pool(Some(1))?;
+    let params = args.build.params();
+    let repeats = args.repeats as usize;
+
+    // The camera rtgi render would use, over the default image aspect of the batch.
+    let framing = AccelKind::Sah.build(&triangles, &params);
+    let camera = choose_camera(&scene, framing.as_ref(), &Default::default(), args.width as f32 / args.height as f32)?;
+    drop(framing);
+    let primary = primary_rays(&camera, args.width, args.height);
+    let incoherent = surface_rays(&scene, args.rays as usize, args.seed);
+    eprintln!(
+        "{name}: {} triangles; {} primary rays ({}x{}), {} incoherent rays; {} threads, median of {repeats}",
+        triangles.len(),
+        primary.len(),
+        args.width,
+        args.height,
+        incoherent.len(),
+        pool.current_num_threads()
+    );
+
+    let mut variants = Vec::new();
+    let mut linear: Option<(f64, f64)> = None;
+    for &kind in &args.accel.0 {
+        eprintln!("measuring {kind} ...");
+        let report = measure_variant(kind, &triangles, &params, &primary, &incoherent, args, &pool, &single, linear);
+        if kind == AccelKind::Linear {
+            linear = Some((report.primary.mrays_all_threads, report.incoherent.mrays_all_threads));
+        }
+        variants.push(report);
+    }
+    // The linear scan may have been measured after others: fill in their speedups.
+    if let Some((primary_linear, incoherent_linear)) = linear {
+        for v in variants.iter_mut().filter(|v| v.variant != "linear") {
+            v.primary.speedup_vs_linear = Some(v.primary.mrays_all_threads / primary_linear);
+            v.incoherent.speedup_vs_linear = Some(v.incoherent.mrays_all_threads / incoherent_linear);
+        }
+    }
+
+    let report = BenchReport {
+        scene: name,
+        triangles: triangles.len(),
+        threads: pool.current_num_threads(),
+        repeats: args.repeats,
+        primary_rays: primary.len(),
+        incoherent_rays: incoherent.len(),
+        incoherent_seed: args.seed,
+        params: ParamsReport {
+            max_leaf_size: params.max_leaf_size,
+            sah_bins: params.sah_bins,
+            traversal_cost: params.traversal_cost,
+        },
+        variants,
+    };
+    print_table(&report, args.linear_rays);
+    if let Some(json) = &args.json {
+        crate::common::write_atomically(json, serde_json::to_string_pretty(&report)?.as_bytes())?;
+        eprintln!("wrote {}", json.display());
+    }
+    Ok(())
+}
+
+#[allow(clippy::too_many_arguments)]
+fn measure_variant(
+    kind: AccelKind,
+    triangles: &[[rtgi_math::Vec3; 3]],
+    params: &BuildParams,
+    primary: &[Ray],
+    incoherent: &[Ray],
+    args: &BenchArgs,
+    pool: &rayon::ThreadPool,
+    single: &rayon::ThreadPool,
+    linear: Option<(f64, f64)>,
+) -> VariantReport {
+    let repeats = args.repeats as usize;
+    let build_ms = |pool: &rayon::ThreadPool| {
+        let mut times: Vec<f64> = (0..repeats)
+            .map(|_| {
+                let start = Instant::now();
+                let accel = pool.install(|| kind.build(triangles, params));
+                let ms = start.elapsed().as_secs_f64() * 1e3;
+                drop(accel);
+                ms
+            })
+            .collect();
+        times.sort_by(f64::total_cmp);
+        times[times.len() / 2]
+    };
+    let build_ms_1_thread = build_ms(single);
+    let build_ms_all_threads = build_ms(pool);
+    let accel = pool.install(|| kind.build(triangles, params));
+
+    // The linear scan is timed on an evenly spaced subset of each batch.
+    let subset = |rays: &[Ray]| -> Vec<Ray> {
+        if kind != AccelKind::Linear || rays.len() <= args.linear_rays as usize {
+            return rays.to_vec();
+        }
+        let stride = rays.len().div_ceil(args.linear_rays as usize);
+        rays.iter().step_by(stride).copied().collect()
+    };
+    let batch = |rays: &[Ray], linear_mrays: Option<f64>| {
+        let rays = subset(rays);
+        let timed_repeats = if kind == AccelKind::Linear { repeats.min(3) } else { repeats };
+        let trace = |r: &Ray| accel.intersect(r).is_some();
+        let mrays_1_thread = throughput(&rays, single, timed_repeats, trace);
+        let mrays_all_threads = throughput(&rays, pool, timed_repeats, trace);
+        let (counters, hits) = count(accel.as_ref(), &rays, pool);
+        let per_ray = |n: u64| n as f64 / rays.len().max(1) as f64;
+        BatchReport {
+            rays_timed: rays.len(),
+            mrays_1_thread,
+            mrays_all_threads,
+            hit_fraction: hits as f64 / rays.len().max(1) as f64,
+            nodes_visited_per_ray: per_ray(counters.nodes_visited),
+            triangles_tested_per_ray: per_ray(counters.triangles_tested),
+            speedup_vs_linear: linear_mrays.map(|l| mrays_all_threads / l),
+        }
+    };
+    let primary = batch(primary, linear.map(|l| l.0));
+    let incoherent = batch(incoherent, linear.map(|l| l.1));
+    VariantReport {
+        variant: kind.name().to_owned(),
+        build_ms_1_thread,
+        build_ms_all_threads,
+        stats: accel.build_stats().clone(),
+        primary,
+        incoherent,
+    }
+}
+
+/// Traversal work and hits of a batch.
+fn count(accel: &dyn Accel, rays: &[Ray], pool: &rayon::ThreadPool) -> (TraversalCounters, u64) {
+    pool.install(|| {
+        rays.par_chunks(1024)
+            .map(|chunk| {
+                let mut counters = TraversalCounters::default();
+                let hits = chunk.iter().filter(|r| accel.intersect_counted(r, &mut counters).is_some()).count();
+                (counters, hits as u64)
+            })
+            .reduce(
+                || (TraversalCounters::default(), 0),
+                |(mut a, h), (b, g)| {
+                    a += b;
+                    (a, h + g)
+                },
+            )
+    })
+}
+
+fn print_table(report: &BenchReport, linear_rays: u32) {
+    println!(
+        "{} ({} triangles), {} threads; primary: {} rays, incoherent: {} rays; median of {}",
+        report.scene, report.triangles, report.threads, report.primary_rays, report.incoherent_rays, report.repeats
+    );
+    println!(
+        "{:<15} {:>8} {:>8} {:>7} {:>8} {:>5} {:>8} | {:>15} {:>13} {:>11} | {:>15} {:>13} {:>11}",
+        "",
+        "build ms",
+        "build ms",
+        "SAH",
+        "nodes",
+        "depth",
+        "memory",
+        "primary Mrays/s",
+        "nodes, tris",
+        "x linear",
+        "incoh. Mrays/s",
+        "nodes, tris",
+        "x linear"
+    );
+    println!(
+        "{:<15} {:>8} {:>8} {:>7} {:>8} {:>5} {:>8} | {:>15} {:>13} {:>11} | {:>15} {:>13} {:>11}",
+        "variant",
+        "1 thr",
+        format!("{} thr", report.threads),
+        "cost",
+        "",
+        "",
+        "MiB",
+        format!("1 / {} thr", report.threads),
+        "per ray",
+        "(all thr)",
+        format!("1 / {} thr", report.threads),
+        "per ray",
+        "(all thr)"
+    );
+    let speedup = |s: Option<f64>| s.map_or("-".to_owned(), |s| format!("{s:.0}x"));
+    for v in &report.variants {
+        let batch = |b: &BatchReport| {
+            (
+                format!("{} / {}", significant(b.mrays_1_thread), significant(b.mrays_all_threads)),
+                format!("{:.1}, {:.1}", b.nodes_visited_per_ray, b.triangles_tested_per_ray),
+                speedup(b.speedup_vs_linear),
+            )
+        };
+        let (p, pn, ps) = batch(&v.primary);
+        let (i, inn, is) = batch(&v.incoherent);
+        println!(
+            "{:<15} {:>8.1} {:>8.1} {:>7.1} {:>8} {:>5} {:>8.2} | {:>15} {:>13} {:>11} | {:>15} {:>13} {:>11}",
+            v.variant,
+            v.build_ms_1_thread,
+            v.build_ms_all_threads,
+            v.stats.sah_cost,
+            v.stats.nodes,
+            v.stats.depth,
+            v.stats.memory_bytes as f64 / (1024.0 * 1024.0),
+            p,
+            pn,
+            ps,
+            i,
+            inn,
+            is
+        );
+    }
+    if report.variants.iter().any(|v| v.variant == "linear") {
+        println!("linear: timed on an evenly spaced subset of at most {linear_rays} rays of each batch");
+    }
+}
+
+/// A positive number with three significant digits (at least two decimals),
+/// so that the linear scan's thousandths of a million rays per second show.
+fn significant(x: f64) -> String {
+    if x <= 0.0 || !x.is_finite() {
+        return format!("{x:.2}");
+    }
+    let decimals = (2 - x.log10().floor() as i32).max(2) as usize;
+    format!("{x:.decimals$}")
+}

@@ -1,0 +1,109 @@
+//! Steps that several commands share.
+
+use std::io::Write;
+use std::path::Path;
+use std::time::Instant;
+
+use anyhow::{Context, Result, bail};
+use rtgi_accel::Accel;
+use rtgi_render::frame_scene;
+use rtgi_scene::{Camera, Scene};
+
+use crate::cli::CameraArgs;
+use crate::default_scene;
+
+/// Field of view of the automatic framing when no camera is given.
+pub(crate) const DEFAULT_FOV_DEGREES: f32 = 40.0;
+
+pub(crate) struct LoadedScene {
+    pub(crate) scene: Scene,
+    /// The file's path, or the built-in scene's name.
+    pub(crate) name: String,
+    pub(crate) load_ms: f64,
+}
+
+/// Loads a scene file (or the built-in Cornell box) and prints its warnings.
+pub(crate) fn load_scene(path: Option<&Path>) -> Result<LoadedScene> {
+    let start = Instant::now();
+    let (scene, name) = match path {
+        Some(path) => (Scene::load(path)?, path.display().to_string()),
+        None => (default_scene::load()?, default_scene::NAME.to_owned()),
+    };
+    let load_ms = start.elapsed().as_secs_f64() * 1e3;
+    for warning in &scene.warnings {
+        eprintln!("warning: {warning}");
+    }
+    Ok(LoadedScene { scene, name, load_ms })
+}
+
+/// A pool of `threads` worker threads, or one per core.
+pub(crate) fn thread_pool(threads: Option<u32>) -> Result<rayon::ThreadPool> {
+    let mut pool = rayon::ThreadPoolBuilder::new();
+    if let Some(threads) = threads {
+        pool = pool.num_threads(threads as usize);
+    }
+    pool.build().context("cannot start worker threads")
+}
+
+/// A name beside `path` for a temporary file of this process.
+fn beside(path: &Path, suffix: &str) -> std::path::PathBuf {
+    let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
+    path.with_file_name(format!(".{name}.{}.{suffix}", std::process::id()))
+}
+
+/// Writes `bytes` to `path` through a temporary file beside it, so that a
+/// failure never leaves a partial file or destroys an earlier one.
+pub(crate) fn write_atomically(path: &Path, bytes: &[u8]) -> Result<()> {
+    let temporary = beside(path, "partial");
+    let result = std::fs::File::create(&temporary)
+        .and_then(|mut f| f.write_all(bytes).and_then(|()| f.sync_all()))
+        .and_then(|()| std::fs::rename(&temporary, path));
+    if result.is_err() {
+        let _ = std::fs::remove_file(&temporary);
+    }
+    result.with_context(|| format!("{}: cannot write", path.display()))
+}
+
+/// Checks that `path` can be created, before long work whose result goes there.
+pub(crate) fn check_output_folder(path: &Path) -> Result<()> {
+    if path.is_dir() {
+        bail!("{}: is a directory", path.display());
+    }
+    let probe = beside(path, "probe");
+    std::fs::File::create(&probe).with_context(|| format!("{}: cannot write", path.display()))?;
+    let _ = std::fs::remove_file(&probe);
+    Ok(())
+}
+
+/// The scene's first camera, or an automatic framing, with any camera
+/// options applied on top.
+pub(crate) fn choose_camera(scene: &Scene, accel: &dyn Accel, options: &CameraArgs, aspect: f32) -> Result<Camera> {
+    let fov = match options.fov {
+        Some(degrees) if !(degrees > 0.0 && degrees < 180.0) => {
+            bail!("--fov {degrees}: the field of view must be between 0 and 180 degrees")
+        }
+        Some(degrees) => degrees.to_radians(),
+        None => scene.cameras.first().map_or(DEFAULT_FOV_DEGREES.to_radians(), |c| c.vertical_fov),
+    };
+    let mut camera = match scene.cameras.first() {
+        Some(camera) => *camera,
+        None => frame_scene(scene, accel, fov, aspect),
+    };
+    camera.vertical_fov = fov;
+    if let Some(up) = options.up {
+        camera.up = up;
+    }
+    if let Some(at) = options.at {
+        camera.position = at;
+        if options.look.is_none() {
+            camera.direction = scene.bounds().centroid() - at;
+        }
+    }
+    if let Some(look) = options.look {
+        camera.direction = look - camera.position;
+    }
+    if !camera.is_valid() {
+        bail!("the camera is degenerate: it must look somewhere other than its own position, and not along --up");
+    }
+    Ok(camera)
+}

@@ -1,0 +1,87 @@
+//! Commands that let users see their BVH: its boxes, and what traversal costs.
+
+use std::fmt::Write as _;
+
+use anyhow::{Result, bail};
+use rtgi_accel::{Accel, Bvh};
+use rtgi_image::{HdrImage, OutputFormat, ToneMap, check_writable, heat_colour};
+use rtgi_render::render_traversal_cost;
+
+use crate::cli::{BvhBoxesArgs, HeatmapArgs};
+use crate::common::{LoadedScene, check_output_folder, choose_camera, load_scene, thread_pool, write_atomically};
+
+/// Writes the boxes of the chosen levels as OBJ: eight corners and six
+/// quads a box, one group per level, so that viewers can show or hide
+/// levels and draw them as wireframes.
+pub(crate) fn boxes(args: &BvhBoxesArgs) -> Result<()> {
+    check_output_folder(&args.output)?;
+    let Some(method) = args.accel.accel.split_method() else {
+        bail!("--accel {}: only BVH variants have boxes to export", args.accel.accel);
+    };
+    let LoadedScene { scene, .. } = load_scene(args.scene.as_deref())?;
+    let bvh = Bvh::new(&scene.triangle_positions(), method, &args.accel.build.params());
+    let boxes = bvh.boxes_at_depths(&args.levels);
+    let mut obj = format!(
+        "# BVH boxes of levels {:?}, {} build ({} nodes, depth {}), written by rtgi\n",
+        args.levels,
+        method.name(),
+        bvh.build_stats().nodes,
+        bvh.build_stats().depth
+    );
+    let mut current_level = None;
+    for (index, (level, aabb)) in boxes.iter().enumerate() {
+        if current_level != Some(*level) {
+            let _ = writeln!(obj, "g level_{level}");
+            current_level = Some(*level);
+        }
+        for corner in 0..8 {
+            let pick = |bit: usize, axis: usize| if corner & bit == 0 { aabb.min[axis] } else { aabb.max[axis] };
+            let _ = writeln!(obj, "v {} {} {}", pick(1, 0), pick(2, 1), pick(4, 2));
+        }
+        let base = 8 * index + 1;
+        for face in [[0, 2, 3, 1], [4, 5, 7, 6], [0, 1, 5, 4], [2, 6, 7, 3], [0, 4, 6, 2], [1, 3, 7, 5]] {
+            let _ = writeln!(obj, "f {} {} {} {}", base + face[0], base + face[1], base + face[2], base + face[3]);
+        }
+    }
+    write_atomically(&args.output, obj.as_bytes())?;
+    println!("wrote {} boxes of levels {:?} to {}", boxes.len(), args.levels, args.output.display());
+    Ok(())
+}
+
+/// Renders nodes visited (or triangles tested) per pixel in false colour.
+pub(crate) fn heatmap(args: &HeatmapArgs) -> Result<()> {
+    let format = check_writable(&args.output)?;
+    if args.scale.is_some_and(|s| !(s > 0.0 && s.is_finite())) {
+        bail!("--scale must be a positive number");
+    }
+    let LoadedScene { scene, name, .. } = load_scene(args.scene.as_deref())?;
+    let pool = thread_pool(args.threads)?;
+    let accel = pool.install(|| args.accel.build(&scene));
+    let camera = choose_camera(&scene, accel.as_ref(), &args.camera, args.width as f32 / args.height as f32)?;
+    let (counts, total) =
+        pool.install(|| render_traversal_cost(accel.as_ref(), &camera, args.width, args.height, &|_| {}));
+
+    let channel = |p: rtgi_math::Vec3| if args.triangles { p.y } else { p.x };
+    let maximum = counts.pixels().iter().map(|&p| channel(p)).fold(0.0f32, f32::max);
+    let scale = args.scale.unwrap_or(maximum.max(1.0));
+    let image = match format {
+        OutputFormat::Exr => counts,
+        OutputFormat::Png => {
+            let pixels = counts.pixels().iter().map(|&p| heat_colour(channel(p) / scale)).collect();
+            HdrImage::from_pixels(args.width, args.height, pixels).expect("one colour per pixel")
+        }
+    };
+    image.write(&args.output, &ToneMap::default())?;
+    let rays = total.rays.max(1) as f64;
+    let what = if args.triangles { "triangle tests" } else { "nodes visited" };
+    println!("scene       {name}");
+    println!("accel       {}", accel.build_stats().variant);
+    println!(
+        "per ray     {:.1} nodes visited, {:.1} triangle tests (mean); max {maximum} {what}",
+        total.nodes_visited as f64 / rays,
+        total.triangles_tested as f64 / rays
+    );
+    println!("colour      0 (dark) to {scale} {what} (pale yellow)");
+    println!("wrote       {}", args.output.display());
+    Ok(())
+}

@@ -1,0 +1,60 @@
+//! Every acceleration structure answers exactly as the linear scan does.
+
+use proptest::prelude::*;
+use rtgi_accel::{Accel, LinearScan};
+use rtgi_math::{Ray, Vec3};
+use rtgi_tests::for_every_variant;
+
+fn vec3(range: std::ops::Range<f32>) -> impl Strategy<Value = Vec3> {
+    (range.clone(), range.clone(), range).prop_map(|(x, y, z)| Vec3::new(x, y, z))
+}
+
+/// Soups of triangles of mixed sizes, from slivers to large ones, some overlapping.
+fn soup() -> impl Strategy<Value = Vec<[Vec3; 3]>> {
+    prop::collection::vec((vec3(-10.0..10.0), vec3(-3.0..3.0), vec3(-3.0..3.0)), 1..300)
+        .prop_map(|ts| ts.into_iter().map(|(a, e1, e2)| [a, a + e1, a + e2]).collect())
+}
+
+fn rays() -> impl Strategy<Value = Vec<Ray>> {
+    prop::collection::vec((vec3(-14.0..14.0), vec3(-1.0..1.0), 0.0f32..2.0, prop::bool::ANY), 64).prop_map(|rs| {
+        rs.into_iter()
+            .map(|(o, d, t_min, bounded)| {
+                let t_max = if bounded { t_min + 8.0 } else { f32::INFINITY };
+                Ray::with_range(o, d, t_min, t_max)
+            })
+            .collect()
+    })
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 48, ..ProptestConfig::default() })]
+
+    #[test]
+    fn every_variant_matches_the_linear_scan(triangles in soup(), rays in rays()) {
+        let reference = LinearScan::new(&triangles);
+        let expected: Vec<_> = rays.iter().map(|r| (reference.intersect(r), reference.occluded(r))).collect();
+        let mut failures = Vec::new();
+        for_every_variant(&triangles, |label, accel| {
+            for (ray, (closest, any)) in rays.iter().zip(&expected) {
+                let got = accel.intersect(ray);
+                // Same distance and triangle; barycentrics come from the same test, so they match too.
+                if got.map(|h| (h.t, h.triangle)) != closest.map(|h| (h.t, h.triangle)) {
+                    failures.push(format!("{label}: closest {got:?} != {closest:?} for {ray:?}"));
+                }
+                if accel.occluded(ray) != *any {
+                    failures.push(format!("{label}: any-hit differs for {ray:?}"));
+                }
+            }
+        });
+        prop_assert!(failures.is_empty(), "{}", failures.join("\n"));
+    }
+}
+
+#[test]
+fn helper_covers_every_variant() {
+    let mut labels = Vec::new();
+    for_every_variant(&[[Vec3::ZERO, Vec3::X, Vec3::Y]], |label, _| labels.push(label.to_owned()));
+    for kind in rtgi_accel::AccelKind::ALL {
+        assert!(labels.iter().any(|l| l.starts_with(kind.name())), "{kind} is not tested");
+    }
+}

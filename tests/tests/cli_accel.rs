@@ -1,0 +1,169 @@
+//! End-to-end tests of the commands that expose the acceleration
+//! structures: `rtgi trace`, `rtgi bench`, `rtgi bvh-boxes`, `rtgi heatmap`.
+
+use std::path::Path;
+
+use rtgi_accel::{Accel, LinearScan};
+use rtgi_math::{Ray, Rng, Vec3};
+use rtgi_render::rays::{primary_rays, uniform_sphere};
+use rtgi_scene::Scene;
+use rtgi_tests::{Run, run_cli, scratch_dir, workspace_root};
+
+const RTGI: &str = env!("CARGO_BIN_EXE_rtgi-under-test");
+const BOX: &str = "scenes/cornell-box.toml";
+
+fn rtgi(args: &[&str]) -> Run {
+    run_cli(RTGI, args)
+}
+
+fn s(p: &Path) -> &str {
+    p.to_str().expect("scratch paths are UTF-8")
+}
+
+/// Camera rays, random rays from inside the box, and rays that must miss
+/// without trouble (NaN, zero direction, empty range).
+fn test_rays(scene: &Scene) -> Vec<Ray> {
+    let mut rays = primary_rays(&scene.cameras[0], 24, 24);
+    let mut rng = Rng::new(5, 0);
+    for _ in 0..500 {
+        let origin = Vec3::new(rng.next_f32() * 550.0, rng.next_f32() * 540.0, rng.next_f32() * 550.0);
+        let t_max = if rng.next_f32() < 0.5 { f32::INFINITY } else { rng.next_f32() * 300.0 };
+        rays.push(Ray::with_range(origin, uniform_sphere(rng.next_f32(), rng.next_f32()), 0.0, t_max));
+    }
+    rays.push(Ray::new(Vec3::new(f32::NAN, 1.0, 1.0), Vec3::Z));
+    rays.push(Ray::new(Vec3::splat(100.0), Vec3::ZERO));
+    rays.push(Ray::with_range(Vec3::splat(100.0), Vec3::Y, 5.0, 1.0));
+    rays
+}
+
+fn encode(rays: &[Ray]) -> Vec<u8> {
+    rays.iter()
+        .flat_map(|r| {
+            [r.origin.x, r.origin.y, r.origin.z, r.direction.x, r.direction.y, r.direction.z, r.t_min, r.t_max]
+                .map(f32::to_le_bytes)
+        })
+        .flatten()
+        .collect()
+}
+
+fn decode_hits(bytes: &[u8]) -> Vec<(f32, u32, f32, f32)> {
+    bytes
+        .chunks_exact(16)
+        .map(|c| {
+            let word = |i: usize| [c[i], c[i + 1], c[i + 2], c[i + 3]];
+            (
+                f32::from_le_bytes(word(0)),
+                u32::from_le_bytes(word(4)),
+                f32::from_le_bytes(word(8)),
+                f32::from_le_bytes(word(12)),
+            )
+        })
+        .collect()
+}
+
+#[test]
+fn trace_writes_the_hits_of_every_variant_identically() {
+    let dir = scratch_dir("trace");
+    let scene = Scene::load(&workspace_root().join(BOX)).unwrap();
+    let rays = test_rays(&scene);
+    let rays_path = dir.join("rays.bin");
+    std::fs::write(&rays_path, encode(&rays)).unwrap();
+    let reference = LinearScan::new(&scene.triangle_positions());
+
+    for accel in rtgi_accel::AccelKind::ALL {
+        for any_hit in [false, true] {
+            let out = dir.join(format!("{accel}-{any_hit}.bin"));
+            let mut args = vec!["trace", BOX, "--rays", s(&rays_path), "--out", s(&out), "--accel", accel.name()];
+            if any_hit {
+                args.push("--any-hit");
+            }
+            let run = rtgi(&args);
+            assert!(run.success, "{run:?}");
+            assert!(run.stderr.contains("Mrays/s") && run.stderr.contains("build"), "{}", run.stderr);
+            let hits = decode_hits(&std::fs::read(&out).unwrap());
+            assert_eq!(hits.len(), rays.len());
+            for (ray, &(t, triangle, beta, gamma)) in rays.iter().zip(&hits) {
+                if any_hit {
+                    let expected = if reference.occluded(ray) { 0 } else { u32::MAX };
+                    assert_eq!(triangle, expected, "{accel} any-hit {ray:?}");
+                } else {
+                    match reference.intersect(ray) {
+                        Some(h) => assert_eq!((t, triangle, beta, gamma), (h.t, h.triangle, h.beta, h.gamma)),
+                        None => assert_eq!((t, triangle), (f32::INFINITY, u32::MAX), "{accel} {ray:?}"),
+                    }
+                }
+            }
+        }
+    }
+    // Camera rays into the box hit something (the corners of the view pass
+    // outside the open box); the invalid rays at the end miss.
+    let hits = decode_hits(&std::fs::read(dir.join("sah-false.bin")).unwrap());
+    let central = (4..20).flat_map(|y| (4..20).map(move |x| y * 24 + x));
+    assert!(central.into_iter().all(|i| hits[i].1 != u32::MAX));
+    assert!(hits[hits.len() - 3..].iter().all(|h| h.1 == u32::MAX));
+}
+
+#[test]
+fn trace_refuses_a_truncated_ray_file() {
+    let dir = scratch_dir("trace-bad");
+    let rays = dir.join("short.bin");
+    std::fs::write(&rays, [0u8; 33]).unwrap();
+    let out = dir.join("hits.bin");
+    let run = rtgi(&["trace", BOX, "--rays", s(&rays), "--out", s(&out)]);
+    assert!(!run.success);
+    assert_eq!(run.stderr.trim().lines().count(), 1, "{}", run.stderr);
+    assert!(run.stderr.contains("short.bin") && run.stderr.contains("multiple of 32"), "{}", run.stderr);
+    assert!(!out.exists());
+    let missing = rtgi(&["trace", BOX, "--rays", s(&dir.join("none.bin")), "--out", s(&out)]);
+    assert!(!missing.success && missing.stderr.contains("none.bin"), "{missing:?}");
+}
+
+#[test]
+fn bench_measures_every_variant_and_writes_json() {
+    let dir = scratch_dir("bench");
+    let json = dir.join("bench.json");
+    let run =
+        rtgi(&["bench", "--width", "16", "--height", "16", "--rays", "500", "--repeats", "1", "--json", s(&json)]);
+    assert!(run.success, "{run:?}");
+    for kind in rtgi_accel::AccelKind::ALL {
+        assert!(run.stdout.lines().any(|l| l.starts_with(kind.name())), "{kind} missing from\n{}", run.stdout);
+    }
+    let text = std::fs::read_to_string(&json).unwrap();
+    assert_eq!(text.matches("\"variant\"").count(), rtgi_accel::AccelKind::ALL.len() * 2, "{text}");
+    for field in ["build_ms_all_threads", "sah_cost", "mrays_1_thread", "nodes_visited_per_ray", "speedup_vs_linear"] {
+        assert!(text.contains(field), "{field} missing");
+    }
+}
+
+#[test]
+fn bvh_boxes_are_written_as_obj_groups() {
+    let dir = scratch_dir("boxes");
+    let out = dir.join("boxes.obj");
+    let run = rtgi(&["bvh-boxes", "-o", s(&out), "--levels", "0,1"]);
+    assert!(run.success, "{run:?}");
+    let obj = std::fs::read_to_string(&out).unwrap();
+    assert!(obj.contains("g level_0") && obj.contains("g level_1"));
+    // The root and its two children: 3 boxes of 8 corners and 6 faces.
+    assert_eq!(obj.lines().filter(|l| l.starts_with("v ")).count(), 24);
+    assert_eq!(obj.lines().filter(|l| l.starts_with("f ")).count(), 18);
+    // The file is a valid OBJ that the scene loader reads back: 12 triangles a box.
+    let boxes = Scene::load(&out).unwrap();
+    assert_eq!(boxes.triangles.len(), 36);
+    let linear = rtgi(&["bvh-boxes", "-o", s(&dir.join("l.obj")), "--accel", "linear"]);
+    assert!(!linear.success && linear.stderr.contains("linear"), "{linear:?}");
+}
+
+#[test]
+fn heatmap_counts_nodes_per_pixel() {
+    let dir = scratch_dir("heatmap");
+    let exr = dir.join("cost.exr");
+    let run = rtgi(&["heatmap", "-o", s(&exr), "--width", "20", "--height", "20"]);
+    assert!(run.success, "{run:?}");
+    let counts = rtgi_image::HdrImage::read_exr(&exr).unwrap();
+    // Every ray tests at least the root's box; inside the closed box every camera ray hits.
+    assert!(counts.pixels().iter().all(|p| p.x >= 1.0 && p.z == 1.0));
+    let png = dir.join("cost.png");
+    let run = rtgi(&["heatmap", "-o", s(&png), "--width", "20", "--height", "10", "--triangles"]);
+    assert!(run.success, "{run:?}");
+    assert_eq!(image::open(&png).unwrap().to_rgb8().dimensions(), (20, 10));
+}
