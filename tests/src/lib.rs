@@ -81,10 +81,16 @@ pub fn run_cli(program: &str, args: &[&str]) -> Run {
 ///
 /// [`AccelKind::all_configurations`]: rtgi_accel::AccelKind::all_configurations
 /// [`AccelKind::ALL`]: rtgi_accel::AccelKind::ALL
-pub fn for_every_variant(triangles: &[[rtgi_math::Vec3; 3]], mut check: impl FnMut(&str, &dyn rtgi_accel::Accel)) {
+pub fn for_every_variant(
+    triangles: &[[rtgi_math::Vec3; 3]],
+    mut check: impl FnMut(&str, &dyn rtgi_accel::Accel, &rtgi_accel::BuildParams),
+) {
     for (kind, params) in rtgi_accel::AccelKind::all_configurations() {
         let accel = kind.build(triangles, &params);
-        let label = format!("{kind} (leaf {}, bins {})", params.max_leaf_size, params.sah_bins);
-        check(&label, accel.as_ref());
+        let label = format!(
+            "{kind} (leaf {}, bins {}, {}, {} traversal)",
+            params.max_leaf_size, params.sah_bins, params.intersector, params.traversal
+        );
+        check(&label, accel.as_ref(), &params);
     }
 }

@@ -1,7 +1,7 @@
 //! Every acceleration structure answers exactly as the linear scan does.
 
 use proptest::prelude::*;
-use rtgi_accel::{Accel, LinearScan};
+use rtgi_accel::{Accel, Intersector, LinearScan};
 use rtgi_math::{Ray, Vec3};
 use rtgi_tests::for_every_variant;
 
@@ -31,11 +31,17 @@ proptest! {
 
     #[test]
     fn every_variant_matches_the_linear_scan(triangles in soup(), rays in rays()) {
-        let reference = LinearScan::new(&triangles);
-        let expected: Vec<_> = rays.iter().map(|r| (reference.intersect(r), reference.occluded(r))).collect();
+        let references: Vec<(Intersector, Vec<_>)> = Intersector::ALL
+            .iter()
+            .map(|&i| {
+                let reference = LinearScan::new(&triangles, i);
+                (i, rays.iter().map(|r| (reference.intersect(r), reference.occluded(r))).collect())
+            })
+            .collect();
         let mut failures = Vec::new();
-        for_every_variant(&triangles, |label, accel| {
-            for (ray, (closest, any)) in rays.iter().zip(&expected) {
+        for_every_variant(&triangles, |label, accel, params| {
+            let expected = &references.iter().find(|(i, _)| *i == params.intersector).expect("every intersector").1;
+            for (ray, (closest, any)) in rays.iter().zip(expected) {
                 let got = accel.intersect(ray);
                 // Same distance and triangle; barycentrics come from the same test, so they match too.
                 if got.map(|h| (h.t, h.triangle)) != closest.map(|h| (h.t, h.triangle)) {
@@ -53,7 +59,7 @@ proptest! {
 #[test]
 fn helper_covers_every_variant() {
     let mut labels = Vec::new();
-    for_every_variant(&[[Vec3::ZERO, Vec3::X, Vec3::Y]], |label, _| labels.push(label.to_owned()));
+    for_every_variant(&[[Vec3::ZERO, Vec3::X, Vec3::Y]], |label, _, _| labels.push(label.to_owned()));
     for kind in rtgi_accel::AccelKind::ALL {
         assert!(labels.iter().any(|l| l.starts_with(kind.name())), "{kind} is not tested");
     }

@@ -68,7 +68,7 @@ fn trace_writes_the_hits_of_every_variant_identically() {
     let rays = test_rays(&scene);
     let rays_path = dir.join("rays.bin");
     std::fs::write(&rays_path, encode(&rays)).unwrap();
-    let reference = LinearScan::new(&scene.triangle_positions());
+    let reference = LinearScan::new(&scene.triangle_positions(), rtgi_accel::Intersector::default());
 
     for accel in rtgi_accel::AccelKind::ALL {
         for any_hit in [false, true] {

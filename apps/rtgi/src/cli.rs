@@ -2,7 +2,7 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 use clap::{Args, Parser, Subcommand};
-use rtgi_accel::{AccelKind, BuildParams};
+use rtgi_accel::{AccelKind, BuildParams, Intersector, Traversal};
 use rtgi_image::ToneOperator;
 use rtgi_math::Vec3;
 use rtgi_render::PixelSampler;
@@ -253,6 +253,14 @@ pub(crate) struct BuildArgs {
     /// Cost of a BVH traversal step relative to a ray/triangle test, for the SAH
     #[arg(long, default_value_t = BuildParams::default().traversal_cost)]
     pub(crate) traversal_cost: f32,
+
+    /// Ray/triangle test: watertight, moller-trumbore
+    #[arg(long, default_value_t = Intersector::default())]
+    pub(crate) intersector: Intersector,
+
+    /// BVH slab test: robust, fast
+    #[arg(long, default_value_t = Traversal::default())]
+    pub(crate) traversal: Traversal,
 }
 
 impl BuildArgs {
@@ -261,6 +269,8 @@ impl BuildArgs {
             max_leaf_size: self.leaf_size as usize,
             sah_bins: self.sah_bins as usize,
             traversal_cost: self.traversal_cost,
+            intersector: self.intersector,
+            traversal: self.traversal,
         }
     }
 }

@@ -3,7 +3,7 @@ use std::str::FromStr;
 
 use rtgi_math::Vec3;
 
-use crate::{Accel, Bvh, LinearScan, SplitMethod};
+use crate::{Accel, Bvh, Intersector, LinearScan, SplitMethod, Traversal};
 
 /// The acceleration structures this crate offers, selectable by name.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -29,11 +29,21 @@ pub struct BuildParams {
     pub sah_bins: usize,
     /// Cost of a traversal step relative to one ray/triangle test, for the SAH.
     pub traversal_cost: f32,
+    /// The ray/triangle test every query uses.
+    pub intersector: Intersector,
+    /// The slab test of BVH traversal.
+    pub traversal: Traversal,
 }
 
 impl Default for BuildParams {
     fn default() -> Self {
-        Self { max_leaf_size: 4, sah_bins: 16, traversal_cost: 1.0 }
+        Self {
+            max_leaf_size: 4,
+            sah_bins: 16,
+            traversal_cost: 1.0,
+            intersector: Intersector::default(),
+            traversal: Traversal::default(),
+        }
     }
 }
 
@@ -72,7 +82,7 @@ impl AccelKind {
     /// Builds this structure over `triangles`; hits name triangles by their index here.
     pub fn build(self, triangles: &[[Vec3; 3]], params: &BuildParams) -> Box<dyn Accel> {
         match self.split_method() {
-            None => Box::new(LinearScan::new(triangles)),
+            None => Box::new(LinearScan::new(triangles, params.intersector)),
             Some(method) => Box::new(Bvh::new(triangles, method, params)),
         }
     }
@@ -80,22 +90,26 @@ impl AccelKind {
 
 impl AccelKind {
     /// Every variant with a spread of build parameters (leaf sizes 1, 3 and
-    /// 8; for the binned SAH also 2 and 32 bins): the configurations that
+    /// 8; for the binned SAH also 2 and 32 bins), each with both
+    /// intersectors, all with the robust traversal: the configurations that
     /// tests run each case over, so that a new variant is tested as soon as
     /// it is added to [`AccelKind::ALL`].
     pub fn all_configurations() -> Vec<(AccelKind, BuildParams)> {
         let mut configurations = Vec::new();
-        for &kind in Self::ALL {
-            if kind.split_method().is_none() {
-                configurations.push((kind, BuildParams::default()));
-                continue;
-            }
-            for max_leaf_size in [1, 3, 8] {
-                configurations.push((kind, BuildParams { max_leaf_size, ..BuildParams::default() }));
-            }
-            if kind == AccelKind::Sah {
-                for sah_bins in [2, 32] {
-                    configurations.push((kind, BuildParams { sah_bins, ..BuildParams::default() }));
+        for &intersector in Intersector::ALL {
+            let base = BuildParams { intersector, ..BuildParams::default() };
+            for &kind in Self::ALL {
+                if kind.split_method().is_none() {
+                    configurations.push((kind, base.clone()));
+                    continue;
+                }
+                for max_leaf_size in [1, 3, 8] {
+                    configurations.push((kind, BuildParams { max_leaf_size, ..base.clone() }));
+                }
+                if kind == AccelKind::Sah {
+                    for sah_bins in [2, 32] {
+                        configurations.push((kind, BuildParams { sah_bins, ..base.clone() }));
+                    }
                 }
             }
         }

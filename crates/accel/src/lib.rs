@@ -27,11 +27,11 @@ mod kind;
 mod linear;
 mod triangle;
 
-pub use bvh::{Bvh, BvhNode, SplitMethod};
+pub use bvh::{Bvh, BvhNode, SplitMethod, Traversal};
 pub use counters::{Counter, NoCounter, TraversalCounters};
 pub use kind::{AccelKind, BuildParams, UnknownAccel};
 pub use linear::LinearScan;
-pub use triangle::{TriangleHit, intersect_triangle};
+pub use triangle::{Intersector, TriangleHit};
 
 use rtgi_math::Ray;
 use serde::Serialize;

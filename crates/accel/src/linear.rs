@@ -1,43 +1,61 @@
 use std::time::Instant;
 
-use rtgi_math::{Ray, Vec3};
+use rtgi_math::{Ray, Vec3, Vec3A};
 
-use crate::{Accel, BuildStats, Counter, Hit, NoCounter, TraversalCounters, intersect_triangle};
+use crate::triangle::{MollerTrumbore, TriangleTest, Watertight};
+use crate::{Accel, BuildStats, Counter, Hit, Intersector, NoCounter, TraversalCounters};
 
 /// The reference structure: every ray is tested against every triangle, in
 /// index order, O(n) per ray. Slow, simple, and the answer every other
 /// structure must reproduce.
 #[derive(Debug)]
 pub struct LinearScan {
-    triangles: Vec<[Vec3; 3]>,
+    triangles: Vec<[Vec3A; 3]>,
     stats: BuildStats,
+    intersector: Intersector,
 }
 
 impl LinearScan {
-    pub fn new(triangles: &[[Vec3; 3]]) -> Self {
+    pub fn new(triangles: &[[Vec3; 3]], intersector: Intersector) -> Self {
         let start = Instant::now();
-        let triangles = triangles.to_vec();
+        let excluded_triangles = triangles.iter().filter(|t| !crate::bvh::is_hittable(t)).count();
+        let triangles: Vec<[Vec3A; 3]> = triangles.iter().map(|t| t.map(Vec3A::from)).collect();
         let stats = BuildStats {
             variant: "linear".into(),
             triangles: triangles.len(),
-            excluded_triangles: triangles.iter().filter(|t| !crate::bvh::is_hittable(t)).count(),
+            excluded_triangles,
             build_ms: start.elapsed().as_secs_f64() * 1e3,
             memory_bytes: std::mem::size_of_val(triangles.as_slice()),
             ..BuildStats::default()
         };
-        Self { triangles, stats }
+        Self { triangles, stats, intersector }
     }
 
     fn closest<C: Counter>(&self, ray: &Ray, counter: &mut C) -> Option<Hit> {
+        match self.intersector {
+            Intersector::Watertight => self.closest_with::<C, Watertight>(ray, counter),
+            Intersector::MollerTrumbore => self.closest_with::<C, MollerTrumbore>(ray, counter),
+        }
+    }
+
+    fn any<C: Counter>(&self, ray: &Ray, counter: &mut C) -> bool {
+        match self.intersector {
+            Intersector::Watertight => self.any_with::<C, Watertight>(ray, counter),
+            Intersector::MollerTrumbore => self.any_with::<C, MollerTrumbore>(ray, counter),
+        }
+    }
+
+    fn closest_with<C: Counter, T: TriangleTest>(&self, ray: &Ray, counter: &mut C) -> Option<Hit> {
         if !ray.is_valid() {
             return None;
         }
+        let test_ray = T::prepare(ray.origin.into(), ray.direction.into());
         let mut closest: Option<Hit> = None;
         let mut t_max = ray.t_max;
         counter.triangles_tested(self.triangles.len() as u32);
         for (index, triangle) in self.triangles.iter().enumerate() {
             // Strictly closer only: at equal t the lower index, found first, stays.
-            if let Some(h) = intersect_triangle(ray.origin, ray.direction, ray.t_min, t_max, triangle) {
+            if let Some(h) = T::intersect(&test_ray, ray.t_min, t_max, triangle) {
                 if closest.is_none_or(|c| h.t < c.t) {
                     t_max = h.t;
                     closest = Some(Hit { t: h.t, triangle: index as u32, beta: h.beta, gamma: h.gamma });
@@ -47,12 +65,13 @@ impl LinearScan {
         closest
     }
 
-    fn any<C: Counter>(&self, ray: &Ray, counter: &mut C) -> bool {
+    fn any_with<C: Counter, T: TriangleTest>(&self, ray: &Ray, counter: &mut C) -> bool {
         if !ray.is_valid() {
             return false;
         }
+        let test_ray = T::prepare(ray.origin.into(), ray.direction.into());
         for (index, triangle) in self.triangles.iter().enumerate() {
-            if intersect_triangle(ray.origin, ray.direction, ray.t_min, ray.t_max, triangle).is_some() {
+            if T::intersect(&test_ray, ray.t_min, ray.t_max, triangle).is_some() {
                 counter.triangles_tested(index as u32 + 1);
                 return true;
             }

@@ -1,6 +1,12 @@
+//! Ray/triangle intersection tests.
+
+use std::fmt;
+use std::str::FromStr;
+
 use rtgi_math::{Vec3, Vec3A};
 
-/// Where a ray hits a triangle: distance and barycentric coordinates.
+/// Where a ray hits a triangle: distance and barycentric coordinates of
+/// the second and third corners (the first corner's is `1 - beta - gamma`).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct TriangleHit {
     pub t: f32,
@@ -8,48 +14,202 @@ pub struct TriangleHit {
     pub gamma: f32,
 }
 
-/// Ray/triangle intersection by Cramer's rule, as in the course and in
-/// Möller and Trumbore, "Fast, Minimum Storage Ray/Triangle Intersection"
-/// (JGT 1997): solve `o + t d = v0 + beta (v1 - v0) + gamma (v2 - v0)`.
-///
-/// Returns the hit if `t` lies in `[t_min, t_max]` and the point is inside
-/// the triangle, edges included. Both sides of the triangle are hit.
-/// Degenerate triangles (zero determinant) and rays in the triangle's plane
-/// are never hit.
-#[inline]
-pub fn intersect_triangle(origin: Vec3, direction: Vec3, t_min: f32, t_max: f32, v: &[Vec3; 3]) -> Option<TriangleHit> {
-    moller_trumbore(origin.into(), direction.into(), t_min, t_max, &v.map(Vec3A::from))
+/// The ray/triangle tests on offer.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum Intersector {
+    /// Woop, Benthin and Wald, "Watertight Ray/Triangle Intersection" (JCGT
+    /// 2013): a ray through a shared edge or vertex of a closed mesh always
+    /// hits at least one of the triangles that share it.
+    #[default]
+    Watertight,
+    /// Möller and Trumbore (JGT 1997), the course's Cramer's rule: faster to
+    /// write, but rounding lets rays slip through shared edges.
+    MollerTrumbore,
 }
 
-/// [`intersect_triangle`] on SIMD vectors, as the structures store them.
-#[inline(always)]
-pub(crate) fn moller_trumbore(
+impl Intersector {
+    pub const ALL: &'static [Intersector] = &[Intersector::Watertight, Intersector::MollerTrumbore];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            Intersector::Watertight => "watertight",
+            Intersector::MollerTrumbore => "moller-trumbore",
+        }
+    }
+
+    /// Intersects one ray with one triangle: the hit if its `t` lies in
+    /// `[t_min, t_max]` and the point is inside the triangle, edges
+    /// included. Both sides are hit; triangles of zero area and rays in a
+    /// triangle's plane never are.
+    pub fn intersect(
+        self,
+        origin: Vec3,
+        direction: Vec3,
+        t_min: f32,
+        t_max: f32,
+        v: &[Vec3; 3],
+    ) -> Option<TriangleHit> {
+        let v = v.map(Vec3A::from);
+        match self {
+            Intersector::Watertight => {
+                Watertight::intersect(&Watertight::prepare(origin.into(), direction.into()), t_min, t_max, &v)
+            }
+            Intersector::MollerTrumbore => {
+                MollerTrumbore::intersect(&MollerTrumbore::prepare(origin.into(), direction.into()), t_min, t_max, &v)
+            }
+        }
+    }
+}
+
+impl fmt::Display for Intersector {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl FromStr for Intersector {
+    type Err = String;
+
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        Self::ALL.iter().copied().find(|i| i.name() == s).ok_or_else(|| {
+            let names: Vec<_> = Self::ALL.iter().map(|i| i.name()).collect();
+            format!("unknown intersector '{s}' (expected one of: {})", names.join(", "))
+        })
+    }
+}
+
+/// A ray/triangle test with per-ray precomputation, for the structures'
+/// inner loops (monomorphised, so the choice costs nothing per triangle).
+pub(crate) trait TriangleTest {
+    type Ray;
+    fn prepare(origin: Vec3A, direction: Vec3A) -> Self::Ray;
+    fn intersect(ray: &Self::Ray, t_min: f32, t_max: f32, v: &[Vec3A; 3]) -> Option<TriangleHit>;
+}
+
+pub(crate) struct MollerTrumbore;
+
+pub(crate) struct MollerTrumboreRay {
     origin: Vec3A,
     direction: Vec3A,
-    t_min: f32,
-    t_max: f32,
-    v: &[Vec3A; 3],
-) -> Option<TriangleHit> {
-    let edge1 = v[1] - v[0];
-    let edge2 = v[2] - v[0];
-    let p = direction.cross(edge2);
-    let det = edge1.dot(p);
-    if det == 0.0 || !det.is_finite() {
-        return None;
+}
+
+impl TriangleTest for MollerTrumbore {
+    type Ray = MollerTrumboreRay;
+
+    #[inline(always)]
+    fn prepare(origin: Vec3A, direction: Vec3A) -> Self::Ray {
+        MollerTrumboreRay { origin, direction }
     }
-    let inv_det = 1.0 / det;
-    let s = origin - v[0];
-    let beta = s.dot(p) * inv_det;
-    if !(0.0..=1.0).contains(&beta) {
-        return None;
+
+    /// Solves `o + t d = v0 + beta (v1 - v0) + gamma (v2 - v0)` by Cramer's rule.
+    #[inline(always)]
+    fn intersect(ray: &Self::Ray, t_min: f32, t_max: f32, v: &[Vec3A; 3]) -> Option<TriangleHit> {
+        let edge1 = v[1] - v[0];
+        let edge2 = v[2] - v[0];
+        let p = ray.direction.cross(edge2);
+        let det = edge1.dot(p);
+        if det == 0.0 || !det.is_finite() {
+            return None;
+        }
+        let inv_det = 1.0 / det;
+        let s = ray.origin - v[0];
+        let beta = s.dot(p) * inv_det;
+        if !(0.0..=1.0).contains(&beta) {
+            return None;
+        }
+        let q = s.cross(edge1);
+        let gamma = ray.direction.dot(q) * inv_det;
+        if gamma < 0.0 || beta + gamma > 1.0 {
+            return None;
+        }
+        let t = edge2.dot(q) * inv_det;
+        (t >= t_min && t <= t_max).then_some(TriangleHit { t, beta, gamma })
     }
-    let q = s.cross(edge1);
-    let gamma = direction.dot(q) * inv_det;
-    if gamma < 0.0 || beta + gamma > 1.0 {
-        return None;
+}
+
+pub(crate) struct Watertight;
+
+/// The ray in the watertight test's frame: the axis where the direction is
+/// largest becomes z, and a shear maps the direction onto +z.
+pub(crate) struct WatertightRay {
+    origin: Vec3A,
+    /// Source axes of the permuted x, y and z.
+    axes: [usize; 3],
+    shear: [f32; 3],
+}
+
+impl TriangleTest for Watertight {
+    type Ray = WatertightRay;
+
+    /// Section 3 of Woop et al.: `kz` is the dimension where the direction
+    /// is largest in magnitude; `kx`, `ky` follow cyclically and swap when
+    /// `d[kz] < 0`, so that the winding of triangles is preserved.
+    #[inline(always)]
+    fn prepare(origin: Vec3A, direction: Vec3A) -> Self::Ray {
+        let d = direction.to_array();
+        let a = direction.abs().to_array();
+        let kz = if a[0] >= a[1] && a[0] >= a[2] {
+            0
+        } else if a[1] >= a[2] {
+            1
+        } else {
+            2
+        };
+        let (mut kx, mut ky) = ((kz + 1) % 3, (kz + 2) % 3);
+        if d[kz] < 0.0 {
+            std::mem::swap(&mut kx, &mut ky);
+        }
+        WatertightRay { origin, axes: [kx, ky, kz], shear: [d[kx] / d[kz], d[ky] / d[kz], 1.0 / d[kz]] }
     }
-    let t = edge2.dot(q) * inv_det;
-    (t >= t_min && t <= t_max).then_some(TriangleHit { t, beta, gamma })
+
+    #[inline(always)]
+    fn intersect(ray: &Self::Ray, t_min: f32, t_max: f32, v: &[Vec3A; 3]) -> Option<TriangleHit> {
+        let [kx, ky, kz] = ray.axes;
+        let [sx, sy, sz] = ray.shear;
+        // Vertices relative to the origin, permuted and sheared. Every vertex
+        // goes through the same arithmetic whichever triangle it belongs to,
+        // so neighbours see the same transformed edge.
+        let transform = |vertex: Vec3A| {
+            let p = (vertex - ray.origin).to_array();
+            [p[kx] - sx * p[kz], p[ky] - sy * p[kz], p[kz]]
+        };
+        let [a, b, c] = v.map(transform);
+        // Scaled barycentrics: the 2D edge functions. A shared edge gives
+        // exactly negated values in the two triangles (products commute and
+        // x - y = -(y - x) exactly); no fused multiply-add may change that.
+        let mut u = c[0] * b[1] - c[1] * b[0];
+        let mut v_ = a[0] * c[1] - a[1] * c[0];
+        let mut w = b[0] * a[1] - b[1] * a[0];
+        // On an edge, single precision may have rounded a tiny value to zero:
+        // decide in double precision, where the products are exact.
+        if u == 0.0 || v_ == 0.0 || w == 0.0 {
+            let edge = |p: [f32; 3], q: [f32; 3]| (p[0] as f64 * q[1] as f64 - p[1] as f64 * q[0] as f64) as f32;
+            u = edge(c, b);
+            v_ = edge(a, c);
+            w = edge(b, a);
+        }
+        if (u < 0.0 || v_ < 0.0 || w < 0.0) && (u > 0.0 || v_ > 0.0 || w > 0.0) {
+            return None;
+        }
+        let det = u + v_ + w;
+        if det == 0.0 || !det.is_finite() {
+            return None;
+        }
+        // Scaled distance, compared against the range scaled by the
+        // determinant so that only hits pay for the division.
+        let t_scaled = u * (sz * a[2]) + v_ * (sz * b[2]) + w * (sz * c[2]);
+        let (t_scaled, abs_det) = if det < 0.0 { (-t_scaled, -det) } else { (t_scaled, det) };
+        if t_scaled < t_min * abs_det || t_scaled > t_max * abs_det {
+            return None;
+        }
+        let inv_det = 1.0 / det;
+        let t = t_scaled / abs_det;
+        // Rounding of the division can move t just outside the range checked above.
+        if t < t_min || t > t_max {
+            return None;
+        }
+        Some(TriangleHit { t, beta: v_ * inv_det, gamma: w * inv_det })
+    }
 }
 
 #[cfg(test)]
@@ -58,31 +218,72 @@ mod tests {
 
     const TRI: [Vec3; 3] = [Vec3::new(0.0, 0.0, 0.0), Vec3::new(1.0, 0.0, 0.0), Vec3::new(0.0, 1.0, 0.0)];
 
+    /// Within a few units in the last place: the tests compute t and the
+    /// barycentrics by different formulas, each rounded differently.
+    fn close(a: f32, b: f32) -> bool {
+        (a - b).abs() <= 4.0 * f32::EPSILON * a.abs().max(b.abs()).max(1.0)
+    }
+
     #[test]
     fn barycentrics_reproduce_the_hit_point() {
-        let o = Vec3::new(0.25, 0.5, -2.0);
-        let hit = intersect_triangle(o, Vec3::Z, 0.0, f32::INFINITY, &TRI).unwrap();
-        assert_eq!(hit.t, 2.0);
-        let p = (1.0 - hit.beta - hit.gamma) * TRI[0] + hit.beta * TRI[1] + hit.gamma * TRI[2];
-        assert!((p - (o + hit.t * Vec3::Z)).length() < 1e-6);
-        assert_eq!((hit.beta, hit.gamma), (0.25, 0.5));
+        for test in Intersector::ALL {
+            let o = Vec3::new(0.25, 0.5, -2.0);
+            let hit = test.intersect(o, Vec3::Z, 0.0, f32::INFINITY, &TRI).unwrap();
+            assert!(close(hit.t, 2.0) && close(hit.beta, 0.25) && close(hit.gamma, 0.5), "{test}: {hit:?}");
+        }
     }
 
     #[test]
     fn both_sides_hit_and_range_respected() {
-        let from_above = intersect_triangle(Vec3::new(0.2, 0.2, 3.0), -Vec3::Z, 0.0, 10.0, &TRI);
-        assert_eq!(from_above.map(|h| h.t), Some(3.0));
-        assert!(intersect_triangle(Vec3::new(0.2, 0.2, 3.0), -Vec3::Z, 0.0, 2.9, &TRI).is_none());
-        assert!(intersect_triangle(Vec3::new(0.2, 0.2, 3.0), -Vec3::Z, 3.1, 9.0, &TRI).is_none());
-        assert!(intersect_triangle(Vec3::new(0.2, 0.2, 3.0), Vec3::Z, 0.0, 10.0, &TRI).is_none());
+        for test in Intersector::ALL {
+            let o = Vec3::new(0.2, 0.2, 3.0);
+            assert!(close(test.intersect(o, -Vec3::Z, 0.0, 10.0, &TRI).unwrap().t, 3.0), "{test}");
+            assert!(test.intersect(o, -Vec3::Z, 0.0, 2.9, &TRI).is_none(), "{test}");
+            assert!(test.intersect(o, -Vec3::Z, 3.1, 9.0, &TRI).is_none(), "{test}");
+            assert!(test.intersect(o, Vec3::Z, 0.0, 10.0, &TRI).is_none(), "{test}");
+            // A reversed triangle (the other winding) is hit the same way.
+            let reversed = [TRI[0], TRI[2], TRI[1]];
+            let hit = test.intersect(o, -Vec3::Z, 0.0, 10.0, &reversed).unwrap();
+            assert!(close(hit.t, 3.0) && close(hit.beta, 0.2) && close(hit.gamma, 0.2), "{test}: {hit:?}");
+        }
     }
 
     #[test]
-    fn misses_outside_and_degenerate() {
-        assert!(intersect_triangle(Vec3::new(0.8, 0.8, -1.0), Vec3::Z, 0.0, 9.0, &TRI).is_none());
-        let line = [Vec3::ZERO, Vec3::X, 2.0 * Vec3::X];
-        assert!(intersect_triangle(Vec3::new(0.5, 0.0, -1.0), Vec3::Z, 0.0, 9.0, &line).is_none());
-        // In the triangle's plane.
-        assert!(intersect_triangle(Vec3::new(-1.0, 0.2, 0.0), Vec3::X, 0.0, 9.0, &TRI).is_none());
+    fn misses_outside_degenerate_and_in_plane() {
+        for test in Intersector::ALL {
+            assert!(test.intersect(Vec3::new(0.8, 0.8, -1.0), Vec3::Z, 0.0, 9.0, &TRI).is_none());
+            let line = [Vec3::ZERO, Vec3::X, 2.0 * Vec3::X];
+            assert!(test.intersect(Vec3::new(0.5, 0.0, -1.0), Vec3::Z, 0.0, 9.0, &line).is_none(), "{test}");
+            assert!(test.intersect(Vec3::new(-1.0, 0.2, 0.0), Vec3::X, 0.0, 9.0, &TRI).is_none(), "{test}");
+        }
+    }
+
+    #[test]
+    fn watertight_counts_edges_and_vertices_as_inside() {
+        let w = Intersector::Watertight;
+        // On the hypotenuse, on a leg and on a corner.
+        for p in [Vec3::new(0.5, 0.5, -1.0), Vec3::new(0.5, 0.0, -1.0), Vec3::new(0.0, 0.0, -1.0)] {
+            assert!(w.intersect(p, Vec3::Z, 0.0, 9.0, &TRI).is_some(), "{p}");
+        }
+    }
+
+    #[test]
+    fn every_direction_axis_and_sign() {
+        // The test permutes axes by the largest direction component; try each.
+        for axis in 0..3 {
+            for sign in [1.0f32, -1.0] {
+                let mut d = [0.1f32, 0.2, 0.15];
+                d[axis] = sign;
+                let d = Vec3::from(d);
+                // A big triangle across the ray, 5 units ahead.
+                let centre = 5.0 * d;
+                let frame = rtgi_math::Frame::from_z(d.normalize());
+                let tri = [centre + frame.x * 3.0, centre + frame.y * 3.0, centre - (frame.x + frame.y) * 3.0];
+                for test in Intersector::ALL {
+                    let hit = test.intersect(Vec3::ZERO, d, 0.0, f32::INFINITY, &tri).unwrap();
+                    assert!((hit.t - 5.0).abs() < 1e-5, "{test} axis {axis} sign {sign}: {}", hit.t);
+                }
+            }
+        }
     }
 }

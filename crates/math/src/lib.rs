@@ -19,6 +19,7 @@ mod float;
 mod frame;
 mod ray;
 mod rng;
+mod spawn;
 
 pub use aabb::Aabb;
 pub use float::{gamma, next_float_down, next_float_up};
@@ -27,3 +28,4 @@ pub use glam;
 pub use glam::{BVec3A, Mat3, Mat4, Vec2, Vec3, Vec3A, Vec4, vec2, vec3};
 pub use ray::{Ray, RayWithInverse};
 pub use rng::{Rng, hash_u64};
+pub use spawn::{SurfacePoint, geometric_normal, offset_ray_origin};

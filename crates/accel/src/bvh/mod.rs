@@ -14,6 +14,7 @@ mod traverse;
 mod validate;
 
 pub use build::SplitMethod;
+pub use traverse::Traversal;
 
 use std::time::Instant;
 
@@ -103,6 +104,8 @@ pub struct Bvh {
     /// For each triangle in leaf order, its index in the input.
     triangle_ids: Vec<u32>,
     stats: BuildStats,
+    intersector: crate::Intersector,
+    traversal: Traversal,
 }
 
 impl Bvh {
@@ -143,7 +146,14 @@ impl Bvh {
                 + std::mem::size_of::<[Vec3A; 3]>() * triangle_ids.len()
                 + std::mem::size_of_val(triangle_ids.as_slice()),
         };
-        Self { nodes: tree.nodes, triangles: leaf_triangles, triangle_ids, stats }
+        Self {
+            nodes: tree.nodes,
+            triangles: leaf_triangles,
+            triangle_ids,
+            stats,
+            intersector: params.intersector,
+            traversal: params.traversal,
+        }
     }
 
     /// The flattened nodes; the root is node 0 (absent for an empty tree).
@@ -228,6 +238,7 @@ mod tests {
     fn every_bvh(triangles: &[[Vec3; 3]]) -> Vec<(String, Bvh)> {
         AccelKind::all_configurations()
             .into_iter()
+            .filter(|(_, params)| params.intersector == crate::Intersector::default())
             .filter_map(|(kind, params)| {
                 let method = kind.split_method()?;
                 Some((format!("{kind} {params:?}"), Bvh::new(triangles, method, &params)))
@@ -238,7 +249,7 @@ mod tests {
     #[test]
     fn trees_are_valid_and_agree_with_the_linear_scan() {
         let triangles = random_soup(3000, 1);
-        let linear = crate::LinearScan::new(&triangles);
+        let linear = crate::LinearScan::new(&triangles, crate::Intersector::default());
         let mut rng = Rng::new(2, 0);
         let rays: Vec<Ray> = (0..500)
             .map(|_| {

@@ -1,10 +1,15 @@
-//! Front-to-back traversal with an explicit stack.
+//! Front-to-back traversal with an explicit stack, generic over the
+//! ray/triangle test and the slab test so that every combination runs as
+//! its own monomorphised loop.
+
+use std::fmt;
+use std::str::FromStr;
 
 use rtgi_math::{BVec3A, Ray, Vec3A, gamma};
 
 use super::{Bvh, BvhNode};
-use crate::triangle::moller_trumbore;
-use crate::{Counter, Hit};
+use crate::triangle::{MollerTrumbore, TriangleTest, Watertight};
+use crate::{Counter, Hit, Intersector};
 
 /// Entries of the largest traversal stack. A stack holds at most one entry
 /// per level of the tree, and builds never exceed 64 + 32 levels (see
@@ -19,10 +24,52 @@ pub(crate) const STACK_SIZE: usize = 128;
 /// Traversal", JCGT 2013; pbrt-v4 `Bounds3::IntersectP`).
 const ROBUST_FAR_SCALE: f32 = 1.0 + 2.0 * gamma(3);
 
+/// How a BVH tests rays against its boxes.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum Traversal {
+    /// Conservative: exit distances enlarged by `1 + 2γ(3)` (Ize 2013),
+    /// near and far planes chosen by the direction's sign bit, and the NaN
+    /// of `0 · ∞` (an origin on a slab plane along a zero direction
+    /// component) ignored. Never drops a box the ray touches.
+    #[default]
+    Robust,
+    /// The common textbook slab test: `min`/`max` of the two plane
+    /// distances, no enlargement. Rounding can drop boxes that rays graze,
+    /// and NaN can drop boxes whose planes contain the origin.
+    Fast,
+}
+
+impl Traversal {
+    pub const ALL: &'static [Traversal] = &[Traversal::Robust, Traversal::Fast];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            Traversal::Robust => "robust",
+            Traversal::Fast => "fast",
+        }
+    }
+}
+
+impl fmt::Display for Traversal {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl FromStr for Traversal {
+    type Err = String;
+
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        Self::ALL.iter().copied().find(|t| t.name() == s).ok_or_else(|| {
+            let names: Vec<_> = Self::ALL.iter().map(|t| t.name()).collect();
+            format!("unknown traversal '{s}' (expected one of: {})", names.join(", "))
+        })
+    }
+}
+
 /// A ray prepared for box tests.
 struct PreparedRay {
     origin: Vec3A,
-    direction: Vec3A,
     inv_direction: Vec3A,
     /// Lanes where the direction's sign bit is set (so -0 counts as negative):
     /// there the box's max plane is entered first.
@@ -34,11 +81,9 @@ impl PreparedRay {
     #[inline(always)]
     fn new(ray: &Ray) -> Self {
         let direction = Vec3A::from(ray.direction);
-        let inv_direction = Vec3A::ONE / direction;
         Self {
             origin: ray.origin.into(),
-            direction,
-            inv_direction,
+            inv_direction: Vec3A::ONE / direction,
             negative: BVec3A::new(
                 direction.x.is_sign_negative(),
                 direction.y.is_sign_negative(),
@@ -47,25 +92,40 @@ impl PreparedRay {
             t_min: ray.t_min,
         }
     }
+}
 
-    /// The distance at which the ray enters the node's box within
-    /// `[t_min, t_max]`, or +∞ if it misses.
-    ///
-    /// A NaN slab distance (`0 · ∞`, an origin on a slab plane with a zero
-    /// direction component) is discarded by the compare-and-select, so it
-    /// neither hides nor invents a hit; no min/max instruction sees a NaN,
-    /// whose handling differs between SIMD instruction sets.
+/// A slab test: the distance at which the ray enters the node's box within
+/// `[t_min, t_max]`, or +∞ if it misses.
+trait SlabTest {
+    fn enter(ray: &PreparedRay, node: &BvhNode, t_max: f32) -> f32;
+}
+
+struct RobustSlabs;
+
+impl SlabTest for RobustSlabs {
     #[inline(always)]
-    fn enter(&self, node: &BvhNode, t_max: f32) -> f32 {
+    fn enter(ray: &PreparedRay, node: &BvhNode, t_max: f32) -> f32 {
         let (min, max) = node.corners();
-        let t_min_planes = (min - self.origin) * self.inv_direction;
-        let t_max_planes = (max - self.origin) * self.inv_direction;
-        let near = Vec3A::select(self.negative, t_max_planes, t_min_planes);
-        let far = Vec3A::select(self.negative, t_min_planes, t_max_planes) * ROBUST_FAR_SCALE;
-        let lower = Vec3A::splat(self.t_min);
-        let upper = Vec3A::splat(t_max);
-        let (enter, exit) = clip_nan_ignoring(near, far, lower, upper);
+        let t_min_planes = (min - ray.origin) * ray.inv_direction;
+        let t_max_planes = (max - ray.origin) * ray.inv_direction;
+        let near = Vec3A::select(ray.negative, t_max_planes, t_min_planes);
+        let far = Vec3A::select(ray.negative, t_min_planes, t_max_planes) * ROBUST_FAR_SCALE;
+        let (enter, exit) = clip_nan_ignoring(near, far, Vec3A::splat(ray.t_min), Vec3A::splat(t_max));
         if enter <= exit && enter < f32::INFINITY { enter } else { f32::INFINITY }
+    }
+}
+
+struct FastSlabs;
+
+impl SlabTest for FastSlabs {
+    #[inline(always)]
+    fn enter(ray: &PreparedRay, node: &BvhNode, t_max: f32) -> f32 {
+        let (min, max) = node.corners();
+        let t1 = (min - ray.origin) * ray.inv_direction;
+        let t2 = (max - ray.origin) * ray.inv_direction;
+        let enter = t1.min(t2).max_element().max(ray.t_min);
+        let exit = t1.max(t2).min_element().min(t_max);
+        if enter <= exit { enter } else { f32::INFINITY }
     }
 }
 
@@ -96,10 +156,11 @@ impl Bvh {
     /// and shrinking `t_max`. At equal distances the triangle with the lower
     /// input index wins, so every variant and leaf size gives the same answer.
     #[inline(always)]
-    fn leaf_closest<C: Counter>(
+    fn leaf_closest<C: Counter, T: TriangleTest>(
         &self,
         leaf: &BvhNode,
-        prepared: &PreparedRay,
+        test_ray: &T::Ray,
+        t_min: f32,
         t_max: &mut f32,
         best: &mut Option<Hit>,
         counter: &mut C,
@@ -107,7 +168,7 @@ impl Bvh {
         let range = leaf.first() as usize..(leaf.first() + leaf.count()) as usize;
         counter.triangles_tested(leaf.count());
         for (triangle, &id) in self.triangles[range.clone()].iter().zip(&self.triangle_ids[range]) {
-            let Some(h) = moller_trumbore(prepared.origin, prepared.direction, prepared.t_min, *t_max, triangle) else {
+            let Some(h) = T::intersect(test_ray, t_min, *t_max, triangle) else {
                 continue;
             };
             // The test only reports t <= t_max, the best distance so far.
@@ -122,36 +183,69 @@ impl Bvh {
     /// hit, the farther child of two pushed on a fixed-size stack no larger
     /// than the tree's depth needs.
     pub(crate) fn closest<C: Counter>(&self, ray: &Ray, counter: &mut C) -> Option<Hit> {
-        match self.stats.depth {
-            0..=32 => self.closest_with_stack::<C, 32>(ray, counter),
-            33..=64 => self.closest_with_stack::<C, 64>(ray, counter),
-            _ => self.closest_with_stack::<C, STACK_SIZE>(ray, counter),
+        match (self.intersector, self.traversal) {
+            (Intersector::Watertight, Traversal::Robust) => {
+                self.closest_sized::<C, Watertight, RobustSlabs>(ray, counter)
+            }
+            (Intersector::Watertight, Traversal::Fast) => self.closest_sized::<C, Watertight, FastSlabs>(ray, counter),
+            (Intersector::MollerTrumbore, Traversal::Robust) => {
+                self.closest_sized::<C, MollerTrumbore, RobustSlabs>(ray, counter)
+            }
+            (Intersector::MollerTrumbore, Traversal::Fast) => {
+                self.closest_sized::<C, MollerTrumbore, FastSlabs>(ray, counter)
+            }
         }
     }
 
     /// Any hit: stops at the first triangle found.
     pub(crate) fn any<C: Counter>(&self, ray: &Ray, counter: &mut C) -> bool {
-        match self.stats.depth {
-            0..=32 => self.any_with_stack::<C, 32>(ray, counter),
-            33..=64 => self.any_with_stack::<C, 64>(ray, counter),
-            _ => self.any_with_stack::<C, STACK_SIZE>(ray, counter),
+        match (self.intersector, self.traversal) {
+            (Intersector::Watertight, Traversal::Robust) => self.any_sized::<C, Watertight, RobustSlabs>(ray, counter),
+            (Intersector::Watertight, Traversal::Fast) => self.any_sized::<C, Watertight, FastSlabs>(ray, counter),
+            (Intersector::MollerTrumbore, Traversal::Robust) => {
+                self.any_sized::<C, MollerTrumbore, RobustSlabs>(ray, counter)
+            }
+            (Intersector::MollerTrumbore, Traversal::Fast) => {
+                self.any_sized::<C, MollerTrumbore, FastSlabs>(ray, counter)
+            }
         }
     }
 
-    fn closest_with_stack<C: Counter, const STACK: usize>(&self, ray: &Ray, counter: &mut C) -> Option<Hit> {
+    fn closest_sized<C: Counter, T: TriangleTest, S: SlabTest>(&self, ray: &Ray, counter: &mut C) -> Option<Hit> {
+        match self.stats.depth {
+            0..=32 => self.closest_with_stack::<C, T, S, 32>(ray, counter),
+            33..=64 => self.closest_with_stack::<C, T, S, 64>(ray, counter),
+            _ => self.closest_with_stack::<C, T, S, STACK_SIZE>(ray, counter),
+        }
+    }
+
+    fn any_sized<C: Counter, T: TriangleTest, S: SlabTest>(&self, ray: &Ray, counter: &mut C) -> bool {
+        match self.stats.depth {
+            0..=32 => self.any_with_stack::<C, T, S, 32>(ray, counter),
+            33..=64 => self.any_with_stack::<C, T, S, 64>(ray, counter),
+            _ => self.any_with_stack::<C, T, S, STACK_SIZE>(ray, counter),
+        }
+    }
+
+    fn closest_with_stack<C: Counter, T: TriangleTest, S: SlabTest, const STACK: usize>(
+        &self,
+        ray: &Ray,
+        counter: &mut C,
+    ) -> Option<Hit> {
         if !ray.is_valid() || self.nodes.is_empty() {
             return None;
         }
         let prepared = PreparedRay::new(ray);
+        let test_ray = T::prepare(ray.origin.into(), ray.direction.into());
         let mut best: Option<Hit> = None;
         let mut t_max = ray.t_max;
         let root = &self.nodes[0];
         counter.node_visited();
-        if prepared.enter(root, t_max) == f32::INFINITY {
+        if S::enter(&prepared, root, t_max) == f32::INFINITY {
             return None;
         }
         if root.is_leaf() {
-            self.leaf_closest(root, &prepared, &mut t_max, &mut best, counter);
+            self.leaf_closest::<C, T>(root, &test_ray, ray.t_min, &mut t_max, &mut best, counter);
             return best;
         }
         let mut stack = [0u32; STACK];
@@ -162,21 +256,21 @@ impl Bvh {
             counter.node_visited();
             counter.node_visited();
             let (mut near, mut far) = (&pair[0], &pair[1]);
-            let (mut enter_near, mut enter_far) = (prepared.enter(near, t_max), prepared.enter(far, t_max));
+            let (mut enter_near, mut enter_far) = (S::enter(&prepared, near, t_max), S::enter(&prepared, far, t_max));
             if enter_far < enter_near {
                 std::mem::swap(&mut near, &mut far);
                 std::mem::swap(&mut enter_near, &mut enter_far);
             }
             let mut descend_near = enter_near < f32::INFINITY;
             if descend_near && near.is_leaf() {
-                self.leaf_closest(near, &prepared, &mut t_max, &mut best, counter);
+                self.leaf_closest::<C, T>(near, &test_ray, ray.t_min, &mut t_max, &mut best, counter);
                 descend_near = false;
             }
             // The near leaf may have found a hit in front of the far box. (A
             // missed box enters at +∞, which an unbounded t_max does not exclude.)
             let mut descend_far = enter_far < f32::INFINITY && enter_far <= t_max;
             if descend_far && far.is_leaf() {
-                self.leaf_closest(far, &prepared, &mut t_max, &mut best, counter);
+                self.leaf_closest::<C, T>(far, &test_ray, ray.t_min, &mut t_max, &mut best, counter);
                 descend_far = false;
             }
             children = match (descend_near, descend_far) {
@@ -198,16 +292,21 @@ impl Bvh {
         }
     }
 
-    fn any_with_stack<C: Counter, const STACK: usize>(&self, ray: &Ray, counter: &mut C) -> bool {
+    fn any_with_stack<C: Counter, T: TriangleTest, S: SlabTest, const STACK: usize>(
+        &self,
+        ray: &Ray,
+        counter: &mut C,
+    ) -> bool {
         if !ray.is_valid() || self.nodes.is_empty() {
             return false;
         }
         let prepared = PreparedRay::new(ray);
+        let test_ray = T::prepare(ray.origin.into(), ray.direction.into());
         let t_max = ray.t_max;
         let leaf_hit = |leaf: &BvhNode, counter: &mut C| {
             let range = leaf.first() as usize..(leaf.first() + leaf.count()) as usize;
             for (tested, triangle) in self.triangles[range].iter().enumerate() {
-                if moller_trumbore(prepared.origin, prepared.direction, prepared.t_min, t_max, triangle).is_some() {
+                if T::intersect(&test_ray, ray.t_min, t_max, triangle).is_some() {
                     counter.triangles_tested(tested as u32 + 1);
                     return true;
                 }
@@ -217,7 +316,7 @@ impl Bvh {
         };
         let root = &self.nodes[0];
         counter.node_visited();
-        if prepared.enter(root, t_max) == f32::INFINITY {
+        if S::enter(&prepared, root, t_max) == f32::INFINITY {
             return false;
         }
         if root.is_leaf() {
@@ -232,7 +331,7 @@ impl Bvh {
             counter.node_visited();
             let mut descend = [false; 2];
             for (side, node) in pair.iter().enumerate() {
-                if prepared.enter(node, t_max) < f32::INFINITY {
+                if S::enter(&prepared, node, t_max) < f32::INFINITY {
                     if node.is_leaf() {
                         if leaf_hit(node, counter) {
                             return true;

@@ -1,0 +1,142 @@
+//! Rays that leave surfaces without hitting them again.
+//!
+//! A hit point computed in floating point lies near the surface, not on
+//! it: a ray spawned there may hit the surface it leaves. Instead of a
+//! fixed epsilon, which fails at some scale, the origin moves off the
+//! surface along the geometric normal by a conservative bound on the hit
+//! point's rounding error, then one more float away (pbrt-v4, section
+//! 6.8.6, `OffsetRayOrigin`). The offset is a few ulps of the coordinates,
+//! so it works at every scale and leaks almost no light through thin gaps.
+
+use glam::Vec3;
+
+use crate::float::{gamma, next_float_down, next_float_up};
+use crate::ray::Ray;
+
+/// A point on a triangle, with a per-coordinate bound on the absolute
+/// error of its computed position and the triangle's geometric normal.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SurfacePoint {
+    pub position: Vec3,
+    /// `|computed - exact| <= error` in each coordinate.
+    pub error: Vec3,
+    /// Unit geometric normal (either side).
+    pub normal: Vec3,
+}
+
+impl SurfacePoint {
+    /// The point with barycentric coordinates `(1 - beta - gamma, beta,
+    /// gamma)` on the triangle `corners`, as a ray/triangle test reports
+    /// it. The error bound `γ(7) Σ |b_i p_i|` covers the barycentrics' and
+    /// the interpolation's rounding (pbrt-v4, section 6.8.5).
+    pub fn on_triangle(corners: &[Vec3; 3], beta: f32, gamma_: f32) -> Self {
+        let alpha = 1.0 - beta - gamma_;
+        let [p0, p1, p2] = corners;
+        let position = alpha * *p0 + beta * *p1 + gamma_ * *p2;
+        let error = gamma(7) * ((alpha * *p0).abs() + (beta * *p1).abs() + (gamma_ * *p2).abs());
+        Self { position, error, normal: geometric_normal(corners) }
+    }
+
+    /// The origin for a ray leaving this point towards `direction`.
+    pub fn offset_origin(&self, direction: Vec3) -> Vec3 {
+        offset_ray_origin(self.position, self.error, self.normal, direction)
+    }
+
+    /// A ray from this point towards `direction`, over `(0, ∞)`.
+    pub fn spawn_ray(&self, direction: Vec3) -> Ray {
+        Ray::with_range(self.offset_origin(direction), direction, SPAWN_T_MIN, f32::INFINITY)
+    }
+
+    /// A ray from this point to `target`: both ends are moved off their
+    /// surfaces by their error bounds, towards each other, and the ray runs
+    /// over `[0, 1 - 16ε]` of the segment between them. (The parameter
+    /// bound stops ties with the target's surface, whose computed distance
+    /// may round to 1; it is relative, so the same at every scale.)
+    pub fn spawn_ray_to(&self, target: &SurfacePoint) -> Ray {
+        let from = self.offset_origin(target.position - self.position);
+        let to = target.offset_origin(from - target.position);
+        Ray::with_range(from, to - from, SPAWN_T_MIN, SHADOW_T_MAX)
+    }
+
+    /// A ray from this point to a point `target` that lies on no surface
+    /// (a point light), over `[0, 1 - 16ε]`.
+    pub fn spawn_ray_to_point(&self, target: Vec3) -> Ray {
+        let from = self.offset_origin(target - self.position);
+        Ray::with_range(from, target - from, SPAWN_T_MIN, SHADOW_T_MAX)
+    }
+}
+
+/// The unit normal of a triangle by the right-hand rule, or zero for a
+/// degenerate one. Edges are scaled to unit size first, so that the cross
+/// product of tiny triangles (edges of 1e-20) does not underflow.
+pub fn geometric_normal(corners: &[Vec3; 3]) -> Vec3 {
+    let unit = |e: Vec3| {
+        let size = e.abs().max_element();
+        if size > 0.0 { e / size } else { Vec3::ZERO }
+    };
+    unit(corners[1] - corners[0]).cross(unit(corners[2] - corners[0])).normalize_or_zero()
+}
+
+/// Spawned rays exclude `t = 0` (the smallest positive float is their
+/// start): an origin moved off an exactly computed point on an exact plane
+/// may be only a subnormal distance away, and the products of a
+/// ray/triangle test can round such a tiny negative distance to -0.
+const SPAWN_T_MIN: f32 = f32::from_bits(1);
+
+/// The end of shadow-ray segments: 1 less the rounding of a computed hit distance.
+const SHADOW_T_MAX: f32 = 1.0 - 16.0 * f32::EPSILON;
+
+/// Moves `p` off its surface to the side of `normal` that `direction`
+/// points to, by the error bound `error` projected on the normal, and then
+/// rounds each moved coordinate one float further to that side (pbrt-v4,
+/// `OffsetRayOrigin`). The last step happens even where the error bound is
+/// zero (a point computed exactly, on an axis-aligned surface), so the
+/// origin always leaves the surface and a hit at `t = 0` cannot occur.
+pub fn offset_ray_origin(p: Vec3, error: Vec3, normal: Vec3, direction: Vec3) -> Vec3 {
+    let side = if direction.dot(normal) < 0.0 { -normal } else { normal };
+    let moved = p + side.abs().dot(error) * side;
+    let away = |value: f32, towards: f32| {
+        if towards > 0.0 {
+            next_float_up(value)
+        } else if towards < 0.0 {
+            next_float_down(value)
+        } else {
+            value
+        }
+    };
+    Vec3::new(away(moved.x, side.x), away(moved.y, side.y), away(moved.z, side.z))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn offset_is_on_the_side_of_the_direction_and_scales_with_the_point() {
+        for scale in [1e-20f32, 1e-3, 1.0, 1e3, 1e7, 1e20] {
+            let corners =
+                [Vec3::new(0.0, 0.0, 1.0), Vec3::new(1.0, 0.0, 1.0), Vec3::new(0.0, 1.0, 1.0)].map(|c| c * scale);
+            let point = SurfacePoint::on_triangle(&corners, 0.25, 0.25);
+            assert!(point.error.max_element() > 0.0 && point.error.max_element() < 1e-5 * scale);
+            let up = point.offset_origin(Vec3::Z);
+            let down = point.offset_origin(-Vec3::Z);
+            assert!(up.z > point.position.z && down.z < point.position.z, "scale {scale}");
+            // A few ulps, not a fixed distance.
+            assert!((up.z - point.position.z) < 64.0 * f32::EPSILON * scale, "scale {scale}");
+            assert_eq!((up.x, up.y), (point.position.x, point.position.y));
+            // Exact points on exact planes still move off them.
+            let exact = SurfacePoint { position: Vec3::new(0.0, 0.0, scale), error: Vec3::ZERO, normal: Vec3::Z };
+            assert!(exact.offset_origin(-Vec3::Z).z < scale && exact.offset_origin(Vec3::Z).z > scale);
+        }
+    }
+
+    #[test]
+    fn shadow_segment_ends_short_of_the_target() {
+        let a = SurfacePoint { position: Vec3::ZERO, error: Vec3::splat(1e-7), normal: Vec3::Y };
+        let b = SurfacePoint { position: Vec3::new(0.0, 10.0, 0.0), error: Vec3::splat(1e-6), normal: -Vec3::Y };
+        let ray = a.spawn_ray_to(&b);
+        assert!(ray.origin.y > 0.0);
+        let end = ray.at(ray.t_max);
+        assert!(end.y < 10.0 && end.y > 9.999);
+    }
+}
