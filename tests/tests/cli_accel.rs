@@ -129,10 +129,18 @@ fn bench_measures_every_variant_and_writes_json() {
         assert!(run.stdout.lines().any(|l| l.starts_with(kind.name())), "{kind} missing from\n{}", run.stdout);
     }
     let text = std::fs::read_to_string(&json).unwrap();
-    assert_eq!(text.matches("\"variant\"").count(), rtgi_accel::AccelKind::ALL.len() * 2, "{text}");
-    for field in ["build_ms_all_threads", "sah_cost", "mrays_1_thread", "nodes_visited_per_ray", "speedup_vs_linear"] {
+    // Each variant names itself twice (its row and its build statistics).
+    assert_eq!(text.matches("\"build_ms_all_threads\"").count(), rtgi_accel::AccelKind::ALL.len(), "{text}");
+    for field in ["sah_cost", "mrays_1_thread", "nodes_visited_per_ray", "speedup_vs_linear"] {
         assert!(text.contains(field), "{field} missing");
     }
+    // Every intersector with every traversal, beside their failure rates.
+    let combinations = rtgi_accel::Intersector::ALL.len() * rtgi_accel::Traversal::ALL.len();
+    assert_eq!(text.matches("\"closed_mesh_escapes\"").count(), combinations, "{text}");
+    assert!(run.stdout.contains("What accuracy costs"), "{}", run.stdout);
+    // The default, watertight and robust, lets nothing through.
+    let default_row = run.stdout.lines().find(|l| l.starts_with("watertight       robust")).expect("default row");
+    assert_eq!(default_row.matches("0 (0.0000%)").count(), 2, "{default_row}");
 }
 
 #[test]

@@ -10,6 +10,7 @@
 
 use rtgi_accel::{AccelKind, BuildParams, Intersector};
 use rtgi_math::{Ray, Rng, SurfacePoint, Vec3};
+use rtgi_render::probes::{ClosedMesh, icosphere, quad, rays_through_diagonal};
 use rtgi_tests::for_every_variant;
 
 /// Rays that must hit something, traced through every variant: counts the
@@ -33,41 +34,19 @@ fn report(case: &str, label: &str, params: &BuildParams, failures: usize, total:
     }
 }
 
-/// A unit square as two triangles sharing the diagonal (0,0)-(1,1), in the
-/// plane z = 0, scaled by `size` and moved by `offset` (both powers of two
-/// or sums of them, so corners stay exact).
-fn quad(size: f32, offset: Vec3) -> Vec<[Vec3; 3]> {
-    let p = |x: f32, y: f32| offset + Vec3::new(x * size, y * size, 0.0);
-    vec![[p(0.0, 0.0), p(1.0, 0.0), p(1.0, 1.0)], [p(0.0, 0.0), p(1.0, 1.0), p(0.0, 1.0)]]
-}
-
-/// Rays from a grid of origins above the quad to points exactly on its diagonal.
-fn rays_through_diagonal(size: f32, offset: Vec3, steps: u32) -> Vec<Ray> {
-    let mut rays = Vec::new();
-    for k in 1..steps {
-        let target = offset + Vec3::new(k as f32, k as f32, 0.0) * (size / steps as f32);
-        for (i, j) in [(-2i32, 1i32), (0, -3), (3, 2), (1, 1), (-1, 4)] {
-            let origin = offset + Vec3::new(i as f32, j as f32, 2.0) * size;
-            let direction = target - origin;
-            assert_eq!(origin + direction, target, "the test's coordinates must be exact");
-            rays.push(Ray::new(origin, direction));
-        }
-    }
-    rays
-}
-
 #[test]
 fn rays_exactly_through_a_shared_edge_never_miss() {
-    // At the origin, far from it, and tiny: the grid step is 8 ulps of the coordinates.
-    for (size, offset) in [
-        (1.0, Vec3::ZERO),
-        (64.0, Vec3::splat(1048576.0)),    // 2^20: ulp 1/8
-        (4096.0, Vec3::splat(16777216.0)), // 2^24: ulp 2
-        (2f32.powi(-40), Vec3::ZERO),
-        (2f32.powi(-20), Vec3::splat(2f32.powi(-10))),
+    // At the origin, far from it, and tiny; the grid of size / 2^bits is
+    // at least the ulp of the coordinates there, so every ray is exact.
+    for (size, offset, bits) in [
+        (1.0, Vec3::ZERO, 20),
+        (1024.0, Vec3::splat(1048576.0), 13),
+        (65536.0, Vec3::splat(16777216.0), 15),
+        (2f32.powi(-40), Vec3::ZERO, 20),
+        (2f32.powi(-20), Vec3::splat(2f32.powi(-10)), 10),
     ] {
         let triangles = quad(size, offset);
-        let rays = rays_through_diagonal(size, offset, 64);
+        let rays = rays_through_diagonal(size, offset, bits, 4000, 11);
         expect_all_hit(&format!("shared edge (size {size}, offset {})", offset.x), &triangles, &rays);
     }
 }
@@ -96,34 +75,11 @@ fn rays_exactly_through_a_shared_vertex_never_miss() {
     }
 }
 
-/// A closed mesh as triangles over shared vertices.
-struct Mesh {
-    vertices: Vec<Vec3>,
-    faces: Vec<[u32; 3]>,
-}
-
-impl Mesh {
-    fn triangles(&self) -> Vec<[Vec3; 3]> {
-        self.faces.iter().map(|f| f.map(|i| self.vertices[i as usize])).collect()
-    }
-
-    /// Points that rays can aim at exactly: vertices and edge midpoints.
-    fn features(&self) -> Vec<Vec3> {
-        let mut points = self.vertices.clone();
-        for f in &self.faces {
-            for e in 0..3 {
-                points.push(0.5 * (self.vertices[f[e] as usize] + self.vertices[f[(e + 1) % 3] as usize]));
-            }
-        }
-        points
-    }
-}
-
 /// A cube of side 2 centred at the origin, each face an n × n grid.
-fn tessellated_cube(n: u32) -> Mesh {
-    let mut mesh = Mesh { vertices: Vec::new(), faces: Vec::new() };
+fn tessellated_cube(n: u32) -> ClosedMesh {
+    let mut mesh = ClosedMesh { vertices: Vec::new(), faces: Vec::new() };
     let mut index = std::collections::HashMap::new();
-    let mut vertex = |p: Vec3, mesh: &mut Mesh| {
+    let mut vertex = |p: Vec3, mesh: &mut ClosedMesh| {
         *index.entry(p.to_array().map(f32::to_bits)).or_insert_with(|| {
             mesh.vertices.push(p);
             mesh.vertices.len() as u32 - 1
@@ -153,7 +109,7 @@ fn tessellated_cube(n: u32) -> Mesh {
 
 /// A closed cylinder along z with `segments` around and `rings` along,
 /// capped by fans, of radius `radius` and length `length`.
-fn cylinder(radius: f32, length: f32, segments: u32, rings: u32) -> Mesh {
+fn cylinder(radius: f32, length: f32, segments: u32, rings: u32) -> ClosedMesh {
     let mut vertices = Vec::new();
     for r in 0..=rings {
         for s in 0..segments {
@@ -176,92 +132,13 @@ fn cylinder(radius: f32, length: f32, segments: u32, rings: u32) -> Mesh {
         faces.push([bottom, at(0, s + 1), at(0, s)]);
         faces.push([bottom + 1, at(rings, s), at(rings, s + 1)]);
     }
-    Mesh { vertices, faces }
-}
-
-/// An icosphere: an icosahedron subdivided `levels` times, on the unit sphere.
-fn icosphere(levels: u32) -> Mesh {
-    let t = (1.0 + 5f32.sqrt()) / 2.0;
-    let mut vertices: Vec<Vec3> = [
-        (-1.0, t, 0.0),
-        (1.0, t, 0.0),
-        (-1.0, -t, 0.0),
-        (1.0, -t, 0.0),
-        (0.0, -1.0, t),
-        (0.0, 1.0, t),
-        (0.0, -1.0, -t),
-        (0.0, 1.0, -t),
-        (t, 0.0, -1.0),
-        (t, 0.0, 1.0),
-        (-t, 0.0, -1.0),
-        (-t, 0.0, 1.0),
-    ]
-    .iter()
-    .map(|&(x, y, z)| Vec3::new(x, y, z).normalize())
-    .collect();
-    let mut faces: Vec<[u32; 3]> = vec![
-        [0, 11, 5],
-        [0, 5, 1],
-        [0, 1, 7],
-        [0, 7, 10],
-        [0, 10, 11],
-        [1, 5, 9],
-        [5, 11, 4],
-        [11, 10, 2],
-        [10, 7, 6],
-        [7, 1, 8],
-        [3, 9, 4],
-        [3, 4, 2],
-        [3, 2, 6],
-        [3, 6, 8],
-        [3, 8, 9],
-        [4, 9, 5],
-        [2, 4, 11],
-        [6, 2, 10],
-        [8, 6, 7],
-        [9, 8, 1],
-    ];
-    for _ in 0..levels {
-        let mut midpoint = std::collections::HashMap::new();
-        let mut mid = |a: u32, b: u32, vertices: &mut Vec<Vec3>| {
-            *midpoint.entry((a.min(b), a.max(b))).or_insert_with(|| {
-                vertices.push((vertices[a as usize] + vertices[b as usize]).normalize());
-                vertices.len() as u32 - 1
-            })
-        };
-        faces = faces
-            .iter()
-            .flat_map(|&[a, b, c]| {
-                let (ab, bc, ca) = (mid(a, b, &mut vertices), mid(b, c, &mut vertices), mid(c, a, &mut vertices));
-                [[a, ab, ca], [b, bc, ab], [c, ca, bc], [ab, bc, ca]]
-            })
-            .collect();
-    }
-    Mesh { vertices, faces }
-}
-
-/// Rays from points inside a closed mesh: half in random directions, half
-/// aimed at vertices and edge midpoints. None may escape.
-fn leak_rays(mesh: &Mesh, inside: impl Fn(&mut Rng) -> Vec3, count: usize, seed: u64) -> Vec<Ray> {
-    let features = mesh.features();
-    let mut rng = Rng::new(seed, 7);
-    (0..count)
-        .map(|i| {
-            let origin = inside(&mut rng);
-            let direction = if i % 2 == 0 {
-                features[rng.next_below(features.len() as u32) as usize] - origin
-            } else {
-                rtgi_render::rays::uniform_sphere(rng.next_f32(), rng.next_f32())
-            };
-            Ray::new(origin, direction)
-        })
-        .collect()
+    ClosedMesh { vertices, faces }
 }
 
 /// Draws a random point inside a mesh.
 type InsidePoint = Box<dyn Fn(&mut Rng) -> Vec3>;
 
-fn leak_meshes() -> Vec<(&'static str, Mesh, InsidePoint)> {
+fn leak_meshes() -> Vec<(&'static str, ClosedMesh, InsidePoint)> {
     vec![
         (
             "cube",
@@ -286,7 +163,7 @@ fn leak_meshes() -> Vec<(&'static str, Mesh, InsidePoint)> {
 #[test]
 fn nothing_escapes_closed_meshes_in_any_variant() {
     for (name, mesh, inside) in leak_meshes() {
-        let rays = leak_rays(&mesh, inside, 20_000, 1);
+        let rays = mesh.leak_rays(inside, 20_000, 1);
         expect_all_hit(&format!("leak from {name}"), &mesh.triangles(), &rays);
     }
 }
@@ -297,7 +174,7 @@ fn nothing_escapes_closed_meshes_over_a_million_rays() {
     // all-variant test can afford.
     for (name, mesh, inside) in leak_meshes() {
         let accel = AccelKind::Sah.build(&mesh.triangles(), &BuildParams::default());
-        let rays = leak_rays(&mesh, inside, 1_000_000, 2);
+        let rays = mesh.leak_rays(inside, 1_000_000, 2);
         let escaped = rays.iter().filter(|r| accel.intersect(r).is_none()).count();
         assert_eq!(escaped, 0, "{name}: {escaped} of {} rays escaped", rays.len());
     }

@@ -5,8 +5,9 @@ use std::time::Instant;
 
 use anyhow::Result;
 use rayon::prelude::*;
-use rtgi_accel::{Accel, AccelKind, BuildParams, BuildStats, TraversalCounters};
+use rtgi_accel::{Accel, AccelKind, BuildParams, BuildStats, Intersector, Traversal, TraversalCounters};
 use rtgi_math::Ray;
+use rtgi_render::probes::{closed_mesh_probe, shared_edge_probe};
 use rtgi_render::rays::{primary_rays, surface_rays, throughput};
 use serde::Serialize;
 
@@ -26,6 +27,23 @@ struct BenchReport {
     incoherent_seed: u64,
     params: ParamsReport,
     variants: Vec<VariantReport>,
+    /// Every intersector and traversal on one structure: speed beside failure rates.
+    accuracy: Vec<AccuracyReport>,
+}
+
+#[derive(Debug, Serialize)]
+struct AccuracyReport {
+    variant: String,
+    intersector: String,
+    traversal: String,
+    primary_mrays_all_threads: f64,
+    incoherent_mrays_all_threads: f64,
+    /// Rays exactly through the shared edge of two triangles that hit neither.
+    shared_edge_rays: usize,
+    shared_edge_misses: usize,
+    /// Rays from inside a closed mesh (half aimed at vertices and edges) that hit nothing.
+    closed_mesh_rays: usize,
+    closed_mesh_escapes: usize,
 }
 
 #[derive(Debug, Serialize)]
@@ -105,6 +123,8 @@ pub(crate) fn run(args: &BenchArgs) -> Result<()> {
         }
     }
 
+    let accuracy = measure_accuracy(args, &triangles, &params, &primary, &incoherent, &pool);
+
     let report = BenchReport {
         scene: name,
         triangles: triangles.len(),
@@ -119,8 +139,10 @@ pub(crate) fn run(args: &BenchArgs) -> Result<()> {
             traversal_cost: params.traversal_cost,
         },
         variants,
+        accuracy,
     };
     print_table(&report, args.linear_rays);
+    print_accuracy(&report.accuracy);
     if let Some(json) = &args.json {
         crate::common::write_atomically(json, serde_json::to_string_pretty(&report)?.as_bytes())?;
         eprintln!("wrote {}", json.display());
@@ -293,4 +315,70 @@ fn significant(x: f64) -> String {
     }
     let decimals = (2 - x.log10().floor() as i32).max(2) as usize;
     format!("{x:.decimals$}")
+}
+
+/// Every intersector with every traversal on one structure: throughput on
+/// the scene's batches beside the failure rates on the robustness probes.
+fn measure_accuracy(
+    args: &BenchArgs,
+    triangles: &[[rtgi_math::Vec3; 3]],
+    params: &BuildParams,
+    primary: &[Ray],
+    incoherent: &[Ray],
+    pool: &rayon::ThreadPool,
+) -> Vec<AccuracyReport> {
+    let kind = args.accuracy_accel;
+    let (edge_triangles, edge_rays) = shared_edge_probe();
+    let (mesh_triangles, mesh_rays) = closed_mesh_probe(args.leak_rays as usize, args.seed);
+    let mut reports = Vec::new();
+    for &intersector in Intersector::ALL {
+        for &traversal in Traversal::ALL {
+            eprintln!("measuring {kind} with {intersector} and {traversal} traversal ...");
+            let params = BuildParams { intersector, traversal, ..params.clone() };
+            let accel = pool.install(|| kind.build(triangles, &params));
+            let trace = |r: &Ray| accel.intersect(r).is_some();
+            let edges = kind.build(&edge_triangles, &params);
+            let mesh = kind.build(&mesh_triangles, &params);
+            let misses = |accel: &dyn Accel, rays: &[Ray]| {
+                pool.install(|| rays.par_iter().filter(|r| accel.intersect(r).is_none()).count())
+            };
+            reports.push(AccuracyReport {
+                variant: kind.name().to_owned(),
+                intersector: intersector.name().to_owned(),
+                traversal: traversal.name().to_owned(),
+                primary_mrays_all_threads: throughput(primary, pool, args.repeats as usize, trace),
+                incoherent_mrays_all_threads: throughput(incoherent, pool, args.repeats as usize, trace),
+                shared_edge_rays: edge_rays.len(),
+                shared_edge_misses: misses(edges.as_ref(), &edge_rays),
+                closed_mesh_rays: mesh_rays.len(),
+                closed_mesh_escapes: misses(mesh.as_ref(), &mesh_rays),
+            });
+        }
+    }
+    reports
+}
+
+fn print_accuracy(reports: &[AccuracyReport]) {
+    let Some(first) = reports.first() else { return };
+    println!();
+    println!(
+        "What accuracy costs ({}): throughput on all threads beside failures on {} rays exactly through shared edges and {} rays from inside a closed mesh",
+        first.variant, first.shared_edge_rays, first.closed_mesh_rays
+    );
+    println!(
+        "{:<16} {:<10} {:>15} {:>15} {:>20} {:>20}",
+        "intersector", "traversal", "primary Mrays/s", "incoh. Mrays/s", "shared-edge misses", "closed-mesh escapes"
+    );
+    let rate = |n: usize, of: usize| format!("{n} ({:.4}%)", 100.0 * n as f64 / of.max(1) as f64);
+    for r in reports {
+        println!(
+            "{:<16} {:<10} {:>15.2} {:>15.2} {:>20} {:>20}",
+            r.intersector,
+            r.traversal,
+            r.primary_mrays_all_threads,
+            r.incoherent_mrays_all_threads,
+            rate(r.shared_edge_misses, r.shared_edge_rays),
+            rate(r.closed_mesh_escapes, r.closed_mesh_rays)
+        );
+    }
 }

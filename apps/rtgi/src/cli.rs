@@ -129,6 +129,14 @@ pub(crate) struct BenchArgs {
     /// Also write the results as JSON to this file
     #[arg(long)]
     pub(crate) json: Option<PathBuf>,
+
+    /// Structure on which every intersector and traversal is compared for speed and failure rates
+    #[arg(long, default_value = "sah")]
+    pub(crate) accuracy_accel: AccelKind,
+
+    /// Rays from inside a closed mesh for the escape rate
+    #[arg(long, default_value_t = 1_000_000, value_parser = clap::value_parser!(u32).range(1..=100_000_000))]
+    pub(crate) leak_rays: u32,
 }
 
 /// A list of acceleration structures chosen on the command line.

@@ -22,6 +22,7 @@
 
 mod camera;
 mod framing;
+pub mod probes;
 pub mod rays;
 mod sampler;
 mod shade;

@@ -123,8 +123,8 @@ impl SlabTest for FastSlabs {
         let (min, max) = node.corners();
         let t1 = (min - ray.origin) * ray.inv_direction;
         let t2 = (max - ray.origin) * ray.inv_direction;
-        let enter = t1.min(t2).max_element().max(ray.t_min);
-        let exit = t1.max(t2).min_element().min(t_max);
+        let enter = t1.min(t2).max(Vec3A::splat(ray.t_min)).max_element();
+        let exit = t1.max(t2).min(Vec3A::splat(t_max)).min_element();
         if enter <= exit { enter } else { f32::INFINITY }
     }
 }
