@@ -3,6 +3,7 @@
 use std::fmt;
 use std::str::FromStr;
 
+use rtgi_math::glam::{Mat3A, Vec3Swizzles};
 use rtgi_math::{Vec3, Vec3A};
 
 /// Where a ray hits a triangle: distance and barycentric coordinates of
@@ -166,49 +167,49 @@ impl TriangleTest for Watertight {
     fn intersect(ray: &Self::Ray, t_min: f32, t_max: f32, v: &[Vec3A; 3]) -> Option<TriangleHit> {
         let [kx, ky, kz] = ray.axes;
         let [sx, sy, sz] = ray.shear;
-        // Vertices relative to the origin, permuted and sheared. Every vertex
-        // goes through the same arithmetic whichever triangle it belongs to,
-        // so neighbours see the same transformed edge.
-        let transform = |vertex: Vec3A| {
-            let p = (vertex - ray.origin).to_array();
-            [p[kx] - sx * p[kz], p[ky] - sy * p[kz], p[kz]]
-        };
-        let [a, b, c] = v.map(transform);
-        // Scaled barycentrics: the 2D edge functions. A shared edge gives
-        // exactly negated values in the two triangles (products commute and
-        // x - y = -(y - x) exactly); no fused multiply-add may change that.
-        let mut u = c[0] * b[1] - c[1] * b[0];
-        let mut v_ = a[0] * c[1] - a[1] * c[0];
-        let mut w = b[0] * a[1] - b[1] * a[0];
+        // The three vertices relative to the origin, transposed so that each
+        // vector holds one coordinate of all three: lanes are (A, B, C).
+        let by_axis = Mat3A::from_cols(v[0] - ray.origin, v[1] - ray.origin, v[2] - ray.origin).transpose();
+        let (x, y, z) = (by_axis.col(kx), by_axis.col(ky), by_axis.col(kz));
+        // Permuted and sheared. Every vertex goes through the same arithmetic
+        // whichever triangle it belongs to, so neighbours see the same
+        // transformed edge.
+        let xs = x - sx * z;
+        let ys = y - sy * z;
+        // Scaled barycentrics (U, V, W) = the 2D edge functions
+        // (Cx By - Cy Bx, Ax Cy - Ay Cx, Bx Ay - By Ax), one a lane. A shared
+        // edge gives exactly negated values in the two triangles (products
+        // commute and x - y = -(y - x) exactly); no fused multiply-add may
+        // change that.
+        let mut uvw = xs.zxy() * ys.yzx() - ys.zxy() * xs.yzx();
         // On an edge, single precision may have rounded a tiny value to zero:
         // decide in double precision, where the products are exact.
-        if u == 0.0 || v_ == 0.0 || w == 0.0 {
-            let edge = |p: [f32; 3], q: [f32; 3]| (p[0] as f64 * q[1] as f64 - p[1] as f64 * q[0] as f64) as f32;
-            u = edge(c, b);
-            v_ = edge(a, c);
-            w = edge(b, a);
+        if uvw.cmpeq(Vec3A::ZERO).any() {
+            let (xs, ys) = (xs.to_array().map(f64::from), ys.to_array().map(f64::from));
+            let edge = |p: usize, q: usize| (xs[p] * ys[q] - ys[p] * xs[q]) as f32;
+            uvw = Vec3A::new(edge(2, 1), edge(0, 2), edge(1, 0));
         }
-        if (u < 0.0 || v_ < 0.0 || w < 0.0) && (u > 0.0 || v_ > 0.0 || w > 0.0) {
+        if uvw.cmplt(Vec3A::ZERO).any() && uvw.cmpgt(Vec3A::ZERO).any() {
             return None;
         }
-        let det = u + v_ + w;
+        let det = uvw.element_sum();
         if det == 0.0 || !det.is_finite() {
             return None;
         }
         // Scaled distance, compared against the range scaled by the
         // determinant so that only hits pay for the division.
-        let t_scaled = u * (sz * a[2]) + v_ * (sz * b[2]) + w * (sz * c[2]);
+        let t_scaled = uvw.dot(z * sz);
         let (t_scaled, abs_det) = if det < 0.0 { (-t_scaled, -det) } else { (t_scaled, det) };
         if t_scaled < t_min * abs_det || t_scaled > t_max * abs_det {
             return None;
         }
-        let inv_det = 1.0 / det;
         let t = t_scaled / abs_det;
         // Rounding of the division can move t just outside the range checked above.
         if t < t_min || t > t_max {
             return None;
         }
-        Some(TriangleHit { t, beta: v_ * inv_det, gamma: w * inv_det })
+        let [_, beta, gamma] = (uvw / det).to_array();
+        Some(TriangleHit { t, beta, gamma })
     }
 }
 
