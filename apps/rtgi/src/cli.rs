@@ -60,11 +60,8 @@ pub(crate) struct HeatmapArgs {
     #[arg(short, long)]
     pub(crate) output: PathBuf,
 
-    #[arg(long, default_value_t = 512, value_parser = clap::value_parser!(u32).range(1..=MAX_IMAGE_SIDE as i64))]
-    pub(crate) width: u32,
-
-    #[arg(long, default_value_t = 512, value_parser = clap::value_parser!(u32).range(1..=MAX_IMAGE_SIDE as i64))]
-    pub(crate) height: u32,
+    #[command(flatten)]
+    pub(crate) size: ImageSize,
 
     /// Count that maps to the top of the colour scale [default: the image's maximum]
     #[arg(long)]
@@ -195,11 +192,8 @@ pub(crate) struct RenderArgs {
     #[arg(short, long)]
     pub(crate) output: PathBuf,
 
-    #[arg(long, default_value_t = 512, value_parser = clap::value_parser!(u32).range(1..=MAX_IMAGE_SIDE as i64))]
-    pub(crate) width: u32,
-
-    #[arg(long, default_value_t = 512, value_parser = clap::value_parser!(u32).range(1..=MAX_IMAGE_SIDE as i64))]
-    pub(crate) height: u32,
+    #[command(flatten)]
+    pub(crate) size: ImageSize,
 
     /// Samples per pixel
     #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=1_048_576))]
@@ -234,6 +228,22 @@ pub(crate) struct RenderArgs {
     /// Radiance of rays that hit nothing, as R,G,B
     #[arg(long, value_parser = parse_vec3, default_value = "0.05,0.05,0.06")]
     pub(crate) background: Vec3,
+}
+
+/// The size of an image in pixels.
+#[derive(Debug, Args)]
+pub(crate) struct ImageSize {
+    #[arg(long, default_value_t = 512, value_parser = clap::value_parser!(u32).range(1..=MAX_IMAGE_SIDE as i64))]
+    pub(crate) width: u32,
+
+    #[arg(long, default_value_t = 512, value_parser = clap::value_parser!(u32).range(1..=MAX_IMAGE_SIDE as i64))]
+    pub(crate) height: u32,
+}
+
+impl ImageSize {
+    pub(crate) fn aspect(&self) -> f32 {
+        self.width as f32 / self.height as f32
+    }
 }
 
 /// The acceleration structure and its build parameters.

@@ -15,8 +15,8 @@ pub(crate) fn run(args: &RenderArgs) -> Result<()> {
     let LoadedScene { scene, name: scene_name, load_ms } = load_scene(args.scene.as_deref())?;
 
     let settings = RenderSettings {
-        width: args.width,
-        height: args.height,
+        width: args.size.width,
+        height: args.size.height,
         samples_per_pixel: args.spp,
         sampler: args.sampler.unwrap_or(if args.spp == 1 { PixelSampler::Center } else { PixelSampler::Uniform }),
         seed: args.seed,
@@ -26,9 +26,9 @@ pub(crate) fn run(args: &RenderArgs) -> Result<()> {
     let pool = thread_pool(args.threads)?;
 
     let accel = pool.install(|| args.accel.build(&scene));
-    let camera = choose_camera(&scene, accel.as_ref(), &args.camera, args.width as f32 / args.height as f32)?;
+    let camera = choose_camera(&scene, accel.as_ref(), &args.camera, args.size.aspect())?;
     let (image, stats) = pool.install(|| {
-        let bar = progress_bar(args.width as u64 * args.height as u64);
+        let bar = progress_bar(args.size.width as u64 * args.size.height as u64);
         let (image, stats) = render(&scene, accel.as_ref(), &camera, &settings, &|done| bar.inc(done));
         bar.finish_and_clear();
         (image, stats)

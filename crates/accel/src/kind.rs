@@ -1,6 +1,3 @@
-use std::fmt;
-use std::str::FromStr;
-
 use rtgi_math::Vec3;
 
 use crate::{Accel, Bvh, Intersector, LinearScan, SplitMethod, Traversal};
@@ -47,14 +44,6 @@ impl Default for BuildParams {
     }
 }
 
-/// An accelerator name that is not one of [`AccelKind::ALL`].
-#[derive(Clone, Debug, thiserror::Error)]
-#[error("unknown acceleration structure '{name}' (expected one of: {expected})")]
-pub struct UnknownAccel {
-    pub name: String,
-    pub expected: String,
-}
-
 impl AccelKind {
     /// Every variant, in the order tables list them.
     pub const ALL: &'static [AccelKind] =
@@ -88,6 +77,8 @@ impl AccelKind {
     }
 }
 
+rtgi_math::named_choices!(AccelKind, "acceleration structure");
+
 impl AccelKind {
     /// Every variant with a spread of build parameters (leaf sizes 1, 3 and
     /// 8; for the binned SAH also 2 and 32 bins), each with both
@@ -114,22 +105,5 @@ impl AccelKind {
             }
         }
         configurations
-    }
-}
-
-impl fmt::Display for AccelKind {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(self.name())
-    }
-}
-
-impl FromStr for AccelKind {
-    type Err = UnknownAccel;
-
-    fn from_str(name: &str) -> Result<Self, Self::Err> {
-        Self::ALL.iter().copied().find(|k| k.name() == name).ok_or_else(|| UnknownAccel {
-            name: name.to_owned(),
-            expected: Self::ALL.iter().map(|k| k.name()).collect::<Vec<_>>().join(", "),
-        })
     }
 }

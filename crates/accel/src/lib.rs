@@ -29,7 +29,7 @@ mod triangle;
 
 pub use bvh::{Bvh, BvhNode, SplitMethod, Traversal};
 pub use counters::{Counter, NoCounter, TraversalCounters};
-pub use kind::{AccelKind, BuildParams, UnknownAccel};
+pub use kind::{AccelKind, BuildParams};
 pub use linear::LinearScan;
 pub use triangle::{Intersector, TriangleHit};
 

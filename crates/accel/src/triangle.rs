@@ -1,8 +1,5 @@
 //! Ray/triangle intersection tests.
 
-use std::fmt;
-use std::str::FromStr;
-
 use rtgi_math::glam::{Mat3A, Vec3Swizzles};
 use rtgi_math::{Vec3, Vec3A};
 
@@ -62,22 +59,7 @@ impl Intersector {
     }
 }
 
-impl fmt::Display for Intersector {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(self.name())
-    }
-}
-
-impl FromStr for Intersector {
-    type Err = String;
-
-    fn from_str(s: &str) -> Result<Self, Self::Err> {
-        Self::ALL.iter().copied().find(|i| i.name() == s).ok_or_else(|| {
-            let names: Vec<_> = Self::ALL.iter().map(|i| i.name()).collect();
-            format!("unknown intersector '{s}' (expected one of: {})", names.join(", "))
-        })
-    }
-}
+rtgi_math::named_choices!(Intersector, "intersector");
 
 /// A ray/triangle test with per-ray precomputation, for the structures'
 /// inner loops (monomorphised, so the choice costs nothing per triangle).

@@ -1,6 +1,3 @@
-use std::fmt;
-use std::str::FromStr;
-
 use rtgi_math::Vec3;
 
 /// How linear radiance becomes a displayable value in `[0, 1]`.
@@ -39,22 +36,7 @@ impl ToneOperator {
     }
 }
 
-impl fmt::Display for ToneOperator {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(self.name())
-    }
-}
-
-impl FromStr for ToneOperator {
-    type Err = String;
-
-    fn from_str(s: &str) -> Result<Self, Self::Err> {
-        Self::ALL.iter().copied().find(|o| o.name() == s).ok_or_else(|| {
-            let names: Vec<_> = Self::ALL.iter().map(|o| o.name()).collect();
-            format!("unknown tone map '{s}' (expected one of: {})", names.join(", "))
-        })
-    }
-}
+rtgi_math::named_choices!(ToneOperator, "tone map");
 
 /// Exposure followed by a tone operator; used for 8-bit output only.
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -15,6 +15,7 @@
 //! ```
 
 mod aabb;
+mod choices;
 mod float;
 mod frame;
 mod ray;

@@ -1,6 +1,3 @@
-use std::fmt;
-use std::str::FromStr;
-
 use rtgi_math::{Rng, Vec2};
 
 /// Where inside a pixel the samples go.
@@ -32,19 +29,4 @@ impl PixelSampler {
     }
 }
 
-impl fmt::Display for PixelSampler {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(self.name())
-    }
-}
-
-impl FromStr for PixelSampler {
-    type Err = String;
-
-    fn from_str(s: &str) -> Result<Self, Self::Err> {
-        Self::ALL.iter().copied().find(|k| k.name() == s).ok_or_else(|| {
-            let names: Vec<_> = Self::ALL.iter().map(|k| k.name()).collect();
-            format!("unknown sampler '{s}' (expected one of: {})", names.join(", "))
-        })
-    }
-}
+rtgi_math::named_choices!(PixelSampler, "sampler");

@@ -223,53 +223,18 @@ fn binned_core(
 /// than binning them, and exact.
 const SMALL_RANGE: usize = 8;
 
-/// The full sweep of [`sweep`] for at most [`SMALL_RANGE`] primitives,
-/// sorted on the stack. Most nodes of a tree are this small, so this keeps
-/// the per-node overhead of binning (bin arrays to clear, three axes to
-/// evaluate) off the bottom levels.
-fn small(ctx: &Context, prims: &mut [PrimRef], range: &RangeBounds) -> Option<Split> {
-    let count = prims.len();
-    debug_assert!(count <= SMALL_RANGE);
+/// The best split of a range of `count` primitives, over the three axes:
+/// `sorted(axis)` gives the range sorted by centroid along `axis`, and
+/// `right_cost` is scratch space of `count` entries. Returns the summed
+/// `A · N` of both sides, the axis and the left count.
+fn best_sweep<'a>(
+    count: usize,
+    mut sorted: impl FnMut(usize) -> &'a [PrimRef],
+    right_cost: &mut [f32],
+) -> (f32, usize, usize) {
     let mut best = (f32::INFINITY, 0, 0);
-    let mut sorted = [[prims[0]; SMALL_RANGE]; 3];
-    for (axis, order) in sorted.iter_mut().enumerate() {
-        let order = &mut order[..count];
-        order.copy_from_slice(prims);
-        order.sort_unstable_by(by_centroid(axis));
-        let mut right_cost = [0.0f32; SMALL_RANGE];
-        let mut acc = BoxA::EMPTY;
-        for k in (1..count).rev() {
-            acc = acc.union(order[k].bounds());
-            right_cost[k] = acc.half_area() * (count - k) as f32;
-        }
-        let mut acc = BoxA::EMPTY;
-        for k in 0..count - 1 {
-            acc = acc.union(order[k].bounds());
-            let cost = acc.half_area() * (k + 1) as f32 + right_cost[k + 1];
-            let imbalance = |left: usize| left.abs_diff(count - left);
-            if cost < best.0 || (cost == best.0 && imbalance(k + 1) < imbalance(best.2)) {
-                best = (cost, axis, k + 1);
-            }
-        }
-    }
-    if !split_pays(ctx, count, range, best.0) {
-        return None;
-    }
-    let (_, axis, left_count) = best;
-    prims.copy_from_slice(&sorted[axis][..count]);
-    Some(Split::measured(prims, left_count))
-}
-
-/// Full-sweep SAH: every split between neighbouring centroids on every axis
-/// is evaluated exactly. Slow (three sorts per node), and the reference for
-/// the quality of the binned build.
-pub(crate) fn sweep(ctx: &Context, prims: &mut [PrimRef], range: &RangeBounds) -> Option<Split> {
-    let count = prims.len();
-    let mut best = (f32::INFINITY, 0, 0);
-    let mut sorted: [Vec<PrimRef>; 3] = [prims.to_vec(), prims.to_vec(), prims.to_vec()];
-    let mut right_cost = vec![0.0f32; count];
-    for (axis, order) in sorted.iter_mut().enumerate() {
-        order.sort_unstable_by(by_centroid(axis));
+    for axis in 0..3 {
+        let order = sorted(axis);
         let mut acc = BoxA::EMPTY;
         for k in (1..count).rev() {
             acc = acc.union(order[k].bounds());
@@ -287,6 +252,40 @@ pub(crate) fn sweep(ctx: &Context, prims: &mut [PrimRef], range: &RangeBounds) -
             }
         }
     }
+    best
+}
+
+/// The full sweep of [`sweep`] for at most [`SMALL_RANGE`] primitives,
+/// sorted on the stack. Most nodes of a tree are this small, so this keeps
+/// the per-node overhead of binning (bin arrays to clear, three axes to
+/// evaluate) off the bottom levels.
+fn small(ctx: &Context, prims: &mut [PrimRef], range: &RangeBounds) -> Option<Split> {
+    let count = prims.len();
+    debug_assert!(count <= SMALL_RANGE);
+    let mut sorted = [[prims[0]; SMALL_RANGE]; 3];
+    for (axis, order) in sorted.iter_mut().enumerate() {
+        order[..count].copy_from_slice(prims);
+        order[..count].sort_unstable_by(by_centroid(axis));
+    }
+    let best = best_sweep(count, |axis| &sorted[axis][..count], &mut [0.0; SMALL_RANGE]);
+    if !split_pays(ctx, count, range, best.0) {
+        return None;
+    }
+    let (_, axis, left_count) = best;
+    prims.copy_from_slice(&sorted[axis][..count]);
+    Some(Split::measured(prims, left_count))
+}
+
+/// Full-sweep SAH: every split between neighbouring centroids on every axis
+/// is evaluated exactly. Slow (three sorts per node), and the reference for
+/// the quality of the binned build.
+pub(crate) fn sweep(ctx: &Context, prims: &mut [PrimRef], range: &RangeBounds) -> Option<Split> {
+    let count = prims.len();
+    let mut sorted: [Vec<PrimRef>; 3] = [prims.to_vec(), prims.to_vec(), prims.to_vec()];
+    for (axis, order) in sorted.iter_mut().enumerate() {
+        order.sort_unstable_by(by_centroid(axis));
+    }
+    let best = best_sweep(count, |axis| &sorted[axis], &mut vec![0.0; count]);
     if !split_pays(ctx, count, range, best.0) {
         return None;
     }

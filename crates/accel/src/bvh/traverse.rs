@@ -2,9 +2,6 @@
 //! ray/triangle test and the slab test so that every combination runs as
 //! its own monomorphised loop.
 
-use std::fmt;
-use std::str::FromStr;
-
 use rtgi_math::{BVec3A, Ray, Vec3A, gamma};
 
 use super::{Bvh, BvhNode};
@@ -50,22 +47,7 @@ impl Traversal {
     }
 }
 
-impl fmt::Display for Traversal {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(self.name())
-    }
-}
-
-impl FromStr for Traversal {
-    type Err = String;
-
-    fn from_str(s: &str) -> Result<Self, Self::Err> {
-        Self::ALL.iter().copied().find(|t| t.name() == s).ok_or_else(|| {
-            let names: Vec<_> = Self::ALL.iter().map(|t| t.name()).collect();
-            format!("unknown traversal '{s}' (expected one of: {})", names.join(", "))
-        })
-    }
-}
+rtgi_math::named_choices!(Traversal, "traversal");
 
 /// A ray prepared for box tests.
 struct PreparedRay {
