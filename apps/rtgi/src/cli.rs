@@ -30,12 +30,25 @@ pub(crate) enum Command {
     BvhBoxes(BvhBoxesArgs),
     /// Render the traversal cost (BVH nodes visited per pixel) as a heat map
     Heatmap(HeatmapArgs),
+    /// Describe a scene: triangles, materials, textures, lights, cameras, bounds, extensions
+    Info(InfoArgs),
+}
+
+/// `rtgi info`: what a scene file contains.
+#[derive(Debug, Args)]
+pub(crate) struct InfoArgs {
+    /// Scene file (.obj, .gltf, .glb or .toml); the built-in Cornell box when omitted
+    pub(crate) scene: Option<PathBuf>,
+
+    /// Print JSON instead of text
+    #[arg(long)]
+    pub(crate) json: bool,
 }
 
 /// `rtgi bvh-boxes`: the boxes of some levels of a BVH as a wireframe-able mesh.
 #[derive(Debug, Args)]
 pub(crate) struct BvhBoxesArgs {
-    /// Scene file (.obj or .toml); the built-in Cornell box when omitted
+    /// Scene file (.obj, .gltf, .glb or .toml); the built-in Cornell box when omitted
     pub(crate) scene: Option<PathBuf>,
 
     /// OBJ file to write; each level becomes a group named level_N
@@ -53,7 +66,7 @@ pub(crate) struct BvhBoxesArgs {
 /// `rtgi heatmap`: nodes visited per pixel, in false colour.
 #[derive(Debug, Args)]
 pub(crate) struct HeatmapArgs {
-    /// Scene file (.obj or .toml); the built-in Cornell box when omitted
+    /// Scene file (.obj, .gltf, .glb or .toml); the built-in Cornell box when omitted
     pub(crate) scene: Option<PathBuf>,
 
     /// Output image (.png for the false-colour map, .exr for the raw counts)
@@ -85,7 +98,7 @@ pub(crate) struct HeatmapArgs {
 /// `rtgi bench`: what each acceleration structure costs and gives, side by side.
 #[derive(Debug, Args)]
 pub(crate) struct BenchArgs {
-    /// Scene file (.obj or .toml); the built-in Cornell box when omitted
+    /// Scene file (.obj, .gltf, .glb or .toml); the built-in Cornell box when omitted
     pub(crate) scene: Option<PathBuf>,
 
     /// Structures to measure: 'all', or names separated by commas
@@ -160,7 +173,7 @@ fn parse_accel_list(text: &str) -> Result<AccelList, String> {
 /// (an OBJ polygon becomes a fan of triangles, in order).
 #[derive(Debug, Args)]
 pub(crate) struct TraceArgs {
-    /// Scene file (.obj or .toml)
+    /// Scene file (.obj, .gltf, .glb or .toml)
     pub(crate) scene: PathBuf,
 
     /// Binary file of rays (32 bytes each)
@@ -185,7 +198,7 @@ pub(crate) struct TraceArgs {
 
 #[derive(Debug, Args)]
 pub(crate) struct RenderArgs {
-    /// Scene file (.obj or .toml); the built-in Cornell box when omitted
+    /// Scene file (.obj, .gltf, .glb or .toml); the built-in Cornell box when omitted
     pub(crate) scene: Option<PathBuf>,
 
     /// Output image; the format follows the extension (.png or .exr)

@@ -8,6 +8,7 @@ mod cli;
 mod common;
 mod debug_cmd;
 mod default_scene;
+mod info_cmd;
 mod render_cmd;
 mod trace_cmd;
 
@@ -27,6 +28,7 @@ pub fn main() -> ExitCode {
         cli::Command::Bench(args) => bench_cmd::run(&args),
         cli::Command::BvhBoxes(args) => debug_cmd::boxes(&args),
         cli::Command::Heatmap(args) => debug_cmd::heatmap(&args),
+        cli::Command::Info(args) => info_cmd::run(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -6,9 +6,9 @@
 //! so a triangle can be named by its index (an OBJ polygon becomes a fan of
 //! triangles, in order). Textures are decoded at load time.
 //!
-//! Importers: Wavefront OBJ with MTL materials (through `tobj`), and a small
-//! TOML scene description that lists meshes and a camera (see
-//! [`description`]).
+//! Importers: Wavefront OBJ with MTL materials (through `tobj`), glTF 2.0
+//! (`.gltf` and `.glb`, through `gltf`), and a small TOML scene description
+//! that lists meshes and a camera (see [`description`]).
 //!
 //! ```no_run
 //! let scene = rtgi_scene::Scene::load("scenes/cornell-box.toml".as_ref())?;
@@ -21,6 +21,9 @@
 
 mod camera;
 pub mod description;
+mod gltf_import;
+pub use gltf_import::SUPPORTED_GLTF_EXTENSIONS;
+mod light;
 mod material;
 mod mesh;
 pub mod obj;
@@ -28,7 +31,8 @@ mod resolve;
 mod texture;
 
 pub use camera::Camera;
-pub use material::Material;
+pub use light::{Light, LightKind};
+pub use material::{AlphaMode, Material};
 pub use mesh::MeshBuilder;
 pub use resolve::resolve_case_insensitive;
 pub use texture::{ColorEncoding, Texture, TextureId};
@@ -63,6 +67,9 @@ pub struct Scene {
     pub materials: Vec<Material>,
     pub textures: Vec<Texture>,
     pub cameras: Vec<Camera>,
+    pub lights: Vec<Light>,
+    /// The format extensions the file uses (glTF's `extensionsUsed`).
+    pub extensions_used: Vec<String>,
     /// Problems that did not stop the import (a missing texture, an unknown material).
     pub warnings: Vec<String>,
 }
@@ -76,7 +83,9 @@ pub enum SceneError {
     Obj { path: PathBuf, message: String },
     #[error("{path}: not a valid scene description: {message}")]
     Description { path: PathBuf, message: String },
-    #[error("{path}: unsupported scene format (expected .obj or .toml)")]
+    #[error("{path}: not a valid glTF file: {message}")]
+    Gltf { path: PathBuf, message: String },
+    #[error("{path}: unsupported scene format (expected .obj, .gltf, .glb or .toml)")]
     UnsupportedFormat { path: PathBuf },
 }
 
@@ -95,6 +104,7 @@ impl Scene {
         match extension.as_deref() {
             Some("obj") => obj::load(path),
             Some("toml") => description::load(path),
+            Some("gltf") | Some("glb") => gltf_import::load(path),
             _ => Err(SceneError::UnsupportedFormat { path: path.to_owned() }),
         }
     }
@@ -133,6 +143,8 @@ impl Scene {
         }));
         self.textures.extend(other.textures);
         self.cameras.extend(other.cameras);
+        self.lights.extend(other.lights);
+        self.extensions_used.extend(other.extensions_used);
         self.warnings.extend(other.warnings);
     }
 

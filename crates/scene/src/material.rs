@@ -11,7 +11,13 @@ use crate::TextureId;
 /// [`roughness`](Self::roughness) = (2 / (Ns + 2))^¼, Walter et al. 2007), `Ke`
 /// → [`emission`](Self::emission), `Ni` → [`ior`](Self::ior), `d` →
 /// [`opacity`](Self::opacity). Absent fields keep the defaults of
-/// [`Material::default`].
+/// [`Material::default`]; OBJ surfaces are non-metallic and two-sided.
+///
+/// glTF 2.0 metallic-roughness materials map directly: base colour factor
+/// and texture, metallic and roughness factors and texture, normal map and
+/// scale, emissive factor (times KHR_materials_emissive_strength) and
+/// texture, alpha mode and cutoff, double-sided, KHR_materials_transmission
+/// and KHR_materials_ior; `specular` and `shininess` stay zero.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Material {
     pub name: String,
@@ -30,6 +36,30 @@ pub struct Material {
     pub ior: f32,
     /// 1 is opaque, 0 fully transparent.
     pub opacity: f32,
+    /// 0 for dielectrics, 1 for metals (glTF metallic-roughness).
+    pub metallic: f32,
+    /// Metallic in its blue channel, roughness in its green channel, multiplying the factors (linear).
+    pub metallic_roughness_texture: Option<TextureId>,
+    /// Emission multiplies this texture (sRGB) where there is one.
+    pub emission_texture: Option<TextureId>,
+    /// Tangent-space normal map (linear) and its scale.
+    pub normal_texture: Option<(TextureId, f32)>,
+    /// Fraction of light transmitted through the surface (KHR_materials_transmission).
+    pub transmission: f32,
+    pub alpha_mode: AlphaMode,
+    /// Whether the back side is lit as the front (glTF); OBJ surfaces are two-sided.
+    pub double_sided: bool,
+}
+
+/// How a material's alpha (base colour alpha times `opacity`) is used.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum AlphaMode {
+    /// Alpha is ignored.
+    Opaque,
+    /// Surfaces with alpha below the cutoff are holes.
+    Mask { cutoff: f32 },
+    /// Alpha blends the surface with what lies behind.
+    Blend,
 }
 
 impl Default for Material {
@@ -44,6 +74,13 @@ impl Default for Material {
             emission: Vec3::ZERO,
             ior: 1.5,
             opacity: 1.0,
+            metallic: 0.0,
+            metallic_roughness_texture: None,
+            emission_texture: None,
+            normal_texture: None,
+            transmission: 0.0,
+            alpha_mode: AlphaMode::Opaque,
+            double_sided: true,
         }
     }
 }
@@ -56,7 +93,13 @@ impl Material {
 
     /// Shifts texture references when scenes are merged.
     pub(crate) fn offset_textures(&mut self, base: u32) {
-        if let Some(t) = &mut self.base_color_texture {
+        for t in [&mut self.base_color_texture, &mut self.metallic_roughness_texture, &mut self.emission_texture]
+            .into_iter()
+            .flatten()
+        {
+            t.0 += base;
+        }
+        if let Some((t, _)) = &mut self.normal_texture {
             t.0 += base;
         }
     }

@@ -28,11 +28,18 @@ pub struct MeshBuilder {
     uvs: Vec<Vec2>,
     normals: Vec<Vec3>,
     faces: Vec<Face>,
+    crease_angle_degrees: f32,
 }
 
 impl MeshBuilder {
     pub fn new(positions: Vec<Vec3>, uvs: Vec<Vec2>, normals: Vec<Vec3>) -> Self {
-        Self { positions, uvs, normals, faces: Vec::new() }
+        Self { positions, uvs, normals, faces: Vec::new(), crease_angle_degrees: CREASE_ANGLE_DEGREES }
+    }
+
+    /// Computed normals are the faces' own (glTF's rule for meshes without normals).
+    pub fn with_flat_normals(mut self) -> Self {
+        self.crease_angle_degrees = 0.0;
+        self
     }
 
     /// Adds a triangle. Indices must be in range of the arrays given to [`MeshBuilder::new`].
@@ -51,7 +58,7 @@ impl MeshBuilder {
             })
             .collect();
         let adjacency = self.faces_by_position(&face_normals);
-        let cos_crease = CREASE_ANGLE_DEGREES.to_radians().cos();
+        let cos_crease = self.crease_angle_degrees.to_radians().cos();
 
         let mut vertex_of: HashMap<(u32, u32, [u32; 3]), u32> = HashMap::new();
         scene.triangles.reserve(self.faces.len());

@@ -134,8 +134,9 @@ fn load_materials(
             shininess,
             roughness: Material::roughness_from_shininess(shininess),
             emission: m.emissive.map_or(Vec3::ZERO, Vec3::from),
-            ior: m.optical_density.filter(|n| *n > 0.0).unwrap_or(defaults.ior),
+            ior: m.optical_density.filter(|n| *n > 0.0).unwrap_or(1.5),
             opacity: m.dissolve.unwrap_or(1.0).clamp(0.0, 1.0),
+            ..defaults
         });
     }
     texture_paths

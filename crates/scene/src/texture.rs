@@ -68,11 +68,16 @@ impl Texture {
 
     /// Decodes a PNG or JPEG file.
     pub fn load(path: &Path, encoding: ColorEncoding) -> Result<Self, String> {
-        let decoded = image::open(path).map_err(|e| format!("{}: {e}", path.display()))?.to_rgba8();
+        let bytes = std::fs::read(path).map_err(|e| format!("{}: {e}", path.display()))?;
+        Self::decode(&bytes, &path.display().to_string(), encoding)
+    }
+
+    /// Decodes PNG or JPEG bytes; `name` is used in messages.
+    pub fn decode(bytes: &[u8], name: &str, encoding: ColorEncoding) -> Result<Self, String> {
+        let decoded = image::load_from_memory(bytes).map_err(|e| format!("{name}: {e}"))?.to_rgba8();
         let (width, height) = decoded.dimensions();
         let texels = decoded.pixels().map(|p| p.0).collect();
-        Self::from_rgba8(path.display().to_string(), width, height, texels, encoding)
-            .ok_or_else(|| format!("{}: empty image", path.display()))
+        Self::from_rgba8(name, width, height, texels, encoding).ok_or_else(|| format!("{name}: empty image"))
     }
 
     /// A magenta and black checkerboard that stands in for a texture that

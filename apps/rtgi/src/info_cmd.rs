@@ -1,0 +1,195 @@
+//! `rtgi info`: what a scene contains, as text or JSON.
+
+use anyhow::Result;
+use rtgi_scene::{AlphaMode, LightKind, SUPPORTED_GLTF_EXTENSIONS};
+use serde::Serialize;
+
+use crate::cli::InfoArgs;
+use crate::common::{LoadedScene, load_scene};
+
+#[derive(Debug, Serialize)]
+struct Info {
+    scene: String,
+    triangles: usize,
+    vertices: usize,
+    materials: Vec<MaterialInfo>,
+    textures: Vec<TextureInfo>,
+    lights: Vec<LightInfo>,
+    cameras: Vec<CameraInfo>,
+    bounds: Option<[[f32; 3]; 2]>,
+    extensions_used: Vec<String>,
+    extensions_unsupported: Vec<String>,
+    warnings: Vec<String>,
+}
+
+#[derive(Debug, Serialize)]
+struct MaterialInfo {
+    name: String,
+    triangles: usize,
+    base_color: [f32; 3],
+    textured: bool,
+    metallic: f32,
+    roughness: f32,
+    emission: [f32; 3],
+    transmission: f32,
+    ior: f32,
+    alpha: String,
+}
+
+#[derive(Debug, Serialize)]
+struct TextureInfo {
+    name: String,
+    width: u32,
+    height: u32,
+}
+
+#[derive(Debug, Serialize)]
+struct LightInfo {
+    name: String,
+    kind: String,
+    position: [f32; 3],
+    direction: [f32; 3],
+    color: [f32; 3],
+    intensity: f32,
+}
+
+#[derive(Debug, Serialize)]
+struct CameraInfo {
+    position: [f32; 3],
+    direction: [f32; 3],
+    up: [f32; 3],
+    vertical_fov_degrees: f32,
+    aspect: Option<f32>,
+}
+
+pub(crate) fn run(args: &InfoArgs) -> Result<()> {
+    let LoadedScene { scene, name, .. } = load_scene(args.scene.as_deref())?;
+    let mut per_material = vec![0usize; scene.materials.len()];
+    for t in &scene.triangles {
+        per_material[t.material as usize] += 1;
+    }
+    let bounds = scene.bounds();
+    let info = Info {
+        scene: name,
+        triangles: scene.triangles.len(),
+        vertices: scene.vertices.len(),
+        materials: scene
+            .materials
+            .iter()
+            .zip(&per_material)
+            .map(|(m, &triangles)| MaterialInfo {
+                name: m.name.clone(),
+                triangles,
+                base_color: m.base_color.to_array(),
+                textured: m.base_color_texture.is_some(),
+                metallic: m.metallic,
+                roughness: m.roughness,
+                emission: m.emission.to_array(),
+                transmission: m.transmission,
+                ior: m.ior,
+                alpha: match m.alpha_mode {
+                    AlphaMode::Opaque => "opaque".into(),
+                    AlphaMode::Mask { cutoff } => format!("mask (cutoff {cutoff})"),
+                    AlphaMode::Blend => "blend".into(),
+                },
+            })
+            .collect(),
+        textures: scene
+            .textures
+            .iter()
+            .map(|t| TextureInfo { name: t.name.clone(), width: t.width(), height: t.height() })
+            .collect(),
+        lights: scene
+            .lights
+            .iter()
+            .map(|l| LightInfo {
+                name: l.name.clone(),
+                kind: match l.kind {
+                    LightKind::Point => "point".into(),
+                    LightKind::Directional => "directional".into(),
+                    LightKind::Spot { inner_cone, outer_cone } => {
+                        format!("spot (cones {:.1}° / {:.1}°)", inner_cone.to_degrees(), outer_cone.to_degrees())
+                    }
+                },
+                position: l.position.to_array(),
+                direction: l.direction.to_array(),
+                color: l.color.to_array(),
+                intensity: l.intensity,
+            })
+            .collect(),
+        cameras: scene
+            .cameras
+            .iter()
+            .map(|c| CameraInfo {
+                position: c.position.to_array(),
+                direction: c.direction.to_array(),
+                up: c.up.to_array(),
+                vertical_fov_degrees: c.vertical_fov.to_degrees(),
+                aspect: c.aspect,
+            })
+            .collect(),
+        bounds: (!bounds.is_empty()).then(|| [bounds.min.to_array(), bounds.max.to_array()]),
+        extensions_unsupported: scene
+            .extensions_used
+            .iter()
+            .filter(|e| !SUPPORTED_GLTF_EXTENSIONS.contains(&e.as_str()))
+            .cloned()
+            .collect(),
+        extensions_used: scene.extensions_used.clone(),
+        warnings: scene.warnings.clone(),
+    };
+    if args.json {
+        println!("{}", serde_json::to_string_pretty(&info)?);
+    } else {
+        print_text(&info);
+    }
+    Ok(())
+}
+
+fn print_text(info: &Info) {
+    let v = |a: [f32; 3]| format!("({}, {}, {})", a[0], a[1], a[2]);
+    println!("scene       {}", info.scene);
+    println!("triangles   {}", info.triangles);
+    println!("vertices    {}", info.vertices);
+    if let Some([min, max]) = info.bounds {
+        println!("bounds      {} to {}", v(min), v(max));
+    }
+    println!("materials   {}", info.materials.len());
+    for m in &info.materials {
+        println!(
+            "  {:<24} {:>8} triangles, base colour {}{}, metallic {}, roughness {:.3}, emission {}, {}",
+            m.name,
+            m.triangles,
+            v(m.base_color),
+            if m.textured { " x texture" } else { "" },
+            m.metallic,
+            m.roughness,
+            v(m.emission),
+            m.alpha
+        );
+    }
+    println!("textures    {}", info.textures.len());
+    for t in &info.textures {
+        println!("  {} ({}x{})", t.name, t.width, t.height);
+    }
+    println!("lights      {}", info.lights.len());
+    for l in &info.lights {
+        println!("  {:<24} {} at {}, colour {}, intensity {}", l.name, l.kind, v(l.position), v(l.color), l.intensity);
+    }
+    println!("cameras     {}", info.cameras.len());
+    for c in &info.cameras {
+        println!(
+            "  at {} looking {}, up {}, vertical field of view {:.2}°",
+            v(c.position),
+            v(c.direction),
+            v(c.up),
+            c.vertical_fov_degrees
+        );
+    }
+    if !info.extensions_used.is_empty() {
+        println!("extensions  {}", info.extensions_used.join(", "));
+    }
+    for e in &info.extensions_unsupported {
+        println!("warning: extension {e} is not supported and is ignored");
+    }
+}

@@ -1,0 +1,124 @@
+//! glTF import: the shared sample models load with the counts of
+//! ../shared/scenes/INDEX.md, cameras and lights carry the values of their
+//! JSON, and malformed or hostile files give errors that name the file.
+
+use rtgi_math::Vec3;
+use rtgi_scene::{LightKind, Scene, SceneError};
+use rtgi_tests::{scratch_dir, shared_scene};
+
+#[test]
+fn sample_models_load_with_their_triangle_counts() {
+    let expected = [
+        ("gltf/Box/glTF/Box.gltf", 12),
+        ("gltf/Box/glTF-Binary/Box.glb", 12),
+        ("gltf/BoxTextured/glTF/BoxTextured.gltf", 12),
+        ("gltf/BoxTextured/glTF-Binary/BoxTextured.glb", 12),
+        ("gltf/DamagedHelmet/glTF/DamagedHelmet.gltf", 15_452),
+        ("gltf/LightsPunctualLamp/glTF/LightsPunctualLamp.gltf", 6_000),
+        ("gltf/TransmissionTest/glTF/TransmissionTest.gltf", 128_775),
+        ("gltf/TransmissionRoughnessTest/glTF-Binary/TransmissionRoughnessTest.glb", 77_792),
+        ("gltf/AlphaBlendModeTest/glTF/AlphaBlendModeTest.gltf", 61),
+        ("gltf/Cameras/glTF/Cameras.gltf", 2),
+    ];
+    for (file, triangles) in expected {
+        let Some(path) = shared_scene(file) else { continue };
+        let scene = Scene::load(&path).unwrap_or_else(|e| panic!("{e}"));
+        assert_eq!(scene.triangles.len(), triangles, "{file}");
+        // Every texture a material names was found and decoded.
+        assert!(scene.warnings.iter().all(|w| !w.contains("image")), "{file}: {:?}", scene.warnings);
+    }
+}
+
+#[test]
+fn cameras_gltf_has_its_perspective_camera() {
+    let Some(path) = shared_scene("gltf/Cameras/glTF/Cameras.gltf") else { return };
+    let scene = Scene::load(&path).unwrap();
+    // Camera 0: perspective, yfov 0.7, aspect 1, at node translation (0.5, 0.5, 3),
+    // looking along -Z. Camera 1 is orthographic and skipped with a warning.
+    assert_eq!(scene.cameras.len(), 1);
+    let camera = scene.cameras[0];
+    assert_eq!(camera.position, Vec3::new(0.5, 0.5, 3.0));
+    assert_eq!(camera.vertical_fov, 0.7);
+    assert_eq!(camera.aspect, Some(1.0));
+    assert!((camera.direction - -Vec3::Z).length() < 1e-6);
+    assert!((camera.up - Vec3::Y).length() < 1e-6);
+    assert!(scene.warnings.iter().any(|w| w.contains("orthographic")));
+}
+
+#[test]
+fn lights_punctual_lamp_has_its_five_lights() {
+    let Some(path) = shared_scene("gltf/LightsPunctualLamp/glTF/LightsPunctualLamp.gltf") else { return };
+    let scene = Scene::load(&path).unwrap();
+    assert_eq!(scene.lights.len(), 5);
+    let by_name = |name: &str| scene.lights.iter().find(|l| l.name == name).unwrap_or_else(|| panic!("{name}"));
+    // Values from the file's KHR_lights_punctual block.
+    let point = by_name("Point");
+    assert_eq!(point.kind, LightKind::Point);
+    assert_eq!(point.intensity, 15.0);
+    assert_eq!(point.color, Vec3::new(1.0, 0.631_875, 0.239_099_76));
+    assert_eq!(by_name("Point.002").color, Vec3::ONE);
+    assert_eq!(by_name("Point.002").intensity, 1.5);
+    assert_eq!(by_name("Point.001").intensity, 80.0);
+    assert_eq!(by_name("Point.003").intensity, 80.0);
+    assert_eq!(by_name("Point.004").intensity, 180.0);
+    // Placed by their nodes: all distinct positions, near the lamp.
+    for light in &scene.lights {
+        assert!(light.position.length() < 5.0 && light.position != Vec3::ZERO, "{light:?}");
+    }
+}
+
+/// A minimal glTF with one triangle whose buffer is given as `uri` and
+/// whose position accessor has `count` elements.
+fn triangle_gltf(uri: &str, count: u32) -> String {
+    format!(
+        r#"{{"asset":{{"version":"2.0"}},"scene":0,"scenes":[{{"nodes":[0]}}],"nodes":[{{"mesh":0}}],
+        "meshes":[{{"primitives":[{{"attributes":{{"POSITION":0}}}}]}}],
+        "buffers":[{{"uri":"{uri}","byteLength":36}}],
+        "bufferViews":[{{"buffer":0,"byteOffset":0,"byteLength":36}}],
+        "accessors":[{{"bufferView":0,"componentType":5126,"count":{count},"type":"VEC3","max":[1,1,0],"min":[0,0,0]}}]}}"#
+    )
+}
+
+fn triangle_bytes() -> Vec<u8> {
+    [0.0f32, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0].iter().flat_map(|f| f.to_le_bytes()).collect()
+}
+
+fn load_text(name: &str, text: &str) -> Result<Scene, SceneError> {
+    let dir = scratch_dir(&format!("gltf-{name}"));
+    std::fs::write(dir.join("tri.bin"), triangle_bytes()).unwrap();
+    let path = dir.join(format!("{name}.gltf"));
+    std::fs::write(&path, text).unwrap();
+    Scene::load(&path)
+}
+
+#[test]
+fn embedded_and_external_buffers_load() {
+    use base64::Engine as _;
+    let data = format!(
+        "data:application/octet-stream;base64,{}",
+        base64::engine::general_purpose::STANDARD.encode(triangle_bytes())
+    );
+    for (name, uri) in [("embedded", data.as_str()), ("external", "tri.bin"), ("escaped", "tr%69.bin")] {
+        let scene = load_text(name, &triangle_gltf(uri, 3)).unwrap_or_else(|e| panic!("{name}: {e}"));
+        assert_eq!(scene.triangles.len(), 1, "{name}");
+        assert_eq!(scene.vertices[0].normal, Vec3::Z, "{name}: flat normal computed");
+    }
+}
+
+#[test]
+fn hostile_files_are_refused_with_the_file_named() {
+    let cases = [
+        ("notjson", "{ this is not json".to_owned(), "notjson.gltf"),
+        ("overrun", triangle_gltf("tri.bin", 1_000_000), "does not fit"),
+        ("remote", triangle_gltf("https://example.com/tri.bin", 3), "refusing to fetch"),
+        ("escape", triangle_gltf("../../etc/passwd", 3), "leaves the scene's folder"),
+        ("absolute", triangle_gltf("/etc/passwd", 3), "absolute"),
+        ("missing", triangle_gltf("nothere.bin", 3), "nothere.bin"),
+    ];
+    for (name, text, expected) in cases {
+        let error = load_text(name, &text).err().unwrap_or_else(|| panic!("{name} loaded"));
+        let message = error.to_string();
+        assert!(message.contains(&format!("{name}.gltf")), "{name}: {message}");
+        assert!(message.contains(expected), "{name}: {message}");
+    }
+}
