@@ -38,6 +38,8 @@ proptest! {
                 (i, rays.iter().map(|r| (reference.intersect(r), reference.occluded(r))).collect())
             })
             .collect();
+        let references_linear: Vec<(Intersector, LinearScan)> =
+            Intersector::ALL.iter().map(|&i| (i, LinearScan::new(&triangles, i))).collect();
         let mut failures = Vec::new();
         for_every_variant(&triangles, |label, accel, params| {
             let expected = &references.iter().find(|(i, _)| *i == params.intersector).expect("every intersector").1;
@@ -49,6 +51,16 @@ proptest! {
                 }
                 if accel.occluded(ray) != *any {
                     failures.push(format!("{label}: any-hit differs for {ray:?}"));
+                }
+                // With a filter that passes through every third triangle.
+                let reference = references_linear.iter().find(|(i, _)| *i == params.intersector).expect("every intersector");
+                let holes = |t: u32, _: f32, _: f32| t % 3 != 0;
+                let (got, expected) = (accel.intersect_filtered(ray, &holes), reference.1.intersect_filtered(ray, &holes));
+                if got.map(|h| (h.t, h.triangle)) != expected.map(|h| (h.t, h.triangle)) {
+                    failures.push(format!("{label}: filtered closest {got:?} != {expected:?}"));
+                }
+                if accel.occluded_filtered(ray, &holes) != reference.1.occluded_filtered(ray, &holes) {
+                    failures.push(format!("{label}: filtered any-hit differs for {ray:?}"));
                 }
             }
         });

@@ -91,6 +91,36 @@ pub trait Accel: Send + Sync + std::fmt::Debug {
     /// [`Accel::occluded`], adding the work done to `counters`.
     fn occluded_counted(&self, ray: &Ray, counters: &mut TraversalCounters) -> bool;
 
+    /// [`Accel::intersect`], counting only hits that `accept(triangle,
+    /// beta, gamma)` agrees to: the others are passed through, as alpha-masked
+    /// holes are. The filter is called for candidate hits only.
+    fn intersect_filtered(&self, ray: &Ray, accept: &dyn Fn(u32, f32, f32) -> bool) -> Option<Hit>;
+
+    /// [`Accel::occluded`] with the same filter as [`Accel::intersect_filtered`].
+    fn occluded_filtered(&self, ray: &Ray, accept: &dyn Fn(u32, f32, f32) -> bool) -> bool;
+
     /// The statistics of the build.
     fn build_stats(&self) -> &BuildStats;
+}
+
+/// Decides whether a candidate hit counts; monomorphised, so the default
+/// [`AcceptAll`] costs nothing.
+pub(crate) trait HitFilter {
+    fn accept(&self, triangle: u32, beta: f32, gamma: f32) -> bool;
+}
+
+pub(crate) struct AcceptAll;
+
+impl HitFilter for AcceptAll {
+    #[inline(always)]
+    fn accept(&self, _triangle: u32, _beta: f32, _gamma: f32) -> bool {
+        true
+    }
+}
+
+impl HitFilter for &dyn Fn(u32, f32, f32) -> bool {
+    #[inline(always)]
+    fn accept(&self, triangle: u32, beta: f32, gamma: f32) -> bool {
+        self(triangle, beta, gamma)
+    }
 }

@@ -3,7 +3,7 @@ use std::time::Instant;
 use rtgi_math::{Ray, Vec3, Vec3A};
 
 use crate::triangle::{MollerTrumbore, TriangleTest, Watertight};
-use crate::{Accel, BuildStats, Counter, Hit, Intersector, NoCounter, TraversalCounters};
+use crate::{Accel, AcceptAll, BuildStats, Counter, Hit, HitFilter, Intersector, NoCounter, TraversalCounters};
 
 /// The reference structure: every ray is tested against every triangle, in
 /// index order, O(n) per ray. Slow, simple, and the answer every other
@@ -31,21 +31,26 @@ impl LinearScan {
         Self { triangles, stats, intersector }
     }
 
-    fn closest<C: Counter>(&self, ray: &Ray, counter: &mut C) -> Option<Hit> {
+    fn closest<C: Counter, F: HitFilter>(&self, ray: &Ray, counter: &mut C, filter: &F) -> Option<Hit> {
         match self.intersector {
-            Intersector::Watertight => self.closest_with::<C, Watertight>(ray, counter),
-            Intersector::MollerTrumbore => self.closest_with::<C, MollerTrumbore>(ray, counter),
+            Intersector::Watertight => self.closest_with::<C, Watertight, F>(ray, counter, filter),
+            Intersector::MollerTrumbore => self.closest_with::<C, MollerTrumbore, F>(ray, counter, filter),
         }
     }
 
-    fn any<C: Counter>(&self, ray: &Ray, counter: &mut C) -> bool {
+    fn any<C: Counter, F: HitFilter>(&self, ray: &Ray, counter: &mut C, filter: &F) -> bool {
         match self.intersector {
-            Intersector::Watertight => self.any_with::<C, Watertight>(ray, counter),
-            Intersector::MollerTrumbore => self.any_with::<C, MollerTrumbore>(ray, counter),
+            Intersector::Watertight => self.any_with::<C, Watertight, F>(ray, counter, filter),
+            Intersector::MollerTrumbore => self.any_with::<C, MollerTrumbore, F>(ray, counter, filter),
         }
     }
 
-    fn closest_with<C: Counter, T: TriangleTest>(&self, ray: &Ray, counter: &mut C) -> Option<Hit> {
+    fn closest_with<C: Counter, T: TriangleTest, F: HitFilter>(
+        &self,
+        ray: &Ray,
+        counter: &mut C,
+        filter: &F,
+    ) -> Option<Hit> {
         if !ray.is_valid() {
             return None;
         }
@@ -56,7 +61,7 @@ impl LinearScan {
         for (index, triangle) in self.triangles.iter().enumerate() {
             // Strictly closer only: at equal t the lower index, found first, stays.
             if let Some(h) = T::intersect(&test_ray, ray.t_min, t_max, triangle) {
-                if closest.is_none_or(|c| h.t < c.t) {
+                if closest.is_none_or(|c| h.t < c.t) && filter.accept(index as u32, h.beta, h.gamma) {
                     t_max = h.t;
                     closest = Some(Hit { t: h.t, triangle: index as u32, beta: h.beta, gamma: h.gamma });
                 }
@@ -65,13 +70,15 @@ impl LinearScan {
         closest
     }
 
-    fn any_with<C: Counter, T: TriangleTest>(&self, ray: &Ray, counter: &mut C) -> bool {
+    fn any_with<C: Counter, T: TriangleTest, F: HitFilter>(&self, ray: &Ray, counter: &mut C, filter: &F) -> bool {
         if !ray.is_valid() {
             return false;
         }
         let test_ray = T::prepare(ray.origin.into(), ray.direction.into());
         for (index, triangle) in self.triangles.iter().enumerate() {
-            if T::intersect(&test_ray, ray.t_min, ray.t_max, triangle).is_some() {
+            if T::intersect(&test_ray, ray.t_min, ray.t_max, triangle)
+                .is_some_and(|h| filter.accept(index as u32, h.beta, h.gamma))
+            {
                 counter.triangles_tested(index as u32 + 1);
                 return true;
             }
@@ -83,21 +90,29 @@ impl LinearScan {
 
 impl Accel for LinearScan {
     fn intersect(&self, ray: &Ray) -> Option<Hit> {
-        self.closest(ray, &mut NoCounter)
+        self.closest(ray, &mut NoCounter, &AcceptAll)
     }
 
     fn occluded(&self, ray: &Ray) -> bool {
-        self.any(ray, &mut NoCounter)
+        self.any(ray, &mut NoCounter, &AcceptAll)
     }
 
     fn intersect_counted(&self, ray: &Ray, counters: &mut TraversalCounters) -> Option<Hit> {
         counters.rays += 1;
-        self.closest(ray, counters)
+        self.closest(ray, counters, &AcceptAll)
     }
 
     fn occluded_counted(&self, ray: &Ray, counters: &mut TraversalCounters) -> bool {
         counters.rays += 1;
-        self.any(ray, counters)
+        self.any(ray, counters, &AcceptAll)
+    }
+
+    fn intersect_filtered(&self, ray: &Ray, accept: &dyn Fn(u32, f32, f32) -> bool) -> Option<Hit> {
+        self.closest(ray, &mut NoCounter, &accept)
+    }
+
+    fn occluded_filtered(&self, ray: &Ray, accept: &dyn Fn(u32, f32, f32) -> bool) -> bool {
+        self.any(ray, &mut NoCounter, &accept)
     }
 
     fn build_stats(&self) -> &BuildStats {

@@ -30,7 +30,7 @@ mod shade;
 pub use camera::CameraRays;
 pub use framing::frame_scene;
 pub use sampler::PixelSampler;
-pub use shade::{shade_primary, shading_normal};
+pub use shade::{alpha_accepts, has_alpha, shade_primary, shading_normal};
 
 use std::time::Instant;
 
@@ -114,13 +114,20 @@ pub fn render<A: Accel + ?Sized>(
     let (width, height) = (settings.width, settings.height);
     let rays = CameraRays::new(camera, width, height);
     let spp = settings.samples_per_pixel.max(1);
+    let alpha = has_alpha(scene);
     let image = render_pixels(width, height, progress, |x, y| {
         let pixel_index = y as u64 * width as u64 + x as u64;
         let mut sum = Vec3::ZERO;
         for sample in 0..spp {
             let mut rng = Rng::for_sample(settings.seed, pixel_index, sample as u64);
             let ray = rays.ray(x, y, settings.sampler.offset(&mut rng));
-            sum += match accel.intersect(&ray) {
+            let hit = if alpha {
+                let u = rng.next_f32();
+                accel.intersect_filtered(&ray, &|t, b, g| alpha_accepts(scene, t, b, g, u))
+            } else {
+                accel.intersect(&ray)
+            };
+            sum += match hit {
                 Some(hit) => shade_primary(scene, &ray, &hit),
                 None => settings.background,
             };

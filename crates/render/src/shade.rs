@@ -1,6 +1,6 @@
 use rtgi_accel::Hit;
 use rtgi_math::{Ray, Vec3};
-use rtgi_scene::Scene;
+use rtgi_scene::{AlphaMode, Scene};
 
 /// The part of the light that a surface facing away from the viewer still
 /// reflects in the simple shading, so that such faces stay readable.
@@ -33,4 +33,32 @@ pub fn shading_normal(scene: &Scene, hit: &Hit) -> Vec3 {
         let [a, b, c] = triangle.vertices.map(|v| scene.vertices[v as usize].position);
         (b - a).cross(c - a).normalize_or(Vec3::Z)
     })
+}
+
+/// Whether any material of the scene has alpha that makes holes: masked
+/// or blended surfaces. Renders of scenes without skip the per-hit test.
+pub fn has_alpha(scene: &Scene) -> bool {
+    scene.materials.iter().any(|m| m.alpha_mode != AlphaMode::Opaque)
+}
+
+/// Whether a hit on `triangle` at `(beta, gamma)` counts: masked surfaces
+/// are holes where their alpha (base colour alpha times the texture's) is
+/// below the cutoff; blended surfaces are hit with probability alpha, decided
+/// by comparing it with the sample's uniform number `u` (stochastic
+/// transparency, which averages to the blend over samples).
+pub fn alpha_accepts(scene: &Scene, triangle: u32, beta: f32, gamma: f32, u: f32) -> bool {
+    let triangle = &scene.triangles[triangle as usize];
+    let material = &scene.materials[triangle.material as usize];
+    let alpha = || {
+        let texture = material.base_color_texture.map_or(1.0, |t| {
+            let uv = scene.interpolate(triangle, beta, gamma, |v| v.uv);
+            scene.textures[t.0 as usize].sample(uv).w
+        });
+        material.opacity * texture
+    };
+    match material.alpha_mode {
+        AlphaMode::Opaque => true,
+        AlphaMode::Mask { cutoff } => alpha() >= cutoff,
+        AlphaMode::Blend => alpha() > u,
+    }
 }

@@ -22,7 +22,7 @@ use rayon::prelude::*;
 use rtgi_math::{Aabb, Vec3, Vec3A, Vec4};
 
 use crate::boxa::BoxA;
-use crate::{Accel, BuildParams, BuildStats, Hit, NoCounter, TraversalCounters};
+use crate::{Accel, AcceptAll, BuildParams, BuildStats, Hit, NoCounter, TraversalCounters};
 
 /// A node of the flattened tree: its box, and either the index of its first
 /// child (the second follows it) or, for a leaf, the range of its triangles
@@ -196,21 +196,29 @@ pub(crate) fn is_hittable(t: &[Vec3; 3]) -> bool {
 
 impl Accel for Bvh {
     fn intersect(&self, ray: &rtgi_math::Ray) -> Option<Hit> {
-        self.closest(ray, &mut NoCounter)
+        self.closest(ray, &mut NoCounter, &AcceptAll)
     }
 
     fn occluded(&self, ray: &rtgi_math::Ray) -> bool {
-        self.any(ray, &mut NoCounter)
+        self.any(ray, &mut NoCounter, &AcceptAll)
     }
 
     fn intersect_counted(&self, ray: &rtgi_math::Ray, counters: &mut TraversalCounters) -> Option<Hit> {
         counters.rays += 1;
-        self.closest(ray, counters)
+        self.closest(ray, counters, &AcceptAll)
     }
 
     fn occluded_counted(&self, ray: &rtgi_math::Ray, counters: &mut TraversalCounters) -> bool {
         counters.rays += 1;
-        self.any(ray, counters)
+        self.any(ray, counters, &AcceptAll)
+    }
+
+    fn intersect_filtered(&self, ray: &rtgi_math::Ray, accept: &dyn Fn(u32, f32, f32) -> bool) -> Option<Hit> {
+        self.closest(ray, &mut NoCounter, &accept)
+    }
+
+    fn occluded_filtered(&self, ray: &rtgi_math::Ray, accept: &dyn Fn(u32, f32, f32) -> bool) -> bool {
+        self.any(ray, &mut NoCounter, &accept)
     }
 
     fn build_stats(&self) -> &BuildStats {

@@ -6,7 +6,7 @@ use rtgi_math::{BVec3A, Ray, Vec3A, gamma};
 
 use super::{Bvh, BvhNode};
 use crate::triangle::{MollerTrumbore, TriangleTest, Watertight};
-use crate::{Counter, Hit, Intersector};
+use crate::{Counter, Hit, HitFilter, Intersector};
 
 /// Entries of the largest traversal stack. A stack holds at most one entry
 /// per level of the tree, and builds never exceed 64 + 32 levels (see
@@ -138,7 +138,8 @@ impl Bvh {
     /// and shrinking `t_max`. At equal distances the triangle with the lower
     /// input index wins, so every variant and leaf size gives the same answer.
     #[inline(always)]
-    fn leaf_closest<C: Counter, T: TriangleTest>(
+    #[allow(clippy::too_many_arguments)]
+    fn leaf_closest<C: Counter, T: TriangleTest, F: HitFilter>(
         &self,
         leaf: &BvhNode,
         test_ray: &T::Ray,
@@ -146,6 +147,7 @@ impl Bvh {
         t_max: &mut f32,
         best: &mut Option<Hit>,
         counter: &mut C,
+        filter: &F,
     ) {
         let range = leaf.first() as usize..(leaf.first() + leaf.count()) as usize;
         counter.triangles_tested(leaf.count());
@@ -154,7 +156,7 @@ impl Bvh {
                 continue;
             };
             // The test only reports t <= t_max, the best distance so far.
-            if best.is_none_or(|b| h.t < b.t || id < b.triangle) {
+            if best.is_none_or(|b| h.t < b.t || id < b.triangle) && filter.accept(id, h.beta, h.gamma) {
                 *t_max = h.t;
                 *best = Some(Hit { t: h.t, triangle: id, beta: h.beta, gamma: h.gamma });
             }
@@ -164,55 +166,72 @@ impl Bvh {
     /// Closest hit: front to back, leaves tested as soon as their box is
     /// hit, the farther child of two pushed on a fixed-size stack no larger
     /// than the tree's depth needs.
-    pub(crate) fn closest<C: Counter>(&self, ray: &Ray, counter: &mut C) -> Option<Hit> {
+    pub(crate) fn closest<C: Counter, F: HitFilter>(&self, ray: &Ray, counter: &mut C, filter: &F) -> Option<Hit> {
         match (self.intersector, self.traversal) {
             (Intersector::Watertight, Traversal::Robust) => {
-                self.closest_sized::<C, Watertight, RobustSlabs>(ray, counter)
+                self.closest_sized::<C, Watertight, RobustSlabs, F>(ray, counter, filter)
             }
-            (Intersector::Watertight, Traversal::Fast) => self.closest_sized::<C, Watertight, FastSlabs>(ray, counter),
+            (Intersector::Watertight, Traversal::Fast) => {
+                self.closest_sized::<C, Watertight, FastSlabs, F>(ray, counter, filter)
+            }
             (Intersector::MollerTrumbore, Traversal::Robust) => {
-                self.closest_sized::<C, MollerTrumbore, RobustSlabs>(ray, counter)
+                self.closest_sized::<C, MollerTrumbore, RobustSlabs, F>(ray, counter, filter)
             }
             (Intersector::MollerTrumbore, Traversal::Fast) => {
-                self.closest_sized::<C, MollerTrumbore, FastSlabs>(ray, counter)
+                self.closest_sized::<C, MollerTrumbore, FastSlabs, F>(ray, counter, filter)
             }
         }
     }
 
     /// Any hit: stops at the first triangle found.
-    pub(crate) fn any<C: Counter>(&self, ray: &Ray, counter: &mut C) -> bool {
+    pub(crate) fn any<C: Counter, F: HitFilter>(&self, ray: &Ray, counter: &mut C, filter: &F) -> bool {
         match (self.intersector, self.traversal) {
-            (Intersector::Watertight, Traversal::Robust) => self.any_sized::<C, Watertight, RobustSlabs>(ray, counter),
-            (Intersector::Watertight, Traversal::Fast) => self.any_sized::<C, Watertight, FastSlabs>(ray, counter),
+            (Intersector::Watertight, Traversal::Robust) => {
+                self.any_sized::<C, Watertight, RobustSlabs, F>(ray, counter, filter)
+            }
+            (Intersector::Watertight, Traversal::Fast) => {
+                self.any_sized::<C, Watertight, FastSlabs, F>(ray, counter, filter)
+            }
             (Intersector::MollerTrumbore, Traversal::Robust) => {
-                self.any_sized::<C, MollerTrumbore, RobustSlabs>(ray, counter)
+                self.any_sized::<C, MollerTrumbore, RobustSlabs, F>(ray, counter, filter)
             }
             (Intersector::MollerTrumbore, Traversal::Fast) => {
-                self.any_sized::<C, MollerTrumbore, FastSlabs>(ray, counter)
+                self.any_sized::<C, MollerTrumbore, FastSlabs, F>(ray, counter, filter)
             }
         }
     }
 
-    fn closest_sized<C: Counter, T: TriangleTest, S: SlabTest>(&self, ray: &Ray, counter: &mut C) -> Option<Hit> {
-        match self.stats.depth {
-            0..=32 => self.closest_with_stack::<C, T, S, 32>(ray, counter),
-            33..=64 => self.closest_with_stack::<C, T, S, 64>(ray, counter),
-            _ => self.closest_with_stack::<C, T, S, STACK_SIZE>(ray, counter),
-        }
-    }
-
-    fn any_sized<C: Counter, T: TriangleTest, S: SlabTest>(&self, ray: &Ray, counter: &mut C) -> bool {
-        match self.stats.depth {
-            0..=32 => self.any_with_stack::<C, T, S, 32>(ray, counter),
-            33..=64 => self.any_with_stack::<C, T, S, 64>(ray, counter),
-            _ => self.any_with_stack::<C, T, S, STACK_SIZE>(ray, counter),
-        }
-    }
-
-    fn closest_with_stack<C: Counter, T: TriangleTest, S: SlabTest, const STACK: usize>(
+    fn closest_sized<C: Counter, T: TriangleTest, S: SlabTest, F: HitFilter>(
         &self,
         ray: &Ray,
         counter: &mut C,
+        filter: &F,
+    ) -> Option<Hit> {
+        match self.stats.depth {
+            0..=32 => self.closest_with_stack::<C, T, S, F, 32>(ray, counter, filter),
+            33..=64 => self.closest_with_stack::<C, T, S, F, 64>(ray, counter, filter),
+            _ => self.closest_with_stack::<C, T, S, F, STACK_SIZE>(ray, counter, filter),
+        }
+    }
+
+    fn any_sized<C: Counter, T: TriangleTest, S: SlabTest, F: HitFilter>(
+        &self,
+        ray: &Ray,
+        counter: &mut C,
+        filter: &F,
+    ) -> bool {
+        match self.stats.depth {
+            0..=32 => self.any_with_stack::<C, T, S, F, 32>(ray, counter, filter),
+            33..=64 => self.any_with_stack::<C, T, S, F, 64>(ray, counter, filter),
+            _ => self.any_with_stack::<C, T, S, F, STACK_SIZE>(ray, counter, filter),
+        }
+    }
+
+    fn closest_with_stack<C: Counter, T: TriangleTest, S: SlabTest, F: HitFilter, const STACK: usize>(
+        &self,
+        ray: &Ray,
+        counter: &mut C,
+        filter: &F,
     ) -> Option<Hit> {
         if !ray.is_valid() || self.nodes.is_empty() {
             return None;
@@ -227,7 +246,7 @@ impl Bvh {
             return None;
         }
         if root.is_leaf() {
-            self.leaf_closest::<C, T>(root, &test_ray, ray.t_min, &mut t_max, &mut best, counter);
+            self.leaf_closest::<C, T, F>(root, &test_ray, ray.t_min, &mut t_max, &mut best, counter, filter);
             return best;
         }
         let mut stack = [0u32; STACK];
@@ -245,14 +264,14 @@ impl Bvh {
             }
             let mut descend_near = enter_near < f32::INFINITY;
             if descend_near && near.is_leaf() {
-                self.leaf_closest::<C, T>(near, &test_ray, ray.t_min, &mut t_max, &mut best, counter);
+                self.leaf_closest::<C, T, F>(near, &test_ray, ray.t_min, &mut t_max, &mut best, counter, filter);
                 descend_near = false;
             }
             // The near leaf may have found a hit in front of the far box. (A
             // missed box enters at +∞, which an unbounded t_max does not exclude.)
             let mut descend_far = enter_far < f32::INFINITY && enter_far <= t_max;
             if descend_far && far.is_leaf() {
-                self.leaf_closest::<C, T>(far, &test_ray, ray.t_min, &mut t_max, &mut best, counter);
+                self.leaf_closest::<C, T, F>(far, &test_ray, ray.t_min, &mut t_max, &mut best, counter, filter);
                 descend_far = false;
             }
             children = match (descend_near, descend_far) {
@@ -274,10 +293,11 @@ impl Bvh {
         }
     }
 
-    fn any_with_stack<C: Counter, T: TriangleTest, S: SlabTest, const STACK: usize>(
+    fn any_with_stack<C: Counter, T: TriangleTest, S: SlabTest, F: HitFilter, const STACK: usize>(
         &self,
         ray: &Ray,
         counter: &mut C,
+        filter: &F,
     ) -> bool {
         if !ray.is_valid() || self.nodes.is_empty() {
             return false;
@@ -287,10 +307,13 @@ impl Bvh {
         let t_max = ray.t_max;
         let leaf_hit = |leaf: &BvhNode, counter: &mut C| {
             let range = leaf.first() as usize..(leaf.first() + leaf.count()) as usize;
-            for (tested, triangle) in self.triangles[range].iter().enumerate() {
-                if T::intersect(&test_ray, ray.t_min, t_max, triangle).is_some() {
-                    counter.triangles_tested(tested as u32 + 1);
-                    return true;
+            let ids = &self.triangle_ids[range.clone()];
+            for (tested, (triangle, &id)) in self.triangles[range].iter().zip(ids).enumerate() {
+                if let Some(h) = T::intersect(&test_ray, ray.t_min, t_max, triangle) {
+                    if filter.accept(id, h.beta, h.gamma) {
+                        counter.triangles_tested(tested as u32 + 1);
+                        return true;
+                    }
                 }
             }
             counter.triangles_tested(leaf.count());
