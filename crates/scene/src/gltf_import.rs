@@ -15,6 +15,7 @@ use rtgi_math::{Mat3, Mat4, Vec2, Vec3};
 
 use crate::{
     AlphaMode, Camera, ColorEncoding, Light, LightKind, Material, MeshBuilder, Scene, SceneError, Texture, TextureId,
+    Wrap,
 };
 
 /// Extensions this importer understands; others are reported by `rtgi info`.
@@ -219,20 +220,35 @@ fn validate_accessors(document: &gltf::Document, buffers: &[Vec<u8>]) -> Result<
     Ok(())
 }
 
-/// Decoded textures, one per (image, colour encoding) that materials use.
+/// What distinguishes one decoded texture from another: the image, whether
+/// it holds colour (sRGB) or data (linear), and the sampler's wrap modes.
+type TextureKey = (usize, bool, Wrap, Wrap);
+
+/// Decoded textures, one per [`TextureKey`] that materials use.
 struct TextureTable {
-    ids: HashMap<(usize, bool), TextureId>,
+    ids: HashMap<TextureKey, TextureId>,
+}
+
+fn texture_key(texture: &gltf::Texture<'_>, srgb: bool) -> TextureKey {
+    use gltf::texture::WrappingMode;
+    let wrap = |mode: WrappingMode| match mode {
+        WrappingMode::ClampToEdge => Wrap::ClampToEdge,
+        WrappingMode::MirroredRepeat => Wrap::MirroredRepeat,
+        WrappingMode::Repeat => Wrap::Repeat,
+    };
+    let sampler = texture.sampler();
+    (texture.source().index(), srgb, wrap(sampler.wrap_s()), wrap(sampler.wrap_t()))
 }
 
 impl TextureTable {
     fn new(document: &gltf::Document, folder: &Path, buffers: &[Vec<u8>], scene: &mut Scene) -> Self {
         // Which images are used as colour (sRGB) and which as data (linear).
-        let mut wanted: Vec<(usize, bool)> = Vec::new();
+        let mut wanted: Vec<TextureKey> = Vec::new();
         for m in document.materials() {
             let pbr = m.pbr_metallic_roughness();
             let mut want = |t: Option<gltf::Texture<'_>>, srgb: bool| {
                 if let Some(t) = t {
-                    let key = (t.source().index(), srgb);
+                    let key = texture_key(&t, srgb);
                     if !wanted.contains(&key) {
                         wanted.push(key);
                     }
@@ -246,7 +262,7 @@ impl TextureTable {
         let images: Vec<gltf::Image<'_>> = document.images().collect();
         let decoded: Vec<Result<Texture, String>> = wanted
             .par_iter()
-            .map(|&(index, srgb)| {
+            .map(|&(index, srgb, wrap_u, wrap_v)| {
                 let image = &images[index];
                 let encoding = if srgb { ColorEncoding::Srgb } else { ColorEncoding::Linear };
                 let bytes = match image.source() {
@@ -263,7 +279,7 @@ impl TextureTable {
                     }
                 };
                 let name = image.name().map_or_else(|| format!("image {index}"), str::to_owned);
-                Texture::decode(&bytes, &name, encoding)
+                Texture::decode(&bytes, &name, encoding).map(|t| t.with_wrap(wrap_u, wrap_v))
             })
             .collect();
         let mut ids = HashMap::new();
@@ -279,7 +295,7 @@ impl TextureTable {
     }
 
     fn get(&self, texture: gltf::Texture<'_>, srgb: bool) -> Option<TextureId> {
-        self.ids.get(&(texture.source().index(), srgb)).copied()
+        self.ids.get(&texture_key(&texture, srgb)).copied()
     }
 }
 

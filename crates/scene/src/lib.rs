@@ -35,7 +35,7 @@ pub use light::{Light, LightKind};
 pub use material::{AlphaMode, Material};
 pub use mesh::MeshBuilder;
 pub use resolve::resolve_case_insensitive;
-pub use texture::{ColorEncoding, Texture, TextureId};
+pub use texture::{ColorEncoding, Texture, TextureId, Wrap};
 
 use std::path::{Path, PathBuf};
 

@@ -16,7 +16,33 @@ pub enum ColorEncoding {
     Linear,
 }
 
-/// An 8-bit RGBA image, sampled with bilinear filtering and repeat wrapping.
+/// How texture coordinates outside `[0, 1]` map into the image.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum Wrap {
+    #[default]
+    Repeat,
+    ClampToEdge,
+    MirroredRepeat,
+}
+
+impl Wrap {
+    /// The texel index `i` maps to in an axis of `n` texels.
+    #[inline]
+    fn apply(self, i: i64, n: u32) -> u32 {
+        let n = n as i64;
+        let index = match self {
+            Wrap::Repeat => i.rem_euclid(n),
+            Wrap::ClampToEdge => i.clamp(0, n - 1),
+            Wrap::MirroredRepeat => {
+                let m = i.rem_euclid(2 * n);
+                if m >= n { 2 * n - 1 - m } else { m }
+            }
+        };
+        index as u32
+    }
+}
+
+/// An 8-bit RGBA image, sampled with bilinear filtering and its wrap modes.
 ///
 /// Texels are kept as bytes (a quarter of the memory of floats) and decoded
 /// through a table on lookup.
@@ -28,6 +54,8 @@ pub struct Texture {
     height: u32,
     texels: Vec<[u8; 4]>,
     encoding: ColorEncoding,
+    /// Wrap modes along u and v.
+    wrap: [Wrap; 2],
 }
 
 impl std::fmt::Debug for Texture {
@@ -63,7 +91,15 @@ impl Texture {
             height,
             texels,
             encoding,
+            wrap: [Wrap::Repeat; 2],
         })
+    }
+
+    /// This texture with the given wrap modes along u and v.
+    #[must_use]
+    pub fn with_wrap(mut self, u: Wrap, v: Wrap) -> Self {
+        self.wrap = [u, v];
+        self
     }
 
     /// Decodes a PNG or JPEG file.
@@ -84,7 +120,14 @@ impl Texture {
     /// could not be loaded: impossible to mistake for real content.
     pub fn missing(name: impl Into<String>) -> Self {
         let texels = (0..64).map(|i| if (i % 8 + i / 8) % 2 == 0 { [255, 0, 255, 255] } else { [0, 0, 0, 255] });
-        Self { name: name.into(), width: 8, height: 8, texels: texels.collect(), encoding: ColorEncoding::Srgb }
+        Self {
+            name: name.into(),
+            width: 8,
+            height: 8,
+            texels: texels.collect(),
+            encoding: ColorEncoding::Srgb,
+            wrap: [Wrap::Repeat; 2],
+        }
     }
 
     pub fn width(&self) -> u32 {
@@ -127,9 +170,9 @@ impl Texture {
         let y = uv.y * self.height as f32 - 0.5;
         let (x0, y0) = (x.floor(), y.floor());
         let (fx, fy) = (x - x0, y - y0);
-        let wrap = |i: f32, n: u32| (i as i64).rem_euclid(n as i64) as u32;
-        let (xa, xb) = (wrap(x0, self.width), wrap(x0 + 1.0, self.width));
-        let (ya, yb) = (wrap(y0, self.height), wrap(y0 + 1.0, self.height));
+        let [wrap_u, wrap_v] = self.wrap;
+        let (xa, xb) = (wrap_u.apply(x0 as i64, self.width), wrap_u.apply(x0 as i64 + 1, self.width));
+        let (ya, yb) = (wrap_v.apply(y0 as i64, self.height), wrap_v.apply(y0 as i64 + 1, self.height));
         let top = self.texel(xa, ya) * (1.0 - fx) + self.texel(xb, ya) * fx;
         let bottom = self.texel(xa, yb) * (1.0 - fx) + self.texel(xb, yb) * fx;
         top * (1.0 - fy) + bottom * fy
@@ -157,6 +200,19 @@ mod tests {
         let t = two_by_one();
         assert_eq!(t.sample(Vec2::new(1.25, 7.5)), t.sample(Vec2::new(0.25, 0.5)));
         assert_eq!(t.sample(Vec2::new(-0.75, -3.5)), t.sample(Vec2::new(0.25, 0.5)));
+    }
+
+    #[test]
+    fn clamp_and_mirror_wrap_modes() {
+        let clamped = two_by_one().with_wrap(Wrap::ClampToEdge, Wrap::ClampToEdge);
+        assert_eq!(clamped.sample(Vec2::new(3.0, 0.5)).x, 1.0);
+        assert_eq!(clamped.sample(Vec2::new(-3.0, 0.5)).x, 0.0);
+        let mirrored = two_by_one().with_wrap(Wrap::MirroredRepeat, Wrap::Repeat);
+        // Just past the right edge the mirror shows the right texel again.
+        assert_eq!(mirrored.sample(Vec2::new(1.25, 0.5)).x, 1.0);
+        assert_eq!(mirrored.sample(Vec2::new(1.75, 0.5)).x, 0.0);
+        assert_eq!(Wrap::MirroredRepeat.apply(-1, 4), 0);
+        assert_eq!(Wrap::MirroredRepeat.apply(4, 4), 3);
     }
 
     #[test]
