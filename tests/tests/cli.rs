@@ -101,6 +101,7 @@ fn bad_input_fails_with_one_line_and_leaves_no_file() {
     assert_fails_cleanly(&["render", "-o", o, "--accel", "octree"], "octree", &out);
     assert_fails_cleanly(&["render", "-o", o, "--at", "1,2"], "--at", &out);
     assert_fails_cleanly(&["render", "-o", o, "--fov", "180"], "--fov", &out);
+    assert_fails_cleanly(&["render", "-o", o, "--camera", "1"], "--camera 1", &out);
     assert!(!out.exists());
 }
 

@@ -122,3 +122,16 @@ fn hostile_files_are_refused_with_the_file_named() {
         assert!(message.contains(expected), "{name}: {message}");
     }
 }
+
+#[test]
+fn normal_mapped_models_get_unit_tangents_perpendicular_to_their_normals() {
+    let Some(path) = shared_scene("gltf/DamagedHelmet/glTF/DamagedHelmet.gltf") else { return };
+    let scene = Scene::load(&path).unwrap();
+    assert!(scene.materials.iter().any(|m| m.normal_texture.is_some()));
+    for v in &scene.vertices {
+        let t = v.tangent.truncate();
+        assert!((t.length() - 1.0).abs() < 1e-3, "{v:?}");
+        assert!(t.dot(v.normal).abs() < 1e-3, "{v:?}");
+        assert!(v.tangent.w == 1.0 || v.tangent.w == -1.0, "{v:?}");
+    }
+}

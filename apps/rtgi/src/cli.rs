@@ -316,6 +316,10 @@ impl AccelArgs {
 /// Camera options; any given override the scene's camera (or the automatic framing).
 #[derive(Debug, Default, Args)]
 pub(crate) struct CameraArgs {
+    /// Which of the scene's cameras to use, counting from 0 [default: the first]
+    #[arg(long)]
+    pub(crate) camera: Option<usize>,
+
     /// Camera position, as X,Y,Z (it looks at the scene's centre unless --look is given)
     #[arg(long, value_parser = parse_vec3, allow_hyphen_values = true)]
     pub(crate) at: Option<Vec3>,

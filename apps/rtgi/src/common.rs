@@ -78,14 +78,21 @@ pub(crate) fn check_output_folder(path: &Path) -> Result<()> {
 /// The scene's first camera, or an automatic framing, with any camera
 /// options applied on top.
 pub(crate) fn choose_camera(scene: &Scene, accel: &dyn Accel, options: &CameraArgs, aspect: f32) -> Result<Camera> {
+    let chosen = match options.camera {
+        Some(index) if index >= scene.cameras.len() => {
+            bail!("--camera {index}: the scene has {} camera(s), numbered from 0", scene.cameras.len())
+        }
+        Some(index) => scene.cameras.get(index),
+        None => scene.cameras.first(),
+    };
     let fov = match options.fov {
         Some(degrees) if !(degrees > 0.0 && degrees < 180.0) => {
             bail!("--fov {degrees}: the field of view must be between 0 and 180 degrees")
         }
         Some(degrees) => degrees.to_radians(),
-        None => scene.cameras.first().map_or(DEFAULT_FOV_DEGREES.to_radians(), |c| c.vertical_fov),
+        None => chosen.map_or(DEFAULT_FOV_DEGREES.to_radians(), |c| c.vertical_fov),
     };
-    let mut camera = match scene.cameras.first() {
+    let mut camera = match chosen {
         Some(camera) => *camera,
         None => frame_scene(scene, accel, fov, aspect),
     };

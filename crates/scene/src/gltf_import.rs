@@ -11,7 +11,7 @@ use std::path::{Component, Path, PathBuf};
 
 use base64::Engine as _;
 use rayon::prelude::*;
-use rtgi_math::{Mat3, Mat4, Vec2, Vec3};
+use rtgi_math::{Mat3, Mat4, Vec2, Vec3, Vec4};
 
 use crate::{
     AlphaMode, Camera, ColorEncoding, Light, LightKind, Material, MeshBuilder, Scene, SceneError, Texture, TextureId,
@@ -373,6 +373,17 @@ fn add_mesh(
             .read_normals()
             .map(|n| n.map(|n| (normal_matrix * Vec3::from(n)).normalize_or_zero()).collect())
             .unwrap_or_default();
+        let tangents: Vec<Vec4> = reader
+            .read_tangents()
+            .map(|t| {
+                t.map(|t| {
+                    let direction = (Mat3::from_mat4(*transform) * Vec3::new(t[0], t[1], t[2])).normalize_or_zero();
+                    // A mirroring transform also mirrors the bitangent.
+                    direction.extend(if flip { -t[3] } else { t[3] })
+                })
+                .collect()
+            })
+            .unwrap_or_default();
         let uvs: Vec<Vec2> =
             reader.read_tex_coords(0).map(|t| t.into_f32().map(Vec2::from).collect()).unwrap_or_default();
         let indices: Vec<u32> = match reader.read_indices() {
@@ -386,7 +397,8 @@ fn add_mesh(
         let has_uvs = uvs.len() == positions.len();
         let material = primitive.material().index().map_or(default_material, |i| i as u32);
         // glTF asks for flat normals where a mesh has none.
-        let mut builder = MeshBuilder::new(positions, uvs, normals).with_flat_normals();
+        let tangents = if has_normals && tangents.len() == normals.len() { tangents } else { Vec::new() };
+        let mut builder = MeshBuilder::new(positions, uvs, normals).with_flat_normals().with_tangents(tangents);
         for t in indices.chunks_exact(3) {
             let corners = if flip { [t[0], t[2], t[1]] } else { [t[0], t[1], t[2]] };
             builder.push(corners, has_uvs.then_some(corners), has_normals.then_some(corners), material);

@@ -39,7 +39,7 @@ pub use texture::{ColorEncoding, Texture, TextureId, Wrap};
 
 use std::path::{Path, PathBuf};
 
-use rtgi_math::{Aabb, Vec2, Vec3};
+use rtgi_math::{Aabb, Vec2, Vec3, Vec4};
 
 /// A vertex as triangles reference it.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -50,6 +50,11 @@ pub struct Vertex {
     /// Texture coordinates with the origin at the top left of the image (OBJ's
     /// bottom-left `v` is flipped on import).
     pub uv: Vec2,
+    /// Unit tangent along increasing u, perpendicular to the normal, for
+    /// normal maps; `w` (±1) gives the bitangent: `cross(normal, tangent) * w`.
+    /// From the file where it has them, else computed from the texture
+    /// coordinates (Lengyel, "Computing Tangent Space Basis Vectors", 2001).
+    pub tangent: Vec4,
 }
 
 /// A triangle: indices into [`Scene::vertices`] and [`Scene::materials`].

@@ -1,6 +1,6 @@
 use std::collections::HashMap;
 
-use rtgi_math::{Vec2, Vec3};
+use rtgi_math::{Frame, Vec2, Vec3, Vec4};
 
 use crate::{Scene, Triangle, Vertex};
 
@@ -29,11 +29,27 @@ pub struct MeshBuilder {
     normals: Vec<Vec3>,
     faces: Vec<Face>,
     crease_angle_degrees: f32,
+    /// Tangents given by the file, indexed like the normals.
+    tangents: Vec<Vec4>,
 }
 
 impl MeshBuilder {
     pub fn new(positions: Vec<Vec3>, uvs: Vec<Vec2>, normals: Vec<Vec3>) -> Self {
-        Self { positions, uvs, normals, faces: Vec::new(), crease_angle_degrees: CREASE_ANGLE_DEGREES }
+        Self {
+            positions,
+            uvs,
+            normals,
+            faces: Vec::new(),
+            crease_angle_degrees: CREASE_ANGLE_DEGREES,
+            tangents: Vec::new(),
+        }
+    }
+
+    /// Tangents from the file, one per normal; they are used where faces
+    /// use the file's normals, and computed elsewhere.
+    pub fn with_tangents(mut self, tangents: Vec<Vec4>) -> Self {
+        self.tangents = tangents;
+        self
     }
 
     /// Computed normals are the faces' own (glTF's rule for meshes without normals).
@@ -61,6 +77,10 @@ impl MeshBuilder {
         let cos_crease = self.crease_angle_degrees.to_radians().cos();
 
         let mut vertex_of: HashMap<(u32, u32, [u32; 3]), u32> = HashMap::new();
+        let first_vertex = scene.vertices.len();
+        let first_triangle = scene.triangles.len();
+        // Vertices whose tangent the file gave.
+        let mut given_tangent: Vec<bool> = Vec::new();
         scene.triangles.reserve(self.faces.len());
         for (face_index, face) in self.faces.iter().enumerate() {
             let own = face_normals[face_index].normalize_or_zero();
@@ -84,16 +104,20 @@ impl MeshBuilder {
                 let uv_index = face.uvs.map_or(u32::MAX, |u| u[corner]);
                 let key = (position_index, uv_index, normal.to_array().map(f32::to_bits));
                 vertices[corner] = *vertex_of.entry(key).or_insert_with(|| {
+                    let tangent = face.normals.and_then(|n| self.tangents.get(n[corner] as usize).copied());
+                    given_tangent.push(tangent.is_some());
                     scene.vertices.push(Vertex {
                         position: self.positions[position_index as usize],
                         normal,
                         uv: face.uvs.map_or(Vec2::ZERO, |u| self.uvs[u[corner] as usize]),
+                        tangent: tangent.unwrap_or(Vec4::ZERO),
                     });
                     scene.vertices.len() as u32 - 1
                 });
             }
             scene.triangles.push(Triangle { vertices, material: face.material });
         }
+        compute_tangents(scene, first_vertex, first_triangle, &given_tangent);
     }
 
     /// For each position, the faces using it, in compressed-row form. Faces
@@ -119,6 +143,43 @@ impl MeshBuilder {
             }
         }
         Adjacency { offsets, faces }
+    }
+}
+
+/// Tangents for the vertices from `first_vertex` on that the file gave none,
+/// from the texture coordinates of the triangles from `first_triangle` on
+/// (Lengyel 2001): each triangle adds the directions of increasing u and v
+/// to its corners; the sum along u is made perpendicular to the normal, and
+/// the sign of w says whether the v direction agrees with `normal × tangent`.
+fn compute_tangents(scene: &mut Scene, first_vertex: usize, first_triangle: usize, given: &[bool]) {
+    let count = scene.vertices.len() - first_vertex;
+    let mut along_u = vec![Vec3::ZERO; count];
+    let mut along_v = vec![Vec3::ZERO; count];
+    for triangle in &scene.triangles[first_triangle..] {
+        let [a, b, c] = triangle.vertices.map(|v| scene.vertices[v as usize]);
+        let (e1, e2) = (b.position - a.position, c.position - a.position);
+        let (d1, d2) = (b.uv - a.uv, c.uv - a.uv);
+        let det = d1.x * d2.y - d2.x * d1.y;
+        if det == 0.0 || !det.is_finite() {
+            continue;
+        }
+        let u = (e1 * d2.y - e2 * d1.y) / det;
+        let v = (e2 * d1.x - e1 * d2.x) / det;
+        for &index in &triangle.vertices {
+            let local = index as usize - first_vertex;
+            along_u[local] += u;
+            along_v[local] += v;
+        }
+    }
+    for (local, vertex) in scene.vertices[first_vertex..].iter_mut().enumerate() {
+        if given.get(local).copied().unwrap_or(false) {
+            continue;
+        }
+        let n = vertex.normal;
+        let t = (along_u[local] - n * n.dot(along_u[local])).normalize_or_zero();
+        let t = if t == Vec3::ZERO { Frame::from_z(n).x } else { t };
+        let w = if n.cross(t).dot(along_v[local]) < 0.0 { -1.0 } else { 1.0 };
+        vertex.tangent = t.extend(w);
     }
 }
 
@@ -163,6 +224,23 @@ mod tests {
             for v in [a, b, c] {
                 assert!((v.normal - geometric).length() < 1e-6);
             }
+        }
+    }
+
+    #[test]
+    fn tangents_follow_increasing_u_and_are_perpendicular() {
+        // A quad in the xy plane with u along +x and v along -y (top-left origin).
+        let positions = vec![Vec3::ZERO, Vec3::X, Vec3::new(1.0, 1.0, 0.0), Vec3::Y];
+        let uvs = vec![Vec2::new(0.0, 1.0), Vec2::new(1.0, 1.0), Vec2::new(1.0, 0.0), Vec2::new(0.0, 0.0)];
+        let mut b = MeshBuilder::new(positions, uvs, vec![]);
+        b.push([0, 1, 2], Some([0, 1, 2]), None, 0);
+        b.push([0, 2, 3], Some([0, 2, 3]), None, 0);
+        let mut scene = Scene::default();
+        b.finish_into(&mut scene);
+        for v in &scene.vertices {
+            assert!((v.tangent.truncate() - Vec3::X).length() < 1e-6, "{:?}", v.tangent);
+            // v grows towards -y, and normal × tangent = +z × +x = +y: opposite.
+            assert_eq!(v.tangent.w, -1.0);
         }
     }
 
