@@ -175,3 +175,21 @@ fn heatmap_counts_nodes_per_pixel() {
     assert!(run.success, "{run:?}");
     assert_eq!(image::open(&png).unwrap().to_rgb8().dimensions(), (20, 10));
 }
+
+#[test]
+fn info_describes_scenes_as_text_and_json() {
+    let run = rtgi(&["info"]);
+    assert!(run.success, "{run:?}");
+    assert!(run.stdout.contains("triangles   32") && run.stdout.contains("cameras     1"), "{}", run.stdout);
+    let Some(lamp) = rtgi_tests::shared_scene("gltf/LightsPunctualLamp/glTF/LightsPunctualLamp.gltf") else { return };
+    let run = rtgi(&["info", s(&lamp), "--json"]);
+    assert!(run.success, "{run:?}");
+    assert_eq!(run.stdout.matches("\"intensity\"").count(), 5, "{}", run.stdout);
+    assert!(run.stdout.contains("\"extensions_used\"") && run.stdout.contains("KHR_lights_punctual"));
+    let Some(transmission) = rtgi_tests::shared_scene("gltf/TransmissionTest/glTF/TransmissionTest.gltf") else {
+        return;
+    };
+    let run = rtgi(&["info", s(&transmission)]);
+    assert!(run.success, "{run:?}");
+    assert!(run.stdout.contains("warning: extension KHR_xmp is not supported"), "{}", run.stdout);
+}

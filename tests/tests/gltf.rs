@@ -135,3 +135,43 @@ fn normal_mapped_models_get_unit_tangents_perpendicular_to_their_normals() {
         assert!(v.tangent.w == 1.0 || v.tangent.w == -1.0, "{v:?}");
     }
 }
+
+#[test]
+fn spot_and_directional_lights_are_placed_by_their_nodes() {
+    // A spot light moved to (1, 2, 3) and turned to shine along -Y (a -90°
+    // rotation about X takes the light's -Z to -Y), and a directional light.
+    let text = r#"{"asset":{"version":"2.0"},"scene":0,"scenes":[{"nodes":[0,1]}],
+        "extensionsUsed":["KHR_lights_punctual"],
+        "extensions":{"KHR_lights_punctual":{"lights":[
+            {"type":"spot","name":"spot","intensity":20,"color":[1,0.5,0.25],"range":7,
+             "spot":{"innerConeAngle":0.2,"outerConeAngle":0.4}},
+            {"type":"directional","name":"sun","intensity":3}]}},
+        "nodes":[
+            {"translation":[1,2,3],"rotation":[-0.70710678,0,0,0.70710678],"extensions":{"KHR_lights_punctual":{"light":0}}},
+            {"extensions":{"KHR_lights_punctual":{"light":1}}}]}"#;
+    let scene = load_text("lights", text).unwrap();
+    let spot = scene.lights.iter().find(|l| l.name == "spot").unwrap();
+    assert_eq!(spot.kind, LightKind::Spot { inner_cone: 0.2, outer_cone: 0.4 });
+    assert_eq!(spot.position, Vec3::new(1.0, 2.0, 3.0));
+    assert!((spot.direction - -Vec3::Y).length() < 1e-5, "{}", spot.direction);
+    assert_eq!((spot.intensity, spot.range, spot.color), (20.0, Some(7.0), Vec3::new(1.0, 0.5, 0.25)));
+    let sun = scene.lights.iter().find(|l| l.name == "sun").unwrap();
+    assert_eq!((sun.kind, sun.direction, sun.color), (LightKind::Directional, -Vec3::Z, Vec3::ONE));
+}
+
+#[test]
+fn a_missing_texture_is_a_warning_and_a_visible_fallback() {
+    let mut text = triangle_gltf("tri.bin", 3);
+    text.pop(); // the closing brace
+    text.push_str(
+        r#","images":[{"uri":"no-such-image.png"}],"textures":[{"source":0}],
+        "materials":[{"pbrMetallicRoughness":{"baseColorTexture":{"index":0}}}]}"#,
+    );
+    let text = text.replace(r#""attributes":{"POSITION":0}"#, r#""attributes":{"POSITION":0},"material":0"#);
+    let scene = load_text("missing-texture", &text).unwrap();
+    assert!(scene.warnings.iter().any(|w| w.contains("no-such-image.png")), "{:?}", scene.warnings);
+    let texture = scene.materials[0].base_color_texture.expect("the fallback stands in");
+    // Magenta and black: impossible to mistake for content.
+    let texel = scene.textures[texture.0 as usize].sample(rtgi_math::Vec2::splat(1.0 / 16.0));
+    assert!(texel.x > 0.9 && texel.y < 0.1 && texel.z > 0.9, "{texel}");
+}
