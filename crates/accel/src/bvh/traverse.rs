@@ -133,6 +133,29 @@ fn clip_nan_ignoring(near: Vec3A, far: Vec3A, lower: Vec3A, upper: Vec3A) -> (f3
     }
 }
 
+/// Calls `$method` monomorphised for the structure's intersector, slab test
+/// and stack size (32, 64 or 128 entries, the smallest the depth allows):
+/// one branch per ray picks among the twelve compiled loops.
+macro_rules! monomorphise {
+    ($self:ident, $method:ident, $c:ty, $f:ty, $($arg:expr),*) => {{
+        macro_rules! sized {
+            ($t:ty, $s:ty) => {
+                match $self.stats.depth {
+                    0..=32 => $self.$method::<$c, $t, $s, $f, 32>($($arg),*),
+                    33..=64 => $self.$method::<$c, $t, $s, $f, 64>($($arg),*),
+                    _ => $self.$method::<$c, $t, $s, $f, STACK_SIZE>($($arg),*),
+                }
+            };
+        }
+        match ($self.intersector, $self.traversal) {
+            (Intersector::Watertight, Traversal::Robust) => sized!(Watertight, RobustSlabs),
+            (Intersector::Watertight, Traversal::Fast) => sized!(Watertight, FastSlabs),
+            (Intersector::MollerTrumbore, Traversal::Robust) => sized!(MollerTrumbore, RobustSlabs),
+            (Intersector::MollerTrumbore, Traversal::Fast) => sized!(MollerTrumbore, FastSlabs),
+        }
+    }};
+}
+
 impl Bvh {
     /// Tests the triangles of a leaf for the closest hit, updating `best`
     /// and shrinking `t_max`. At equal distances the triangle with the lower
@@ -167,64 +190,12 @@ impl Bvh {
     /// hit, the farther child of two pushed on a fixed-size stack no larger
     /// than the tree's depth needs.
     pub(crate) fn closest<C: Counter, F: HitFilter>(&self, ray: &Ray, counter: &mut C, filter: &F) -> Option<Hit> {
-        match (self.intersector, self.traversal) {
-            (Intersector::Watertight, Traversal::Robust) => {
-                self.closest_sized::<C, Watertight, RobustSlabs, F>(ray, counter, filter)
-            }
-            (Intersector::Watertight, Traversal::Fast) => {
-                self.closest_sized::<C, Watertight, FastSlabs, F>(ray, counter, filter)
-            }
-            (Intersector::MollerTrumbore, Traversal::Robust) => {
-                self.closest_sized::<C, MollerTrumbore, RobustSlabs, F>(ray, counter, filter)
-            }
-            (Intersector::MollerTrumbore, Traversal::Fast) => {
-                self.closest_sized::<C, MollerTrumbore, FastSlabs, F>(ray, counter, filter)
-            }
-        }
+        monomorphise!(self, closest_with_stack, C, F, ray, counter, filter)
     }
 
     /// Any hit: stops at the first triangle found.
     pub(crate) fn any<C: Counter, F: HitFilter>(&self, ray: &Ray, counter: &mut C, filter: &F) -> bool {
-        match (self.intersector, self.traversal) {
-            (Intersector::Watertight, Traversal::Robust) => {
-                self.any_sized::<C, Watertight, RobustSlabs, F>(ray, counter, filter)
-            }
-            (Intersector::Watertight, Traversal::Fast) => {
-                self.any_sized::<C, Watertight, FastSlabs, F>(ray, counter, filter)
-            }
-            (Intersector::MollerTrumbore, Traversal::Robust) => {
-                self.any_sized::<C, MollerTrumbore, RobustSlabs, F>(ray, counter, filter)
-            }
-            (Intersector::MollerTrumbore, Traversal::Fast) => {
-                self.any_sized::<C, MollerTrumbore, FastSlabs, F>(ray, counter, filter)
-            }
-        }
-    }
-
-    fn closest_sized<C: Counter, T: TriangleTest, S: SlabTest, F: HitFilter>(
-        &self,
-        ray: &Ray,
-        counter: &mut C,
-        filter: &F,
-    ) -> Option<Hit> {
-        match self.stats.depth {
-            0..=32 => self.closest_with_stack::<C, T, S, F, 32>(ray, counter, filter),
-            33..=64 => self.closest_with_stack::<C, T, S, F, 64>(ray, counter, filter),
-            _ => self.closest_with_stack::<C, T, S, F, STACK_SIZE>(ray, counter, filter),
-        }
-    }
-
-    fn any_sized<C: Counter, T: TriangleTest, S: SlabTest, F: HitFilter>(
-        &self,
-        ray: &Ray,
-        counter: &mut C,
-        filter: &F,
-    ) -> bool {
-        match self.stats.depth {
-            0..=32 => self.any_with_stack::<C, T, S, F, 32>(ray, counter, filter),
-            33..=64 => self.any_with_stack::<C, T, S, F, 64>(ray, counter, filter),
-            _ => self.any_with_stack::<C, T, S, F, STACK_SIZE>(ray, counter, filter),
-        }
+        monomorphise!(self, any_with_stack, C, F, ray, counter, filter)
     }
 
     fn closest_with_stack<C: Counter, T: TriangleTest, S: SlabTest, F: HitFilter, const STACK: usize>(
