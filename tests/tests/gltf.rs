@@ -175,3 +175,24 @@ fn a_missing_texture_is_a_warning_and_a_visible_fallback() {
     let texel = scene.textures[texture.0 as usize].sample(rtgi_math::Vec2::splat(1.0 / 16.0));
     assert!(texel.x > 0.9 && texel.y < 0.1 && texel.z > 0.9, "{texel}");
 }
+
+#[test]
+fn instanced_meshes_appear_once_per_node_and_mirrors_keep_their_winding() {
+    // One triangle mesh used by three nodes: as is, moved, and mirrored in x.
+    let text = triangle_gltf("tri.bin", 3).replace(
+        r#""nodes":[{"mesh":0}]"#,
+        r#""nodes":[{"mesh":0},{"mesh":0,"translation":[0,0,5]},{"mesh":0,"scale":[-1,1,1]}]"#,
+    );
+    let text = text.replace(r#""scenes":[{"nodes":[0]}]"#, r#""scenes":[{"nodes":[0,1,2]}]"#);
+    let scene = load_text("instances", &text).unwrap();
+    assert_eq!(scene.triangles.len(), 3);
+    let corners = scene.triangle_positions();
+    assert!(corners.iter().any(|t| t[0].z == 5.0), "the moved instance");
+    // The mirrored triangle's corners were reordered, so its winding (and
+    // computed normal) still faces +z like the others.
+    for t in &corners {
+        let normal = (t[1] - t[0]).cross(t[2] - t[0]);
+        assert!(normal.z > 0.0, "{t:?}");
+    }
+    assert!(corners.iter().any(|t| t.iter().any(|p| p.x < 0.0)), "the mirrored instance");
+}
