@@ -50,6 +50,8 @@ fn lights_punctual_lamp_has_its_five_lights() {
     let Some(path) = shared_scene("gltf/LightsPunctualLamp/glTF/LightsPunctualLamp.gltf") else { return };
     let scene = Scene::load(&path).unwrap();
     assert_eq!(scene.lights.len(), 5);
+    // Every primitive names its material: no unused default is added.
+    assert!(scene.materials.iter().all(|m| m.name != "glTF default"));
     let by_name = |name: &str| scene.lights.iter().find(|l| l.name == name).unwrap_or_else(|| panic!("{name}"));
     // Values from the file's KHR_lights_punctual block.
     let point = by_name("Point");
@@ -186,6 +188,8 @@ fn instanced_meshes_appear_once_per_node_and_mirrors_keep_their_winding() {
     let text = text.replace(r#""scenes":[{"nodes":[0]}]"#, r#""scenes":[{"nodes":[0,1,2]}]"#);
     let scene = load_text("instances", &text).unwrap();
     assert_eq!(scene.triangles.len(), 3);
+    // The primitive names no material, so the default one is kept, once.
+    assert_eq!(scene.materials.len(), 1);
     let corners = scene.triangle_positions();
     assert!(corners.iter().any(|t| t[0].z == 5.0), "the moved instance");
     // The mirrored triangle's corners were reordered, so its winding (and

@@ -75,6 +75,10 @@ pub(crate) fn load(path: &Path) -> Result<Scene, SceneError> {
         }
         stack.extend(node.children().map(|child| (child, transform)));
     }
+    // The default material exists for primitives that name none; drop it if none did.
+    if !scene.triangles.iter().any(|t| t.material == default_material) {
+        scene.materials.pop();
+    }
     for (mode, count) in skipped_primitives {
         scene.warnings.push(format!(
             "{}: {count} primitives of mode {mode} skipped (only triangles are rendered)",
