@@ -20,6 +20,7 @@
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 
+pub mod bsdf;
 mod camera;
 mod framing;
 pub mod probes;
