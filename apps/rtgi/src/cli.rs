@@ -212,7 +212,7 @@ pub(crate) struct RenderArgs {
     #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=1_048_576))]
     pub(crate) spp: u32,
 
-    /// Where samples go in a pixel: center, uniform [default: center for 1 spp, uniform otherwise]
+    /// Where samples go in a pixel: center, uniform, stratified, low-discrepancy [default: center for 1 spp, stratified otherwise]
     #[arg(long)]
     pub(crate) sampler: Option<PixelSampler>,
 

@@ -18,7 +18,7 @@ pub(crate) fn run(args: &RenderArgs) -> Result<()> {
         width: args.size.width,
         height: args.size.height,
         samples_per_pixel: args.spp,
-        sampler: args.sampler.unwrap_or(if args.spp == 1 { PixelSampler::Center } else { PixelSampler::Uniform }),
+        sampler: args.sampler.unwrap_or(if args.spp == 1 { PixelSampler::Center } else { PixelSampler::Stratified }),
         seed: args.seed,
         background: args.background,
     };

@@ -30,7 +30,7 @@ mod shade;
 
 pub use camera::CameraRays;
 pub use framing::frame_scene;
-pub use sampler::PixelSampler;
+pub use sampler::{PixelSample, PixelSampler};
 pub use shade::{alpha_accepts, has_alpha, shade_primary, shading_normal};
 
 use std::time::Instant;
@@ -118,10 +118,14 @@ pub fn render<A: Accel + ?Sized>(
     let alpha = has_alpha(scene);
     let image = render_pixels(width, height, progress, |x, y| {
         let pixel_index = y as u64 * width as u64 + x as u64;
+        // One more generator per pixel, past every sample's: its shift of the pixel's pattern.
+        let mut shift = Rng::for_sample(settings.seed, pixel_index, u64::MAX);
+        let pixel_shift = Vec2::new(shift.next_f32(), shift.next_f32());
         let mut sum = Vec3::ZERO;
         for sample in 0..spp {
             let mut rng = Rng::for_sample(settings.seed, pixel_index, sample as u64);
-            let ray = rays.ray(x, y, settings.sampler.offset(&mut rng));
+            let position = PixelSample { index: sample, count: spp, pixel_shift };
+            let ray = rays.ray(x, y, settings.sampler.offset(&position, &mut rng));
             let hit = if alpha {
                 let u = rng.next_f32();
                 accel.intersect_filtered(&ray, &|t, b, g| alpha_accepts(scene, t, b, g, u))
