@@ -26,7 +26,7 @@ fn is_green([r, g, b]: [u8; 3]) -> bool {
 fn default_scene_renders_the_cornell_box() {
     let dir = scratch_dir("default");
     let out = dir.join("box.png");
-    let run = rtgi(&["render", "-o", path_str(&out), "--width", "96", "--height", "96"]);
+    let run = rtgi(&["render", "-o", path_str(&out), "--width", "96", "--height", "96", "--integrator", "primary"]);
     assert!(run.success, "{run:?}");
     assert!(run.stdout.contains("triangles   32"), "{}", run.stdout);
     let image = image::open(&out).unwrap().to_rgb8();
@@ -122,7 +122,8 @@ fn shared_cornell_box_renders_with_its_colours() {
     };
     let dir = scratch_dir("shared-box");
     let out = dir.join("box.png");
-    let run = rtgi(&["render", path_str(&scene), "-o", path_str(&out), "--width", "64", "--height", "64"]);
+    let args = ["render", path_str(&scene), "-o", path_str(&out), "--width", "64", "--height", "64"];
+    let run = rtgi(&[&args[..], &["--integrator", "primary"]].concat());
     assert!(run.success, "{run:?}");
     assert!(run.stdout.contains("triangles   36"), "{}", run.stdout);
     assert!(run.stderr.is_empty(), "unexpected warnings: {}", run.stderr);

@@ -9,7 +9,7 @@
 
 use rtgi_accel::{AccelKind, BuildParams};
 use rtgi_image::ToneMap;
-use rtgi_render::{PixelSampler, RenderSettings, frame_scene, render};
+use rtgi_render::{Integrator, PixelSampler, RenderSettings, frame_scene, render};
 use rtgi_scene::Scene;
 use rtgi_tests::{shared_scene, workspace_root};
 
@@ -32,6 +32,7 @@ fn render_model(relative: &str) -> Option<Vec<u8>> {
         samples_per_pixel: 8,
         sampler: PixelSampler::Uniform,
         seed: 1,
+        integrator: Integrator::Primary,
         ..RenderSettings::default()
     };
     let (image, _) = render(&scene, accel.as_ref(), &camera, &settings, &|_| {});

@@ -5,7 +5,8 @@ use clap::{Args, Parser, Subcommand};
 use rtgi_accel::{AccelKind, BuildParams, Intersector, Traversal};
 use rtgi_image::ToneOperator;
 use rtgi_math::Vec3;
-use rtgi_render::PixelSampler;
+use rtgi_render::{DirectStrategy, EffectOverrides, Integrator, PixelSampler};
+use rtgi_scene::{Light, LightKind};
 
 /// Largest image side accepted: beyond this a typo (an extra zero) would
 /// ask for gigabytes of memory and hours of rendering.
@@ -30,8 +31,25 @@ pub(crate) enum Command {
     BvhBoxes(BvhBoxesArgs),
     /// Render the traversal cost (BVH nodes visited per pixel) as a heat map
     Heatmap(HeatmapArgs),
-    /// Describe a scene: triangles, materials, textures, lights, cameras, bounds, extensions
+    /// Describe a scene: triangles, materials, textures, lights, cameras, bounds, extensions,
+    /// and the effects a render of it simulates
     Info(InfoArgs),
+    /// Measure how far an EXR image is from a reference EXR image (RMSE, relative MSE, max)
+    Compare(CompareArgs),
+}
+
+/// `rtgi compare`: the error of an image against a reference.
+#[derive(Debug, Args)]
+pub(crate) struct CompareArgs {
+    /// The image to measure (.exr)
+    pub(crate) image: PathBuf,
+
+    /// The reference (.exr), for example a high-sample render
+    pub(crate) reference: PathBuf,
+
+    /// Print JSON instead of text
+    #[arg(long)]
+    pub(crate) json: bool,
 }
 
 /// `rtgi info`: what a scene file contains.
@@ -43,6 +61,122 @@ pub(crate) struct InfoArgs {
     /// Print JSON instead of text
     #[arg(long)]
     pub(crate) json: bool,
+
+    /// The render options the printed plan is for
+    #[command(flatten)]
+    pub(crate) lighting: LightingArgs,
+}
+
+/// How light is simulated: shared by `render` and `info` (which prints the plan).
+#[derive(Debug, Args)]
+pub(crate) struct LightingArgs {
+    /// What to compute per pixel: primary, albedo, normal, depth, position, cost, direct, path
+    #[arg(long, default_value = "path")]
+    pub(crate) integrator: Integrator,
+
+    /// Bounces a path may take after the camera ray (path integrator)
+    #[arg(long, default_value_t = 8, value_parser = clap::value_parser!(u32).range(1..=1024))]
+    pub(crate) max_depth: u32,
+
+    /// How direct light is sampled: light, bsdf, or mis (both, weighted)
+    #[arg(long, default_value = "mis")]
+    pub(crate) direct_strategy: DirectStrategy,
+
+    /// Light from far away: a radiance R,G,B or an equirectangular .exr image
+    #[arg(long, value_parser = parse_environment)]
+    pub(crate) environment: Option<EnvironmentArg>,
+
+    /// Add a light (repeatable): point:X,Y,Z:INTENSITY[:R,G,B],
+    /// directional:DX,DY,DZ:IRRADIANCE[:R,G,B] (the direction light travels),
+    /// spot:X,Y,Z:DX,DY,DZ:INTENSITY:INNER_DEG:OUTER_DEG[:R,G,B]
+    #[arg(long = "light", value_parser = parse_light)]
+    pub(crate) lights: Vec<Light>,
+
+    /// Force effects on or off, like +glossy,-textures (see the plan `rtgi info` prints)
+    #[arg(long, allow_hyphen_values = true, default_value = "")]
+    pub(crate) effects: EffectOverrides,
+}
+
+/// The `--environment` option before the file is read.
+#[derive(Clone, Debug)]
+pub(crate) enum EnvironmentArg {
+    Uniform(Vec3),
+    File(PathBuf),
+}
+
+fn parse_environment(text: &str) -> Result<EnvironmentArg, String> {
+    if let Ok(radiance) = parse_vec3(text) {
+        if radiance.min_element() < 0.0 {
+            return Err(format!("environment radiance must not be negative (got '{text}')"));
+        }
+        return Ok(EnvironmentArg::Uniform(radiance));
+    }
+    let path = PathBuf::from(text);
+    if path.extension().is_some_and(|e| e.eq_ignore_ascii_case("exr")) {
+        Ok(EnvironmentArg::File(path))
+    } else {
+        Err(format!("expected a radiance R,G,B or an .exr file (got '{text}')"))
+    }
+}
+
+/// Parses `--light`: fields separated by colons, vectors by commas.
+pub(crate) fn parse_light(text: &str) -> Result<Light, String> {
+    let fields: Vec<&str> = text.split(':').map(str::trim).collect();
+    let number = |s: &str, what: &str| -> Result<f32, String> {
+        s.parse::<f32>()
+            .ok()
+            .filter(|v| v.is_finite() && *v >= 0.0)
+            .ok_or_else(|| format!("light '{text}': {what} must be a non-negative number (got '{s}')"))
+    };
+    let vector = |s: &str| parse_vec3(s).map_err(|e| format!("light '{text}': {e}"));
+    let colour = |rest: &[&str]| -> Result<Vec3, String> {
+        match rest {
+            [] => Ok(Vec3::ONE),
+            [c] => vector(c),
+            _ => Err(format!("light '{text}': too many fields")),
+        }
+    };
+    let unit = |v: Vec3| v.try_normalize().ok_or_else(|| format!("light '{text}': the direction is zero"));
+    let mut light = Light {
+        name: text.to_owned(),
+        kind: LightKind::Point,
+        position: Vec3::ZERO,
+        direction: Vec3::NEG_Y,
+        color: Vec3::ONE,
+        intensity: 1.0,
+        range: None,
+    };
+    match fields.as_slice() {
+        ["point", position, intensity, rest @ ..] => {
+            light.position = vector(position)?;
+            light.intensity = number(intensity, "the intensity")?;
+            light.color = colour(rest)?;
+        }
+        ["directional", direction, irradiance, rest @ ..] => {
+            light.kind = LightKind::Directional;
+            light.direction = unit(vector(direction)?)?;
+            light.intensity = number(irradiance, "the irradiance")?;
+            light.color = colour(rest)?;
+        }
+        ["spot", position, direction, intensity, inner, outer, rest @ ..] => {
+            let (inner, outer) = (number(inner, "the inner angle")?, number(outer, "the outer angle")?);
+            if !(inner <= outer && outer <= 90.0) {
+                return Err(format!("light '{text}': angles must satisfy inner <= outer <= 90 degrees"));
+            }
+            light.kind = LightKind::Spot { inner_cone: inner.to_radians(), outer_cone: outer.to_radians() };
+            light.position = vector(position)?;
+            light.direction = unit(vector(direction)?)?;
+            light.intensity = number(intensity, "the intensity")?;
+            light.color = colour(rest)?;
+        }
+        _ => {
+            return Err(format!(
+                "light '{text}': expected point:X,Y,Z:INTENSITY, directional:DX,DY,DZ:IRRADIANCE or \
+                 spot:X,Y,Z:DX,DY,DZ:INTENSITY:INNER:OUTER, each optionally followed by :R,G,B"
+            ));
+        }
+    }
+    Ok(light)
 }
 
 /// `rtgi bvh-boxes`: the boxes of some levels of a BVH as a wireframe-able mesh.
@@ -208,9 +342,17 @@ pub(crate) struct RenderArgs {
     #[command(flatten)]
     pub(crate) size: ImageSize,
 
-    /// Samples per pixel
-    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=1_048_576))]
-    pub(crate) spp: u32,
+    /// Samples per pixel [default: 16 for the direct and path integrators, 1 otherwise]
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1_048_576))]
+    pub(crate) spp: Option<u32>,
+
+    #[command(flatten)]
+    pub(crate) lighting: LightingArgs,
+
+    /// Also write arbitrary output variables beside the output, as OUTPUT.NAME.exr: a list
+    /// of albedo, normal, depth, position, cost
+    #[arg(long, value_delimiter = ',')]
+    pub(crate) aov: Vec<Integrator>,
 
     /// Where samples go in a pixel: center, uniform, stratified, low-discrepancy [default: center for 1 spp, stratified otherwise]
     #[arg(long)]
@@ -238,7 +380,7 @@ pub(crate) struct RenderArgs {
     #[arg(long, default_value = "clamp")]
     pub(crate) tonemap: ToneOperator,
 
-    /// Radiance of rays that hit nothing, as R,G,B
+    /// Radiance of camera rays that hit nothing and see no environment, as R,G,B
     #[arg(long, value_parser = parse_vec3, default_value = "0.05,0.05,0.06")]
     pub(crate) background: Vec3,
 }

@@ -6,10 +6,10 @@ use std::time::Instant;
 
 use anyhow::{Context, Result, bail};
 use rtgi_accel::Accel;
-use rtgi_render::frame_scene;
+use rtgi_render::{Environment, RenderSettings, frame_scene};
 use rtgi_scene::{Camera, Scene};
 
-use crate::cli::CameraArgs;
+use crate::cli::{CameraArgs, EnvironmentArg, LightingArgs};
 use crate::default_scene;
 
 /// Field of view of the automatic framing when no camera is given.
@@ -113,4 +113,21 @@ pub(crate) fn choose_camera(scene: &Scene, accel: &dyn Accel, options: &CameraAr
         bail!("the camera is degenerate: it must look somewhere other than its own position, and not along --up");
     }
     Ok(camera)
+}
+
+/// Applies the lighting options: adds the `--light`s to the scene and sets
+/// the integrator, depth, strategy, environment (reading its file) and
+/// effect overrides of `settings`.
+pub(crate) fn apply_lighting(args: &LightingArgs, scene: &mut Scene, settings: &mut RenderSettings) -> Result<()> {
+    scene.lights.extend(args.lights.iter().cloned());
+    settings.integrator = args.integrator;
+    settings.max_depth = args.max_depth;
+    settings.direct_strategy = args.direct_strategy;
+    settings.effects = args.effects.clone();
+    settings.environment = match &args.environment {
+        None => None,
+        Some(EnvironmentArg::Uniform(radiance)) => Some(Environment::Uniform(*radiance)),
+        Some(EnvironmentArg::File(path)) => Some(Environment::load(path)?),
+    };
+    Ok(())
 }

@@ -1,10 +1,11 @@
 //! `rtgi info`: what a scene contains, as text or JSON.
 
-use anyhow::Result;
+use anyhow::{Result, bail};
+use rtgi_image::HdrImage;
 use rtgi_scene::{AlphaMode, LightKind, SUPPORTED_GLTF_EXTENSIONS};
 use serde::Serialize;
 
-use crate::cli::InfoArgs;
+use crate::cli::{CompareArgs, InfoArgs};
 use crate::common::{LoadedScene, load_scene};
 
 #[derive(Debug, Serialize)]
@@ -192,4 +193,30 @@ fn print_text(info: &Info) {
     for e in &info.extensions_unsupported {
         println!("warning: extension {e} is not supported and is ignored");
     }
+}
+
+/// `rtgi compare`: prints the error of one EXR image against another.
+pub(crate) fn compare(args: &CompareArgs) -> Result<()> {
+    let image = HdrImage::read_exr(&args.image)?;
+    let reference = HdrImage::read_exr(&args.reference)?;
+    let Some(d) = rtgi_image::compare(&image, &reference) else {
+        bail!(
+            "{}: {}x{} pixels, but the reference {} has {}x{}",
+            args.image.display(),
+            image.width(),
+            image.height(),
+            args.reference.display(),
+            reference.width(),
+            reference.height()
+        );
+    };
+    if args.json {
+        println!("{}", serde_json::to_string_pretty(&d)?);
+    } else {
+        println!("rmse          {:.6}", d.rmse);
+        println!("relative mse  {:.6}", d.relative_mse);
+        println!("max abs       {:.6} at pixel ({}, {})", d.max_abs, d.max_at.0, d.max_at.1);
+        println!("mean          {:.6} (reference {:.6})", d.mean, d.reference_mean);
+    }
+    Ok(())
 }

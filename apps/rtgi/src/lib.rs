@@ -29,6 +29,7 @@ pub fn main() -> ExitCode {
         cli::Command::BvhBoxes(args) => debug_cmd::boxes(&args),
         cli::Command::Heatmap(args) => debug_cmd::heatmap(&args),
         cli::Command::Info(args) => info_cmd::run(&args),
+        cli::Command::Compare(args) => info_cmd::compare(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -18,9 +18,11 @@
 //! # Ok::<(), rtgi_image::ImageError>(())
 //! ```
 
+mod compare;
 mod tonemap;
 mod write;
 
+pub use compare::{Difference, compare};
 pub use tonemap::{ToneMap, ToneOperator, heat_colour, linear_to_srgb, srgb_to_linear};
 pub use write::{ImageError, OutputFormat, check_writable};
 

@@ -1,8 +1,9 @@
 //! Reflectance models, in the local frame of a surface where the shading
 //! normal is +z: `wo` points to the viewer, `wi` to the light, both unit.
 //! Each model evaluates, samples and gives the density of its samples,
-//! consistently (the tests check each against the others). Surfaces are
-//! two-sided: directions are mirrored to the side of `wo`.
+//! consistently (the tests check each against the others). Reflection is
+//! two-sided: directions are mirrored to the side of `wo`. The dielectric
+//! is the exception, as it has to know which side is inside: +z is outside.
 
 use std::f32::consts::PI;
 
@@ -30,6 +31,13 @@ pub enum Bsdf {
     /// lobe with Schlick's Fresnel over a Lambertian base for dielectrics;
     /// `alpha` is the GGX width (perceptual roughness squared).
     MetallicRoughness { base_color: Vec3, metallic: f32, alpha: f32 },
+    /// A GGX specular lobe of constant reflectance (MTL's `Ks`, whose
+    /// Fresnel behaviour the format does not describe).
+    Glossy { reflectance: Vec3, alpha: f32 },
+    /// A smooth boundary between air (+z side) and a medium of index `ior`
+    /// that reflects and refracts by Fresnel's equations; refracted light is
+    /// tinted by `tint` (glTF's base colour for transmission).
+    Dielectric { ior: f32, tint: Vec3 },
 }
 
 impl Bsdf {
@@ -41,7 +49,14 @@ impl Bsdf {
         }
         match *self {
             Bsdf::Lambert { albedo } => albedo / PI,
-            Bsdf::Mirror { .. } => Vec3::ZERO,
+            Bsdf::Mirror { .. } | Bsdf::Dielectric { .. } => Vec3::ZERO,
+            Bsdf::Glossy { reflectance, alpha } => {
+                let wm = (wo + wi).normalize_or_zero();
+                if wm == Vec3::ZERO {
+                    return Vec3::ZERO;
+                }
+                reflectance * (ggx_d(wm, alpha) * ggx_g2(wo, wi, alpha) / (4.0 * wo.z * wi.z))
+            }
             Bsdf::MetallicRoughness { base_color, metallic, alpha } => {
                 let wm = (wo + wi).normalize_or_zero();
                 if wm == Vec3::ZERO {
@@ -64,7 +79,8 @@ impl Bsdf {
         }
         match *self {
             Bsdf::Lambert { .. } => wi.z / PI,
-            Bsdf::Mirror { .. } => 0.0,
+            Bsdf::Mirror { .. } | Bsdf::Dielectric { .. } => 0.0,
+            Bsdf::Glossy { alpha, .. } => ggx_reflection_pdf(wo, wi, alpha),
             Bsdf::MetallicRoughness { metallic, alpha, .. } => {
                 let p_specular = specular_probability(metallic);
                 p_specular * ggx_reflection_pdf(wo, wi, alpha) + (1.0 - p_specular) * wi.z / PI
@@ -73,12 +89,20 @@ impl Bsdf {
     }
 
     /// Draws an incident direction for `wo` from two uniform numbers.
+    ///
+    /// `u.x` also chooses between the lobes of layered models; it is
+    /// stretched back to [0, 1) for the chosen lobe.
     pub fn sample(&self, wo: Vec3, u: Vec2) -> Option<BsdfSample> {
+        if let Bsdf::Dielectric { ior, tint } = *self {
+            return Some(sample_dielectric(wo, ior, tint, u.x));
+        }
         let flip = wo.z < 0.0;
         let local_wo = to_upper(wo);
         let back = |w: Vec3| if flip { Vec3::new(w.x, w.y, -w.z) } else { w };
         let wi = match *self {
             Bsdf::Lambert { .. } => cosine_hemisphere(u),
+            Bsdf::Glossy { alpha, .. } => reflect(local_wo, sample_ggx_visible_normal(local_wo, alpha, u)),
+            Bsdf::Dielectric { .. } => unreachable!("sampled above"),
             Bsdf::Mirror { reflectance } => {
                 let wi = Vec3::new(-local_wo.x, -local_wo.y, local_wo.z);
                 return Some(BsdfSample { wi: back(wi), value: reflectance / wi.z, pdf: 1.0, delta: true });
@@ -101,6 +125,61 @@ impl Bsdf {
         let wi = back(wi);
         let pdf = self.pdf(wo, wi);
         (pdf > 0.0).then(|| BsdfSample { wi, value: self.eval(wo, wi), pdf, delta: false })
+    }
+
+    /// Whether every direction the model scatters to is a Dirac delta, so
+    /// that sampling lights from its surfaces is pointless.
+    pub fn is_delta(&self) -> bool {
+        matches!(self, Bsdf::Mirror { .. } | Bsdf::Dielectric { .. })
+    }
+}
+
+/// Fresnel reflectance of unpolarised light at a smooth dielectric boundary;
+/// `cos_i` ≥ 0 on the incident side, `eta` = n_transmitted / n_incident.
+pub fn fresnel_dielectric(cos_i: f32, eta: f32) -> f32 {
+    let sin2_t = (1.0 - cos_i * cos_i).max(0.0) / (eta * eta);
+    if sin2_t >= 1.0 {
+        return 1.0; // total internal reflection
+    }
+    let cos_t = (1.0 - sin2_t).sqrt();
+    let rs = (cos_i - eta * cos_t) / (cos_i + eta * cos_t);
+    let rp = (eta * cos_i - cos_t) / (eta * cos_i + cos_t);
+    0.5 * (rs * rs + rp * rp)
+}
+
+/// Reflects or refracts at a smooth dielectric, choosing by the Fresnel
+/// reflectance, so the estimator's weight is 1 for reflection and
+/// tint / η² for refraction: radiance is compressed into the smaller solid
+/// angle of the denser medium (Veach 1997, section 5.2), which is why a ray
+/// that enters and leaves a slab carries its radiance unchanged.
+fn sample_dielectric(wo: Vec3, ior: f32, tint: Vec3, u: f32) -> BsdfSample {
+    let entering = wo.z > 0.0;
+    let eta = if entering { ior } else { 1.0 / ior };
+    let cos_i = wo.z.abs();
+    let reflectance = fresnel_dielectric(cos_i, eta);
+    if u < reflectance {
+        let wi = Vec3::new(-wo.x, -wo.y, wo.z);
+        return BsdfSample { wi, value: Vec3::splat(reflectance / cos_i), pdf: reflectance, delta: true };
+    }
+    let sin2_t = (1.0 - cos_i * cos_i).max(0.0) / (eta * eta);
+    let cos_t = (1.0 - sin2_t).max(0.0).sqrt();
+    let normal = if entering { Vec3::Z } else { Vec3::NEG_Z };
+    let wi = (-wo / eta + (cos_i / eta - cos_t) * normal).normalize();
+    let transmittance = 1.0 - reflectance;
+    let value = tint * (transmittance / (eta * eta) / cos_t.max(1e-8));
+    BsdfSample { wi, value, pdf: transmittance, delta: true }
+}
+
+impl Bsdf {
+    /// The model's reflectance for light from straight above, a cheap
+    /// measure of how much it scatters (to choose between lobes).
+    pub fn nominal_albedo(&self) -> Vec3 {
+        match *self {
+            Bsdf::Lambert { albedo } => albedo,
+            Bsdf::Mirror { reflectance } | Bsdf::Glossy { reflectance, .. } => reflectance,
+            Bsdf::MetallicRoughness { base_color, .. } => base_color,
+            Bsdf::Dielectric { tint, .. } => tint,
+        }
     }
 }
 
@@ -193,6 +272,7 @@ mod tests {
             Bsdf::MetallicRoughness { base_color: Vec3::new(0.9, 0.6, 0.3), metallic: 1.0, alpha: 0.3 },
             Bsdf::MetallicRoughness { base_color: Vec3::new(0.9, 0.6, 0.3), metallic: 0.0, alpha: 0.5 },
             Bsdf::MetallicRoughness { base_color: Vec3::ONE, metallic: 0.5, alpha: 0.05 },
+            Bsdf::Glossy { reflectance: Vec3::new(0.9, 0.9, 0.5), alpha: 0.2 },
         ]
     }
 
@@ -290,5 +370,42 @@ mod tests {
         let mirror = Bsdf::Mirror { reflectance: Vec3::splat(0.9) }.sample(direction(0.7), Vec2::ZERO).unwrap();
         assert!((mirror.value * mirror.wi.z / mirror.pdf - Vec3::splat(0.9)).abs().max_element() < 1e-6);
         assert!((mirror.wi - Vec3::new(-0.7f32.sin(), 0.0, 0.7f32.cos())).length() < 1e-6);
+    }
+
+    #[test]
+    fn dielectric_fresnel_and_refraction() {
+        // Normal incidence: ((n - 1) / (n + 1))², from either side.
+        assert!((fresnel_dielectric(1.0, 1.5) - 0.04).abs() < 1e-6);
+        assert!((fresnel_dielectric(1.0, 1.0 / 1.5) - 0.04).abs() < 1e-6);
+        // Total internal reflection beyond the critical angle inside glass.
+        let critical = (1.0f32 / 1.5).asin();
+        assert_eq!(fresnel_dielectric((critical + 0.01).cos(), 1.0 / 1.5), 1.0);
+        assert!(fresnel_dielectric((critical - 0.01).cos(), 1.0 / 1.5) < 1.0);
+
+        let glass = Bsdf::Dielectric { ior: 1.5, tint: Vec3::ONE };
+        for theta in [0.0f32, 0.4, 1.0, 1.5] {
+            let wo = direction(theta);
+            // Refraction obeys Snell's law and leaves through the other side.
+            let refracted = glass.sample(wo, Vec2::new(0.999, 0.0)).unwrap();
+            assert!(refracted.wi.z < 0.0 && refracted.delta);
+            let sin_t = (refracted.wi.x * refracted.wi.x + refracted.wi.y * refracted.wi.y).sqrt();
+            assert!((theta.sin() - 1.5 * sin_t).abs() < 1e-5, "Snell at {theta}");
+            // Reflection and refraction weights, with the 1/η² radiance
+            // compression undone, sum to one: the boundary loses no energy.
+            let reflectance = fresnel_dielectric(theta.cos(), 1.5);
+            let weight = |s: &BsdfSample| s.value * s.wi.z.abs() / s.pdf;
+            let reflected = glass.sample(wo, Vec2::new(0.0, 0.0)).unwrap();
+            assert!((reflected.wi - Vec3::new(-wo.x, -wo.y, wo.z)).length() < 1e-6);
+            let energy = reflectance * weight(&reflected).x + (1.0 - reflectance) * weight(&refracted).x * 1.5 * 1.5;
+            assert!((energy - 1.0).abs() < 1e-5, "energy {energy} at {theta}");
+            // Entering and leaving a parallel slab: the ray leaves parallel
+            // to how it came in, with its radiance unchanged.
+            // The slab's lower face has the outward normal -z: flip z into its frame and back.
+            let flip = |w: Vec3| Vec3::new(w.x, w.y, -w.z);
+            let out = glass.sample(flip(-refracted.wi), Vec2::new(0.999, 0.0)).unwrap();
+            assert!((flip(out.wi) - (-wo)).length() < 1e-5, "{theta}: left along {}", flip(out.wi));
+            let round_trip = weight(&refracted) * weight(&out);
+            assert!((round_trip - Vec3::ONE).abs().max_element() < 1e-5, "{round_trip}");
+        }
     }
 }

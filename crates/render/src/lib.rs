@@ -22,25 +22,36 @@
 
 pub mod bsdf;
 mod camera;
+mod distribution;
+pub mod effects;
 mod framing;
+mod integrator;
+pub mod lights;
 pub mod probes;
 pub mod rays;
 mod sampler;
 mod shade;
 
 pub use camera::CameraRays;
+pub use distribution::Distribution1D;
+pub use effects::{Effect, EffectOverrides, EffectPlan, PlannedEffect};
 pub use framing::frame_scene;
+pub use integrator::{DirectStrategy, Integrator};
+pub use lights::{Environment, EnvironmentMap, LightSet};
 pub use sampler::{PixelSample, PixelSampler};
-pub use shade::{alpha_accepts, has_alpha, shade_primary, shading_normal};
+pub use shade::{albedo, alpha_accepts, has_alpha, shade_primary, shading_normal};
 
 use std::time::Instant;
 
 use rayon::prelude::*;
 use rtgi_accel::{Accel, TraversalCounters};
 use rtgi_image::HdrImage;
-use rtgi_math::{Rng, Vec2, Vec3};
+use rtgi_math::{Ray, Rng, Vec2, Vec3};
 use rtgi_scene::{Camera, Scene};
 use serde::Serialize;
+
+use crate::effects::bits;
+use crate::integrator::Transport;
 
 /// Side of the square tiles that threads take one at a time.
 pub const TILE_SIZE: u32 = 16;
@@ -54,8 +65,17 @@ pub struct RenderSettings {
     pub samples_per_pixel: u32,
     pub sampler: PixelSampler,
     pub seed: u64,
-    /// Radiance of rays that hit nothing.
+    /// Radiance of camera rays that hit nothing, when no environment is seen.
     pub background: Vec3,
+    pub integrator: Integrator,
+    /// Bounces a path may take after the camera ray (1 = direct light only).
+    pub max_depth: u32,
+    pub direct_strategy: DirectStrategy,
+    /// Light from far away; `None` leaves it to the planner (a white sky
+    /// when the scene has no light of its own).
+    pub environment: Option<Environment>,
+    /// Effects forced on or off, whatever the scene needs.
+    pub effects: EffectOverrides,
 }
 
 impl Default for RenderSettings {
@@ -67,6 +87,11 @@ impl Default for RenderSettings {
             sampler: PixelSampler::Center,
             seed: 0,
             background: Vec3::new(0.05, 0.05, 0.06),
+            integrator: Integrator::Path,
+            max_depth: 8,
+            direct_strategy: DirectStrategy::Mis,
+            environment: None,
+            effects: EffectOverrides::default(),
         }
     }
 }
@@ -99,8 +124,9 @@ fn tiles(width: u32, height: u32) -> Vec<(u32, u32, u32, u32)> {
     tiles
 }
 
-/// Renders the primary-hit view: each pixel averages its samples' shaded
-/// closest hits, or the background.
+/// Renders `scene` as `settings.integrator` says: each pixel averages its
+/// samples. For the light-transport integrators the effects planner
+/// ([`EffectPlan::new`]) decides what is simulated.
 ///
 /// `progress` is called from the worker threads with the number of pixels
 /// finished since its last call; it must be cheap.
@@ -112,41 +138,106 @@ pub fn render<A: Accel + ?Sized>(
     progress: &(dyn Fn(u64) + Sync),
 ) -> (HdrImage, RenderStats) {
     let start = Instant::now();
+    let (image, rays) = match settings.integrator {
+        Integrator::Primary => {
+            let alpha = has_alpha(scene);
+            render_samples(camera, settings, progress, |ray, rng, rays| {
+                *rays += 1;
+                let hit = if alpha {
+                    let u = rng.next_f32();
+                    accel.intersect_filtered(&ray, &|t, b, g| alpha_accepts(scene, t, b, g, u))
+                } else {
+                    accel.intersect(&ray)
+                };
+                match hit {
+                    Some(hit) => shade_primary(scene, &ray, &hit),
+                    None => settings.background,
+                }
+            })
+        }
+        Integrator::Direct | Integrator::Path => render_transport(scene, accel, camera, settings, progress),
+        aov => {
+            let alpha = has_alpha(scene);
+            render_samples(camera, settings, progress, |ray, rng, rays| {
+                *rays += 1;
+                shade::aov(aov, scene, accel, alpha, &ray, rng)
+            })
+        }
+    };
+    let stats = RenderStats {
+        width: settings.width,
+        height: settings.height,
+        samples_per_pixel: settings.samples_per_pixel.max(1),
+        rays,
+        render_ms: start.elapsed().as_secs_f64() * 1e3,
+    };
+    (image, stats)
+}
+
+/// Light transport, specialised to the plan's effects: one compiled
+/// version of the path loop per combination of the specialisation bits.
+fn render_transport<A: Accel + ?Sized>(
+    scene: &Scene,
+    accel: &A,
+    camera: &Camera,
+    settings: &RenderSettings,
+    progress: &(dyn Fn(u64) + Sync),
+) -> (HdrImage, u64) {
+    let plan = EffectPlan::new(scene, settings);
+    let white_sky = Environment::Uniform(Vec3::ONE);
+    let environment = if plan.default_environment { Some(&white_sky) } else { settings.environment.as_ref() };
+    let transport = Transport::new(scene, accel, &plan, environment, settings.background, settings.direct_strategy);
+    fn run<const S: u32, A: Accel + ?Sized>(
+        transport: &Transport<'_, A>,
+        camera: &Camera,
+        settings: &RenderSettings,
+        progress: &(dyn Fn(u64) + Sync),
+    ) -> (HdrImage, u64) {
+        render_samples(camera, settings, progress, |ray, rng, rays| transport.radiance::<S>(ray, rng, rays))
+    }
+    macro_rules! specialised {
+        ($($bits:literal)*) => {
+            match plan.specialisation() {
+                $($bits => run::<$bits, A>(&transport, camera, settings, progress),)*
+                other => unreachable!("specialisation {other} out of range"),
+            }
+        };
+    }
+    const _: () = assert!(bits::COUNT == 32);
+    specialised!(0 1 2 3 4 5 6 7 8 9 10 11 12 13 14 15 16 17 18 19 20 21 22 23 24 25 26 27 28 29 30 31)
+}
+
+/// Renders each pixel as the mean of `settings.samples_per_pixel` values
+/// of `sample(camera ray, generator, ray counter)`. Each sample has its own
+/// generator, seeded by (seed, pixel, sample); samples that come out
+/// infinite or NaN count as black rather than spoiling the pixel.
+fn render_samples(
+    camera: &Camera,
+    settings: &RenderSettings,
+    progress: &(dyn Fn(u64) + Sync),
+    sample: impl Fn(Ray, &mut Rng, &mut u64) -> Vec3 + Sync,
+) -> (HdrImage, u64) {
     let (width, height) = (settings.width, settings.height);
     let rays = CameraRays::new(camera, width, height);
     let spp = settings.samples_per_pixel.max(1);
-    let alpha = has_alpha(scene);
-    let image = render_pixels(width, height, progress, |x, y| {
+    render_pixels(width, height, progress, |x, y| {
         let pixel_index = y as u64 * width as u64 + x as u64;
         // One more generator per pixel, past every sample's: its shift of the pixel's pattern.
         let mut shift = Rng::for_sample(settings.seed, pixel_index, u64::MAX);
         let pixel_shift = Vec2::new(shift.next_f32(), shift.next_f32());
         let mut sum = Vec3::ZERO;
-        for sample in 0..spp {
-            let mut rng = Rng::for_sample(settings.seed, pixel_index, sample as u64);
-            let position = PixelSample { index: sample, count: spp, pixel_shift };
+        let mut traced = 0;
+        for index in 0..spp {
+            let mut rng = Rng::for_sample(settings.seed, pixel_index, index as u64);
+            let position = PixelSample { index, count: spp, pixel_shift };
             let ray = rays.ray(x, y, settings.sampler.offset(&position, &mut rng));
-            let hit = if alpha {
-                let u = rng.next_f32();
-                accel.intersect_filtered(&ray, &|t, b, g| alpha_accepts(scene, t, b, g, u))
-            } else {
-                accel.intersect(&ray)
-            };
-            sum += match hit {
-                Some(hit) => shade_primary(scene, &ray, &hit),
-                None => settings.background,
-            };
+            let value = sample(ray, &mut rng, &mut traced);
+            if value.is_finite() {
+                sum += value;
+            }
         }
-        sum / spp as f32
-    });
-    let stats = RenderStats {
-        width,
-        height,
-        samples_per_pixel: spp,
-        rays: width as u64 * height as u64 * spp as u64,
-        render_ms: start.elapsed().as_secs_f64() * 1e3,
-    };
-    (image, stats)
+        (sum / spp as f32, traced)
+    })
 }
 
 /// Renders what tracing costs: per pixel, the boxes tested (red channel)
@@ -161,10 +252,12 @@ pub fn render_traversal_cost<A: Accel + ?Sized>(
     progress: &(dyn Fn(u64) + Sync),
 ) -> (HdrImage, TraversalCounters) {
     let rays = CameraRays::new(camera, width, height);
-    let image = render_pixels(width, height, progress, |x, y| {
+    let (image, _) = render_pixels(width, height, progress, |x, y| {
         let mut counters = TraversalCounters::default();
         let hit = accel.intersect_counted(&rays.ray(x, y, Vec2::splat(0.5)), &mut counters);
-        Vec3::new(counters.nodes_visited as f32, counters.triangles_tested as f32, hit.is_some() as u32 as f32)
+        let value =
+            Vec3::new(counters.nodes_visited as f32, counters.triangles_tested as f32, hit.is_some() as u32 as f32);
+        (value, 1)
     });
     let mut total = TraversalCounters { rays: width as u64 * height as u64, ..TraversalCounters::default() };
     for p in image.pixels() {
@@ -174,32 +267,43 @@ pub fn render_traversal_cost<A: Accel + ?Sized>(
     (image, total)
 }
 
-/// Computes every pixel with `pixel(x, y)`, tile by tile in parallel, and
-/// reports finished pixels to `progress`. The value of a pixel depends only
-/// on its coordinates, so the image is the same for any number of threads.
+/// Computes every pixel with `pixel(x, y)`, which returns the value and
+/// the rays it traced, tile by tile in parallel, and reports finished pixels
+/// to `progress`. The value of a pixel depends only on its coordinates, so
+/// the image is the same for any number of threads. Returns the image and
+/// the total of the rays.
 fn render_pixels(
     width: u32,
     height: u32,
     progress: &(dyn Fn(u64) + Sync),
-    pixel: impl Fn(u32, u32) -> Vec3 + Sync,
-) -> HdrImage {
-    let tile_pixels: Vec<Vec<Vec3>> = tiles(width, height)
+    pixel: impl Fn(u32, u32) -> (Vec3, u64) + Sync,
+) -> (HdrImage, u64) {
+    let tile_pixels: Vec<(Vec<Vec3>, u64)> = tiles(width, height)
         .into_par_iter()
         .map(|(x0, y0, x1, y1)| {
-            let pixels: Vec<Vec3> =
-                (y0..y1).flat_map(|y| (x0..x1).map(move |x| (x, y))).map(|(x, y)| pixel(x, y)).collect();
+            let mut rays = 0;
+            let pixels: Vec<Vec3> = (y0..y1)
+                .flat_map(|y| (x0..x1).map(move |x| (x, y)))
+                .map(|(x, y)| {
+                    let (value, traced) = pixel(x, y);
+                    rays += traced;
+                    value
+                })
+                .collect();
             progress(pixels.len() as u64);
-            pixels
+            (pixels, rays)
         })
         .collect();
     let mut image = HdrImage::new(width, height);
-    for ((x0, y0, x1, _), pixels) in tiles(width, height).into_iter().zip(tile_pixels) {
+    let mut rays = 0;
+    for ((x0, y0, x1, _), (pixels, traced)) in tiles(width, height).into_iter().zip(tile_pixels) {
         let tile_width = (x1 - x0) as usize;
+        rays += traced;
         for (i, value) in pixels.into_iter().enumerate() {
             image.set(x0 + (i % tile_width) as u32, y0 + (i / tile_width) as u32, value);
         }
     }
-    image
+    (image, rays)
 }
 
 #[cfg(test)]

@@ -1,6 +1,8 @@
-use rtgi_accel::Hit;
-use rtgi_math::{Ray, Vec3};
+use rtgi_accel::{Accel, Hit, TraversalCounters};
+use rtgi_math::{Ray, Rng, Vec3};
 use rtgi_scene::{AlphaMode, Scene};
+
+use crate::Integrator;
 
 /// The part of the light that a surface facing away from the viewer still
 /// reflects in the simple shading, so that such faces stay readable.
@@ -13,15 +15,58 @@ const AMBIENT: f32 = 0.2;
 pub fn shade_primary(scene: &Scene, ray: &Ray, hit: &Hit) -> Vec3 {
     let triangle = &scene.triangles[hit.triangle as usize];
     let material = &scene.materials[triangle.material as usize];
-    let uv = scene.interpolate(triangle, hit.beta, hit.gamma, |v| v.uv);
-    let texture = |id: Option<rtgi_scene::TextureId>| {
-        id.map_or(Vec3::ONE, |t| scene.textures[t.0 as usize].sample(uv).truncate())
-    };
-    let albedo = material.base_color * texture(material.base_color_texture);
-    let emission = material.emission * texture(material.emission_texture);
+    let emission = material.emission
+        * material.emission_texture.map_or(Vec3::ONE, |t| {
+            let uv = scene.interpolate(triangle, hit.beta, hit.gamma, |v| v.uv);
+            scene.textures[t.0 as usize].sample(uv).truncate()
+        });
+    let albedo = albedo(scene, hit);
     let normal = shading_normal(scene, hit);
     let cosine = normal.dot(-ray.direction.normalize()).abs();
     albedo * (AMBIENT + (1.0 - AMBIENT) * cosine) + emission
+}
+
+/// The surface colour at the hit: base colour times texture.
+pub fn albedo(scene: &Scene, hit: &Hit) -> Vec3 {
+    let triangle = &scene.triangles[hit.triangle as usize];
+    let material = &scene.materials[triangle.material as usize];
+    let texture = material.base_color_texture.map_or(Vec3::ONE, |t| {
+        let uv = scene.interpolate(triangle, hit.beta, hit.gamma, |v| v.uv);
+        scene.textures[t.0 as usize].sample(uv).truncate()
+    });
+    material.base_color * texture
+}
+
+/// One sample of an arbitrary output variable (an AOV integrator) for a
+/// camera ray; zero where the ray hits nothing.
+pub(crate) fn aov<A: Accel + ?Sized>(
+    kind: Integrator,
+    scene: &Scene,
+    accel: &A,
+    alpha: bool,
+    ray: &Ray,
+    rng: &mut Rng,
+) -> Vec3 {
+    let mut counters = TraversalCounters::default();
+    let hit = if kind == Integrator::Cost {
+        accel.intersect_counted(ray, &mut counters)
+    } else if alpha {
+        let u = rng.next_f32();
+        accel.intersect_filtered(ray, &|t, b, g| alpha_accepts(scene, t, b, g, u))
+    } else {
+        accel.intersect(ray)
+    };
+    if kind == Integrator::Cost {
+        return Vec3::new(counters.nodes_visited as f32, counters.triangles_tested as f32, hit.is_some() as u32 as f32);
+    }
+    let Some(hit) = hit else { return Vec3::ZERO };
+    match kind {
+        Integrator::Albedo => albedo(scene, &hit),
+        Integrator::Normal => shading_normal(scene, &hit),
+        Integrator::Depth => Vec3::splat(hit.t * ray.direction.length()),
+        Integrator::Position => ray.at(hit.t),
+        other => unreachable!("{other} is not an AOV"),
+    }
 }
 
 /// The interpolated vertex normal at the hit, or the triangle's geometric

@@ -14,8 +14,8 @@ use rayon::prelude::*;
 use rtgi_math::{Mat3, Mat4, Vec2, Vec3, Vec4};
 
 use crate::{
-    AlphaMode, Camera, ColorEncoding, Light, LightKind, Material, MeshBuilder, Scene, SceneError, Texture, TextureId,
-    Wrap,
+    AlphaMode, Camera, ColorEncoding, Light, LightKind, Material, MeshBuilder, Scene, SceneError, SurfaceModel,
+    Texture, TextureId, Wrap,
 };
 
 /// Extensions this importer understands; others are reported by `rtgi info`.
@@ -37,7 +37,14 @@ pub(crate) fn load(path: &Path) -> Result<Scene, SceneError> {
         scene.materials.push(convert_material(&material, &textures));
     }
     let default_material = scene.materials.len() as u32;
-    scene.materials.push(Material { name: "glTF default".into(), ..Material::default() });
+    scene.materials.push(Material {
+        name: "glTF default".into(),
+        model: SurfaceModel::MetallicRoughness,
+        base_color: Vec3::ONE,
+        metallic: 1.0,
+        roughness: 1.0,
+        ..Material::default()
+    });
 
     let Some(root) = gltf.document.default_scene().or_else(|| gltf.document.scenes().next()) else {
         scene.warnings.push(format!("{}: the file has no scene", path.display()));
@@ -309,6 +316,7 @@ fn convert_material(m: &gltf::Material<'_>, textures: &TextureTable) -> Material
     let emission = Vec3::from(m.emissive_factor()) * m.emissive_strength().unwrap_or(1.0);
     Material {
         name: m.name().unwrap_or("unnamed").to_owned(),
+        model: SurfaceModel::MetallicRoughness,
         base_color: Vec3::new(r, g, b),
         base_color_texture: pbr.base_color_texture().and_then(|i| textures.get(i.texture(), true)),
         specular: Vec3::ZERO,

@@ -32,7 +32,7 @@ mod texture;
 
 pub use camera::Camera;
 pub use light::{Light, LightKind};
-pub use material::{AlphaMode, Material};
+pub use material::{AlphaMode, Material, SurfaceModel};
 pub use mesh::MeshBuilder;
 pub use resolve::resolve_case_insensitive;
 pub use texture::{ColorEncoding, Texture, TextureId, Wrap};

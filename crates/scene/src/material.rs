@@ -11,7 +11,10 @@ use crate::TextureId;
 /// [`roughness`](Self::roughness) = (2 / (Ns + 2))^¼, Walter et al. 2007), `Ke`
 /// → [`emission`](Self::emission), `Ni` → [`ior`](Self::ior), `d` →
 /// [`opacity`](Self::opacity). Absent fields keep the defaults of
-/// [`Material::default`]; OBJ surfaces are non-metallic and two-sided.
+/// [`Material::default`]; OBJ surfaces are non-metallic and two-sided. MTL's
+/// illumination models 3 and 5 (ray-traced reflection) make the specular
+/// lobe a perfect mirror (roughness 0); 4, 6, 7 and 9 (refraction) make the
+/// surface transmit (transmission 1, refracting by `Ni`).
 ///
 /// glTF 2.0 metallic-roughness materials map directly: base colour factor
 /// and texture, metallic and roughness factors and texture, normal map and
@@ -21,6 +24,8 @@ use crate::TextureId;
 #[derive(Clone, Debug, PartialEq)]
 pub struct Material {
     pub name: String,
+    /// Which reflectance model the fields describe.
+    pub model: SurfaceModel,
     /// Diffuse reflectance (linear RGB), multiplied by the texture where there is one.
     pub base_color: Vec3,
     pub base_color_texture: Option<TextureId>,
@@ -51,6 +56,17 @@ pub struct Material {
     pub double_sided: bool,
 }
 
+/// The two ways the importers describe reflectance.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SurfaceModel {
+    /// MTL's sum of a diffuse lobe (`base_color`) and a specular lobe
+    /// (`specular`, `roughness`); Fresnel effects are not modelled.
+    DiffuseSpecular,
+    /// glTF's metallic-roughness model (`base_color`, `metallic`, `roughness`),
+    /// with Fresnel reflection; `transmission` and `ior` extend it.
+    MetallicRoughness,
+}
+
 /// How a material's alpha (base colour alpha times `opacity`) is used.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum AlphaMode {
@@ -66,6 +82,7 @@ impl Default for Material {
     fn default() -> Self {
         Self {
             name: String::from("default"),
+            model: SurfaceModel::DiffuseSpecular,
             base_color: Vec3::splat(0.8),
             base_color_texture: None,
             specular: Vec3::ZERO,

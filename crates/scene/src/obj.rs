@@ -126,13 +126,17 @@ fn load_materials(
         });
         let shininess = m.shininess.unwrap_or(0.0);
         let defaults = Material::default();
+        let illumination = m.illumination_model.unwrap_or(2);
+        let mirror = matches!(illumination, 3 | 5);
+        let refracts = matches!(illumination, 4 | 6 | 7 | 9);
         scene.materials.push(Material {
             name: m.name.clone(),
             base_color: m.diffuse.map_or(defaults.base_color, Vec3::from),
             base_color_texture,
             specular: m.specular.map_or(Vec3::ZERO, Vec3::from),
             shininess,
-            roughness: Material::roughness_from_shininess(shininess),
+            roughness: if mirror { 0.0 } else { Material::roughness_from_shininess(shininess) },
+            transmission: if refracts { 1.0 } else { 0.0 },
             emission: m.emissive.map_or(Vec3::ZERO, Vec3::from),
             ior: m.optical_density.filter(|n| *n > 0.0).unwrap_or(1.5),
             opacity: m.dissolve.unwrap_or(1.0).clamp(0.0, 1.0),

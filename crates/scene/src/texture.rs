@@ -142,6 +142,17 @@ impl Texture {
         self.encoding
     }
 
+    /// The mean linear value of the texels.
+    pub fn average(&self) -> Vec4 {
+        let mut sum = rtgi_math::glam::DVec4::ZERO;
+        for y in 0..self.height {
+            for x in 0..self.width {
+                sum += self.texel(x, y).as_dvec4();
+            }
+        }
+        (sum / self.texels.len() as f64).as_vec4()
+    }
+
     /// Whether any texel is less than fully opaque.
     pub fn has_alpha(&self) -> bool {
         self.texels.iter().any(|t| t[3] < 255)

@@ -1,0 +1,398 @@
+//! The effects planner: from a scene and the render settings, decide which
+//! effects a render has to simulate, and say why.
+//!
+//! Each effect is either needed by the scene (there are lights to shadow,
+//! materials that refract, textures to look up...) or not; the user can
+//! force any effect on or off with [`EffectOverrides`]. The renderer then
+//! runs code specialised to the plan ([`EffectPlan::specialisation`]):
+//! what the plan leaves out is compiled out, not skipped by a test per sample.
+
+use std::fmt;
+use std::str::FromStr;
+
+use rtgi_scene::{AlphaMode, Material, Scene, SurfaceModel};
+
+use crate::{Integrator, RenderSettings};
+
+/// Something a render may simulate.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum Effect {
+    /// Light sampled from lights, emitters and the environment at every
+    /// surface, with shadow rays (next-event estimation).
+    DirectLight,
+    /// Light emitted by surfaces, seen directly or after bounces.
+    Emission,
+    /// Light from the environment, for rays that leave the scene.
+    Environment,
+    /// Light that has bounced off more than one surface.
+    Indirect,
+    /// Specular and glossy reflection (microfacet lobes, mirrors).
+    Glossy,
+    /// Refraction through transmitting materials.
+    Refraction,
+    /// Texture lookups for colour, emission, metal and roughness.
+    Textures,
+    /// Normal maps perturbing the shading normal.
+    NormalMaps,
+    /// Alpha tests: cut-outs and blended surfaces let rays through.
+    Alpha,
+}
+
+impl Effect {
+    pub const ALL: &'static [Effect] = &[
+        Effect::DirectLight,
+        Effect::Emission,
+        Effect::Environment,
+        Effect::Indirect,
+        Effect::Glossy,
+        Effect::Refraction,
+        Effect::Textures,
+        Effect::NormalMaps,
+        Effect::Alpha,
+    ];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            Effect::DirectLight => "direct-light",
+            Effect::Emission => "emission",
+            Effect::Environment => "environment",
+            Effect::Indirect => "indirect",
+            Effect::Glossy => "glossy",
+            Effect::Refraction => "refraction",
+            Effect::Textures => "textures",
+            Effect::NormalMaps => "normal-maps",
+            Effect::Alpha => "alpha",
+        }
+    }
+}
+
+rtgi_math::named_choices!(Effect, "effect");
+
+/// Effects the user forces on (`+name`) or off (`-name`), parsed from a
+/// comma-separated list such as `+glossy,-textures`.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct EffectOverrides {
+    pub on: Vec<Effect>,
+    pub off: Vec<Effect>,
+}
+
+impl FromStr for EffectOverrides {
+    type Err = String;
+
+    fn from_str(text: &str) -> Result<Self, String> {
+        let mut overrides = EffectOverrides::default();
+        for item in text.split(',').map(str::trim).filter(|s| !s.is_empty()) {
+            let (list, name) = if let Some(name) = item.strip_prefix('+') {
+                (&mut overrides.on, name)
+            } else if let Some(name) = item.strip_prefix('-') {
+                (&mut overrides.off, name)
+            } else {
+                return Err(format!("'{item}': write +effect to force an effect on, -effect to force it off"));
+            };
+            let effect: Effect = name.parse()?;
+            list.push(effect);
+        }
+        if let Some(both) = overrides.on.iter().find(|e| overrides.off.contains(e)) {
+            return Err(format!("effect '{both}' is forced both on and off"));
+        }
+        Ok(overrides)
+    }
+}
+
+/// One line of a plan.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct PlannedEffect {
+    pub effect: Effect,
+    pub enabled: bool,
+    /// Whether the user's override decided, against what the scene needs.
+    pub forced: bool,
+    /// Why the effect is simulated or not.
+    pub reason: String,
+}
+
+/// Which effects a render simulates, and why.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct EffectPlan {
+    pub integrator: Integrator,
+    pub effects: Vec<PlannedEffect>,
+    /// The scene has no light of its own, so a uniform white environment
+    /// lights it (unless the environment is forced off).
+    pub default_environment: bool,
+    /// Bounces the integrator follows after the camera ray.
+    pub max_depth: u32,
+}
+
+/// The specialisation bits the renderer is compiled for.
+pub(crate) mod bits {
+    pub(crate) const ALPHA: u32 = 1;
+    pub(crate) const TEXTURES: u32 = 2;
+    /// Any model besides Lambert: glossy, mirror or refracting surfaces.
+    pub(crate) const SPECULAR: u32 = 4;
+    /// Next-event estimation.
+    pub(crate) const LIGHTS: u32 = 8;
+    /// Radiance picked up where rays hit emitters or leave the scene.
+    pub(crate) const EMITTED: u32 = 16;
+    pub(crate) const COUNT: u32 = 32;
+}
+
+fn names(materials: &[&Material]) -> String {
+    let mut list: Vec<&str> = materials.iter().map(|m| m.name.as_str()).collect();
+    list.dedup();
+    let shown = list.iter().take(4).map(|n| format!("'{n}'")).collect::<Vec<_>>().join(", ");
+    if list.len() > 4 { format!("{shown} and {} more", list.len() - 4) } else { shown }
+}
+
+fn count(n: usize, what: &str) -> String {
+    format!("{n} {what}{}", if n == 1 { "" } else { "s" })
+}
+
+/// Whether a material has a lobe besides diffuse reflection.
+pub(crate) fn is_glossy(m: &Material) -> bool {
+    match m.model {
+        SurfaceModel::DiffuseSpecular => m.specular.max_element() > 0.0,
+        SurfaceModel::MetallicRoughness => true,
+    }
+}
+
+pub(crate) fn transmits(m: &Material) -> bool {
+    match m.model {
+        SurfaceModel::DiffuseSpecular => m.transmission > 0.0,
+        SurfaceModel::MetallicRoughness => m.transmission > 0.0 && m.metallic < 1.0,
+    }
+}
+
+fn is_textured(m: &Material) -> bool {
+    m.base_color_texture.is_some() || m.metallic_roughness_texture.is_some() || m.emission_texture.is_some()
+}
+
+impl EffectPlan {
+    /// Plans a render of `scene` with `settings`.
+    pub fn new(scene: &Scene, settings: &RenderSettings) -> Self {
+        // Materials that some triangle uses: an unused material needs nothing.
+        let mut used = vec![false; scene.materials.len()];
+        for t in &scene.triangles {
+            if let Some(u) = used.get_mut(t.material as usize) {
+                *u = true;
+            }
+        }
+        let used: Vec<&Material> = scene.materials.iter().zip(&used).filter(|(_, u)| **u).map(|(m, _)| m).collect();
+        let with =
+            |test: fn(&Material) -> bool| -> Vec<&Material> { used.iter().copied().filter(|m| test(m)).collect() };
+        let lighting = settings.integrator.simulates_light();
+        let integrator = settings.integrator;
+        let not_lit = || format!("the {integrator} integrator computes no lighting");
+        let overrides = &settings.effects;
+        let mut effects = Vec::new();
+        let mut decide = |effect: Effect, needed: bool, reason: String| {
+            let forced_on = overrides.on.contains(&effect);
+            let forced_off = overrides.off.contains(&effect);
+            let enabled = (needed || forced_on) && !forced_off;
+            let forced = enabled != needed;
+            let reason = match (forced_on, forced_off) {
+                (true, _) if !needed => format!("forced on ({reason})"),
+                (_, true) if needed => format!("forced off ({reason})"),
+                _ => reason,
+            };
+            effects.push(PlannedEffect { effect, enabled, forced, reason });
+            enabled
+        };
+
+        let emitters = with(Material::is_emissive);
+        let emissive_triangles = scene
+            .triangles
+            .iter()
+            .filter(|t| scene.materials.get(t.material as usize).is_some_and(Material::is_emissive))
+            .count();
+        let emission = if !lighting {
+            decide(Effect::Emission, false, not_lit())
+        } else if emissive_triangles > 0 {
+            let reason = format!("{} of {} emit", count(emissive_triangles, "triangle"), names(&emitters));
+            decide(Effect::Emission, true, reason)
+        } else {
+            decide(Effect::Emission, false, "no material emits".into())
+        };
+
+        let lights = scene.lights.len();
+        let environment_given = settings.environment.is_some();
+        let default_environment = lighting && !environment_given && lights == 0 && emissive_triangles == 0;
+        let environment = if !lighting {
+            decide(Effect::Environment, false, not_lit())
+        } else if environment_given {
+            decide(Effect::Environment, true, "an environment is set".into())
+        } else if default_environment {
+            let reason = "the scene has no lights or emitters, so a uniform white sky (radiance 1) lights it; \
+                          --environment chooses another";
+            decide(Effect::Environment, true, reason.into())
+        } else {
+            decide(Effect::Environment, false, "no environment is set (--environment sets one)".into())
+        };
+
+        let direct = if !lighting {
+            decide(Effect::DirectLight, false, not_lit())
+        } else {
+            let mut sources = Vec::new();
+            if lights > 0 {
+                sources.push(count(lights, "light"));
+            }
+            if emission {
+                sources.push(count(emissive_triangles, "emissive triangle"));
+            }
+            if environment {
+                sources.push("the environment".into());
+            }
+            if sources.is_empty() {
+                decide(Effect::DirectLight, false, "nothing emits light".into())
+            } else {
+                decide(Effect::DirectLight, true, format!("shadow rays towards {}", sources.join(", ")))
+            }
+        };
+
+        let reflective: Vec<&Material> = used
+            .iter()
+            .copied()
+            .filter(|m| m.base_color.max_element() > 0.0 || m.specular.max_element() > 0.0)
+            .collect();
+        let max_depth = settings.max_depth;
+        let indirect = if integrator != Integrator::Path {
+            decide(Effect::Indirect, false, format!("the {integrator} integrator stops at the first surface"))
+        } else if max_depth < 2 {
+            decide(Effect::Indirect, false, "--max-depth is below 2".into())
+        } else if !(direct || emission || environment) {
+            decide(Effect::Indirect, false, "there is no light to bounce".into())
+        } else if reflective.is_empty() {
+            decide(Effect::Indirect, false, "no surface reflects light".into())
+        } else {
+            decide(
+                Effect::Indirect,
+                true,
+                format!("up to {max_depth} bounces off {}", count(reflective.len(), "material")),
+            )
+        };
+
+        let glossy = with(is_glossy);
+        if !lighting {
+            decide(Effect::Glossy, false, not_lit());
+        } else if glossy.is_empty() {
+            decide(Effect::Glossy, false, "every material is diffuse".into());
+        } else {
+            decide(
+                Effect::Glossy,
+                true,
+                format!("{} reflect specularly: {}", count(glossy.len(), "material"), names(&glossy)),
+            );
+        }
+
+        let refracting = with(transmits);
+        if !lighting {
+            decide(Effect::Refraction, false, not_lit());
+        } else if refracting.is_empty() {
+            decide(Effect::Refraction, false, "no material transmits".into());
+        } else {
+            let reason = format!("{} transmit: {}", count(refracting.len(), "material"), names(&refracting));
+            decide(Effect::Refraction, true, reason);
+        }
+
+        let textured = with(is_textured);
+        let textures = if textured.is_empty() {
+            decide(Effect::Textures, false, "no material is textured".into())
+        } else {
+            decide(
+                Effect::Textures,
+                true,
+                format!("{} textured: {}", count(textured.len(), "material"), names(&textured)),
+            )
+        };
+
+        let normal_mapped = with(|m| m.normal_texture.is_some());
+        if !lighting {
+            decide(Effect::NormalMaps, false, not_lit());
+        } else if !textures {
+            decide(Effect::NormalMaps, false, "textures are off".into());
+        } else if normal_mapped.is_empty() {
+            decide(Effect::NormalMaps, false, "no material has a normal map".into());
+        } else {
+            let reason = format!("{} normal-mapped: {}", count(normal_mapped.len(), "material"), names(&normal_mapped));
+            decide(Effect::NormalMaps, true, reason);
+        }
+
+        let masked = with(|m| m.alpha_mode != AlphaMode::Opaque);
+        if masked.is_empty() {
+            decide(Effect::Alpha, false, "every material is opaque".into());
+        } else {
+            decide(
+                Effect::Alpha,
+                true,
+                format!("{} cut out or blend: {}", count(masked.len(), "material"), names(&masked)),
+            );
+        }
+
+        let default_environment = default_environment && environment;
+        let max_depth = if indirect { max_depth } else { max_depth.min(1) };
+        Self { integrator, effects, default_environment, max_depth }
+    }
+
+    /// Whether the plan simulates `effect`.
+    pub fn has(&self, effect: Effect) -> bool {
+        self.effects.iter().any(|e| e.effect == effect && e.enabled)
+    }
+
+    /// The effects the plan leaves out.
+    pub fn omitted(&self) -> impl Iterator<Item = Effect> + '_ {
+        self.effects.iter().filter(|e| !e.enabled).map(|e| e.effect)
+    }
+
+    /// The set of specialisations the renderer runs for this plan.
+    pub(crate) fn specialisation(&self) -> u32 {
+        let mut mask = 0;
+        if self.has(Effect::Alpha) {
+            mask |= bits::ALPHA;
+        }
+        if self.has(Effect::Textures) {
+            mask |= bits::TEXTURES;
+        }
+        if self.has(Effect::Glossy) || self.has(Effect::Refraction) {
+            mask |= bits::SPECULAR;
+        }
+        if self.has(Effect::DirectLight) {
+            mask |= bits::LIGHTS;
+        }
+        if self.has(Effect::Emission) || self.has(Effect::Environment) {
+            mask |= bits::EMITTED;
+        }
+        mask
+    }
+}
+
+impl fmt::Display for EffectPlan {
+    /// One line per effect: `+` simulated, `-` left out, `!` where an
+    /// override decided, with the reason.
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let depth = match self.integrator {
+            Integrator::Path => format!(", up to {} bounces", self.max_depth),
+            _ => String::new(),
+        };
+        writeln!(f, "plan: {} integrator{depth}", self.integrator)?;
+        for e in &self.effects {
+            let sign = if e.enabled { '+' } else { '-' };
+            let forced = if e.forced { '!' } else { ' ' };
+            writeln!(f, "  {sign}{forced}{:<13} {}", e.effect.name(), e.reason)?;
+        }
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn overrides_parse() {
+        let o: EffectOverrides = "+glossy, -textures,+alpha".parse().unwrap();
+        assert_eq!(o.on, vec![Effect::Glossy, Effect::Alpha]);
+        assert_eq!(o.off, vec![Effect::Textures]);
+        assert!("glossy".parse::<EffectOverrides>().unwrap_err().contains("+effect"));
+        assert!("+shiny".parse::<EffectOverrides>().unwrap_err().contains("unknown effect 'shiny'"));
+        assert!("+alpha,-alpha".parse::<EffectOverrides>().is_err());
+        assert_eq!("".parse::<EffectOverrides>().unwrap(), EffectOverrides::default());
+    }
+}

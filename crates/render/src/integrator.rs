@@ -1,0 +1,446 @@
+//! Light transport: direct lighting and path tracing with next-event
+//! estimation, multiple importance sampling and Russian roulette, compiled
+//! once per set of effects ([`EffectPlan::specialisation`]).
+//!
+//! Every bounce draws the same block of random numbers whatever the plan,
+//! so that a render whose plan leaves an effect out follows the same paths
+//! as one with the effect forced on: the images agree, which the tests check.
+
+use rtgi_accel::{Accel, Hit};
+use rtgi_math::{Frame, Ray, Rng, SurfacePoint, Vec2, Vec3, Vec4};
+use rtgi_scene::{Material, Scene, SurfaceModel, Triangle};
+
+use crate::bsdf::Bsdf;
+use crate::effects::{Effect, EffectPlan, bits, is_glossy, transmits};
+use crate::lights::{Environment, LightSet};
+use crate::shade::alpha_accepts;
+
+/// What the renderer computes for each pixel.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Integrator {
+    /// The closest hit's colour, lit from the viewer (a fast preview).
+    Primary,
+    /// The closest hit's surface colour.
+    Albedo,
+    /// The closest hit's unit shading normal (x, y, z in [-1, 1]).
+    Normal,
+    /// The distance to the closest hit (0 where nothing is hit).
+    Depth,
+    /// The closest hit's position.
+    Position,
+    /// Boxes (red) and triangles (green) tested to find the closest hit.
+    Cost,
+    /// Light arriving directly from lights and emitters, after one reflection.
+    Direct,
+    /// Global illumination: paths of many reflections.
+    Path,
+}
+
+impl Integrator {
+    pub const ALL: &'static [Integrator] = &[
+        Integrator::Primary,
+        Integrator::Albedo,
+        Integrator::Normal,
+        Integrator::Depth,
+        Integrator::Position,
+        Integrator::Cost,
+        Integrator::Direct,
+        Integrator::Path,
+    ];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            Integrator::Primary => "primary",
+            Integrator::Albedo => "albedo",
+            Integrator::Normal => "normal",
+            Integrator::Depth => "depth",
+            Integrator::Position => "position",
+            Integrator::Cost => "cost",
+            Integrator::Direct => "direct",
+            Integrator::Path => "path",
+        }
+    }
+
+    /// Whether the integrator computes how light travels (rather than a
+    /// property of the closest hit).
+    pub fn simulates_light(self) -> bool {
+        matches!(self, Integrator::Direct | Integrator::Path)
+    }
+
+    /// Whether the integrator writes an arbitrary output variable.
+    pub fn is_aov(self) -> bool {
+        matches!(
+            self,
+            Integrator::Albedo | Integrator::Normal | Integrator::Depth | Integrator::Position | Integrator::Cost
+        )
+    }
+}
+
+rtgi_math::named_choices!(Integrator, "integrator");
+
+/// How direct light is estimated at each surface.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum DirectStrategy {
+    /// Sample points on lights only (misses glossy highlights of big lights).
+    Light,
+    /// Sample the BSDF only (cannot find point lights; noisy for small lights).
+    Bsdf,
+    /// Both, weighted by Veach's power heuristic.
+    Mis,
+}
+
+impl DirectStrategy {
+    pub const ALL: &'static [DirectStrategy] = &[DirectStrategy::Light, DirectStrategy::Bsdf, DirectStrategy::Mis];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            DirectStrategy::Light => "light",
+            DirectStrategy::Bsdf => "bsdf",
+            DirectStrategy::Mis => "mis",
+        }
+    }
+}
+
+rtgi_math::named_choices!(DirectStrategy, "direct-light strategy");
+
+/// Bounces after which Russian roulette may end a path.
+const ROULETTE_AFTER: u32 = 3;
+
+/// GGX widths below this are treated as perfect mirrors (metals) or clamped
+/// (dielectrics): narrower lobes only add fireflies in f32.
+const MIN_ALPHA: f32 = 1e-3;
+
+/// The indices of a bounce's random numbers.
+mod dim {
+    pub(super) const LOBE: usize = 0;
+    pub(super) const BSDF: usize = 1; // and 2
+    pub(super) const LIGHT_CHOICE: usize = 3;
+    pub(super) const LIGHT: usize = 4; // and 5
+    pub(super) const ROULETTE: usize = 6;
+    pub(super) const ALPHA: usize = 7;
+    pub(super) const COUNT: usize = 8;
+}
+
+/// What the light-transport loop needs, prepared once per render.
+pub(crate) struct Transport<'a, A: Accel + ?Sized> {
+    scene: &'a Scene,
+    accel: &'a A,
+    lights: LightSet,
+    environment: Option<&'a Environment>,
+    background: Vec3,
+    max_depth: u32,
+    strategy: DirectStrategy,
+    glossy: bool,
+    refraction: bool,
+    normal_maps: bool,
+}
+
+/// A surface hit, ready to scatter light.
+struct Interaction {
+    point: SurfacePoint,
+    /// Local shading frame: `z` is the shading normal, on the side of the
+    /// geometric normal `point.normal`.
+    frame: Frame,
+    bsdf: Bsdf,
+    /// Compensates the random choice of one lobe of a layered material.
+    weight: Vec3,
+}
+
+fn power_heuristic(a: f32, b: f32) -> f32 {
+    let (a2, b2) = (a * a, b * b);
+    if a2.is_infinite() { 1.0 } else { a2 / (a2 + b2).max(f32::MIN_POSITIVE) }
+}
+
+fn luminance(c: Vec3) -> f32 {
+    c.dot(Vec3::new(0.2126, 0.7152, 0.0722))
+}
+
+impl<'a, A: Accel + ?Sized> Transport<'a, A> {
+    pub(crate) fn new(
+        scene: &'a Scene,
+        accel: &'a A,
+        plan: &EffectPlan,
+        environment: Option<&'a Environment>,
+        background: Vec3,
+        strategy: DirectStrategy,
+    ) -> Self {
+        let environment = environment.filter(|_| plan.has(Effect::Environment));
+        Self {
+            scene,
+            accel,
+            lights: LightSet::new(scene, plan.has(Effect::Emission), environment),
+            environment,
+            background,
+            max_depth: plan.max_depth,
+            strategy,
+            glossy: plan.has(Effect::Glossy),
+            refraction: plan.has(Effect::Refraction),
+            normal_maps: plan.has(Effect::NormalMaps),
+        }
+    }
+
+    fn closest<const S: u32>(&self, ray: &Ray, u_alpha: f32) -> Option<Hit> {
+        if S & bits::ALPHA != 0 {
+            self.accel.intersect_filtered(ray, &|t, b, g| alpha_accepts(self.scene, t, b, g, u_alpha))
+        } else {
+            self.accel.intersect(ray)
+        }
+    }
+
+    fn occluded<const S: u32>(&self, ray: &Ray, u_alpha: f32) -> bool {
+        if S & bits::ALPHA != 0 {
+            self.accel.occluded_filtered(ray, &|t, b, g| alpha_accepts(self.scene, t, b, g, u_alpha))
+        } else {
+            self.accel.occluded(ray)
+        }
+    }
+
+    /// The radiance arriving along `ray` (a camera ray); adds the rays it
+    /// traces to `rays`.
+    pub(crate) fn radiance<const S: u32>(&self, mut ray: Ray, rng: &mut Rng, rays: &mut u64) -> Vec3 {
+        let scene = self.scene;
+        let mut radiance = Vec3::ZERO;
+        let mut throughput = Vec3::ONE;
+        // The density of the BSDF sample that produced `ray`; None for the
+        // camera ray and specular bounces, whose emitters count in full.
+        let mut previous_pdf: Option<f32> = None;
+        let mut depth = 0;
+        loop {
+            let u: [f32; dim::COUNT] = std::array::from_fn(|_| rng.next_f32());
+            *rays += 1;
+            let Some(hit) = self.closest::<S>(&ray, u[dim::ALPHA]) else {
+                match self.environment {
+                    Some(environment) if S & bits::EMITTED != 0 => {
+                        let direction = ray.direction.normalize();
+                        let weight = self
+                            .emitted_weight::<S>(previous_pdf, || self.lights.pdf_environment(environment, direction));
+                        radiance += throughput * environment.radiance(direction) * weight;
+                    }
+                    _ if depth == 0 => radiance += self.background,
+                    _ => {}
+                }
+                break;
+            };
+            let triangle = &scene.triangles[hit.triangle as usize];
+            let material = &scene.materials[triangle.material as usize];
+            let direction_length = ray.direction.length();
+            let wo = -ray.direction / direction_length;
+            if S & bits::EMITTED != 0
+                && let Some(emitter) = self.lights.emitter(hit.triangle)
+            {
+                let emitted = emitter.radiance(scene, hit.beta, hit.gamma, wo);
+                let weight = self.emitted_weight::<S>(previous_pdf, || {
+                    self.lights.pdf_emitter(hit.triangle, wo, hit.t * direction_length)
+                });
+                radiance += throughput * emitted * weight;
+            }
+            if depth == self.max_depth {
+                break;
+            }
+            let interaction = self.interact::<S>(&hit, triangle, material, u[dim::LOBE]);
+            let (frame, bsdf) = (&interaction.frame, &interaction.bsdf);
+            let wo_local = frame.to_local(wo);
+            let reflects_only = !matches!(bsdf, Bsdf::Dielectric { .. });
+            let geometric = interaction.point.normal;
+            let wo_side = wo.dot(geometric);
+
+            if S & bits::LIGHTS != 0 && self.strategy != DirectStrategy::Bsdf && !bsdf.is_delta() {
+                let u_light = Vec2::new(u[dim::LIGHT], u[dim::LIGHT + 1]);
+                if let Some(light) =
+                    self.lights.sample(scene, self.environment, &interaction.point, u[dim::LIGHT_CHOICE], u_light)
+                    && light.wi.dot(geometric) * wo_side > 0.0
+                {
+                    let wi_local = frame.to_local(light.wi);
+                    let f = bsdf.eval(wo_local, wi_local);
+                    if f != Vec3::ZERO {
+                        *rays += 1;
+                        if !self.occluded::<S>(&light.shadow_ray, u[dim::ALPHA]) {
+                            let weight = if light.delta || self.strategy == DirectStrategy::Light {
+                                1.0
+                            } else {
+                                power_heuristic(light.pdf, bsdf.pdf(wo_local, wi_local))
+                            };
+                            radiance += throughput
+                                * interaction.weight
+                                * f
+                                * light.radiance
+                                * (wi_local.z.abs() * weight / light.pdf);
+                        }
+                    }
+                }
+            }
+
+            let Some(sample) = bsdf.sample(wo_local, Vec2::new(u[dim::BSDF], u[dim::BSDF + 1])) else { break };
+            let wi = frame.to_world(sample.wi);
+            // Reflection must stay on the side it came from, by the true
+            // surface as well as by the shading normal.
+            if reflects_only && wi.dot(geometric) * wo_side <= 0.0 {
+                break;
+            }
+            throughput *= interaction.weight * sample.value * (sample.wi.z.abs() / sample.pdf);
+            previous_pdf = (!sample.delta).then_some(sample.pdf);
+            depth += 1;
+            if depth >= ROULETTE_AFTER {
+                let survival = throughput.max_element().min(0.95);
+                if u[dim::ROULETTE] >= survival {
+                    break;
+                }
+                throughput /= survival;
+            }
+            if !throughput.is_finite() || throughput.max_element() <= 0.0 {
+                break;
+            }
+            ray = interaction.point.spawn_ray(wi);
+        }
+        radiance
+    }
+
+    /// The weight of emitted light found by a BSDF-sampled ray, given the
+    /// BSDF's density for it (`None` after the camera or a specular bounce)
+    /// and the density with which light sampling would have found it.
+    #[inline]
+    fn emitted_weight<const S: u32>(&self, bsdf_pdf: Option<f32>, light_pdf: impl FnOnce() -> f32) -> f32 {
+        match bsdf_pdf {
+            None => 1.0,
+            // Without light sampling, BSDF sampling is the only estimator.
+            Some(_) if S & bits::LIGHTS == 0 => 1.0,
+            Some(pdf) => match self.strategy {
+                DirectStrategy::Light => 0.0,
+                DirectStrategy::Bsdf => 1.0,
+                DirectStrategy::Mis => power_heuristic(pdf, light_pdf()),
+            },
+        }
+    }
+
+    /// The shading frame and BSDF at a hit.
+    fn interact<const S: u32>(&self, hit: &Hit, triangle: &Triangle, material: &Material, u_lobe: f32) -> Interaction {
+        let scene = self.scene;
+        let corners = triangle.vertices.map(|v| scene.vertices[v as usize].position);
+        let point = SurfacePoint::on_triangle(&corners, hit.beta, hit.gamma);
+        let mut normal = scene.interpolate(triangle, hit.beta, hit.gamma, |v| v.normal);
+        let mut base_color = material.base_color;
+        let mut roughness = material.roughness;
+        let mut metallic = material.metallic;
+        if S & bits::TEXTURES != 0 {
+            let uv = scene.interpolate(triangle, hit.beta, hit.gamma, |v| v.uv);
+            let texture = |id: rtgi_scene::TextureId| scene.textures[id.0 as usize].sample(uv);
+            if let Some(id) = material.base_color_texture {
+                base_color *= texture(id).truncate();
+            }
+            if let Some(id) = material.metallic_roughness_texture {
+                let t = texture(id);
+                roughness *= t.y;
+                metallic *= t.z;
+            }
+            if self.normal_maps
+                && let Some((id, scale)) = material.normal_texture
+            {
+                let tangent: Vec4 = scene.interpolate(triangle, hit.beta, hit.gamma, |v| v.tangent);
+                normal = perturb(normal, tangent, texture(id).truncate(), scale);
+            }
+        }
+        let mut normal = normal.try_normalize().unwrap_or(point.normal);
+        // Keep the geometric normal on the shading normal's side: the shading
+        // normal says where "outside" is (for refraction).
+        let mut point = point;
+        if point.normal.dot(normal) < 0.0 {
+            point.normal = -point.normal;
+        }
+        if !normal.is_finite() {
+            normal = point.normal;
+        }
+        let (bsdf, weight) = self.choose_bsdf::<S>(material, base_color, roughness, metallic, u_lobe);
+        Interaction { point, frame: Frame::from_z(normal), bsdf, weight }
+    }
+
+    /// The material's BSDF; layered materials choose one lobe at random
+    /// (by `u`), with the weight that keeps the estimate unbiased.
+    fn choose_bsdf<const S: u32>(
+        &self,
+        material: &Material,
+        base_color: Vec3,
+        roughness: f32,
+        metallic: f32,
+        u: f32,
+    ) -> (Bsdf, Vec3) {
+        let lambert = (Bsdf::Lambert { albedo: base_color }, Vec3::ONE);
+        if S & bits::SPECULAR == 0 {
+            return lambert;
+        }
+        let transmission = if self.refraction && transmits(material) {
+            match material.model {
+                SurfaceModel::DiffuseSpecular => material.transmission,
+                SurfaceModel::MetallicRoughness => material.transmission * (1.0 - metallic),
+            }
+        } else {
+            0.0
+        };
+        if u < transmission {
+            let tint = match material.model {
+                SurfaceModel::DiffuseSpecular => Vec3::ONE,
+                SurfaceModel::MetallicRoughness => base_color,
+            };
+            return (Bsdf::Dielectric { ior: material.ior.max(1.0 + 1e-4), tint }, Vec3::ONE);
+        }
+        if !self.glossy || !is_glossy(material) {
+            return lambert;
+        }
+        let u = (u - transmission) / (1.0 - transmission);
+        let alpha = roughness * roughness;
+        match material.model {
+            SurfaceModel::MetallicRoughness => {
+                if alpha < MIN_ALPHA && metallic >= 1.0 {
+                    (Bsdf::Mirror { reflectance: base_color }, Vec3::ONE)
+                } else {
+                    (Bsdf::MetallicRoughness { base_color, metallic, alpha: alpha.max(MIN_ALPHA) }, Vec3::ONE)
+                }
+            }
+            SurfaceModel::DiffuseSpecular => {
+                let specular = material.specular;
+                let p_specular = luminance(specular) / (luminance(specular) + luminance(base_color)).max(1e-12);
+                if u < p_specular {
+                    let lobe = if alpha < MIN_ALPHA {
+                        Bsdf::Mirror { reflectance: specular }
+                    } else {
+                        Bsdf::Glossy { reflectance: specular, alpha }
+                    };
+                    (lobe, Vec3::splat(1.0 / p_specular))
+                } else {
+                    (Bsdf::Lambert { albedo: base_color }, Vec3::splat(1.0 / (1.0 - p_specular)))
+                }
+            }
+        }
+    }
+}
+
+/// The shading normal bent by a tangent-space normal map texel (glTF:
+/// stored as (n + 1) / 2, x and y scaled by `scale`).
+fn perturb(normal: Vec3, tangent: Vec4, texel: Vec3, scale: f32) -> Vec3 {
+    let n = normal.normalize_or_zero();
+    let t = (tangent.truncate() - n * n.dot(tangent.truncate())).normalize_or_zero();
+    if n == Vec3::ZERO || t == Vec3::ZERO {
+        return normal;
+    }
+    let b = n.cross(t) * if tangent.w < 0.0 { -1.0 } else { 1.0 };
+    let m = texel * 2.0 - Vec3::ONE;
+    let m = Vec3::new(m.x * scale, m.y * scale, m.z);
+    let bent = (t * m.x + b * m.y + n * m.z).normalize_or_zero();
+    if bent == Vec3::ZERO { normal } else { bent }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn flat_normal_map_texel_keeps_the_normal() {
+        let n = Vec3::new(0.0, 0.6, 0.8);
+        let t = Vec4::new(1.0, 0.0, 0.0, 1.0);
+        assert!((perturb(n, t, Vec3::new(0.5, 0.5, 1.0), 1.0) - n).length() < 1e-6);
+        // Tilting towards +u tilts the normal towards the tangent.
+        let bent = perturb(Vec3::Z, t, Vec3::new(1.0, 0.5, 0.5 + 0.5f32.sqrt() * 0.5), 1.0);
+        assert!(bent.x > 0.5 && bent.z > 0.5, "{bent}");
+        assert!((power_heuristic(1.0, 1.0) - 0.5).abs() < 1e-6);
+        assert_eq!(power_heuristic(1.0, 0.0), 1.0);
+    }
+}
