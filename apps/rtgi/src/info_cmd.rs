@@ -2,11 +2,12 @@
 
 use anyhow::{Result, bail};
 use rtgi_image::HdrImage;
+use rtgi_render::{EffectPlan, RenderSettings};
 use rtgi_scene::{AlphaMode, LightKind, SUPPORTED_GLTF_EXTENSIONS};
 use serde::Serialize;
 
 use crate::cli::{CompareArgs, InfoArgs};
-use crate::common::{LoadedScene, load_scene};
+use crate::common::{LoadedScene, apply_lighting, load_scene};
 
 #[derive(Debug, Serialize)]
 struct Info {
@@ -21,6 +22,26 @@ struct Info {
     extensions_used: Vec<String>,
     extensions_unsupported: Vec<String>,
     warnings: Vec<String>,
+    /// What `rtgi render` with the given options would simulate, and why.
+    plan: PlanInfo,
+}
+
+#[derive(Debug, Serialize)]
+struct PlanInfo {
+    integrator: String,
+    max_depth: u32,
+    default_environment: bool,
+    effects: Vec<EffectInfo>,
+    #[serde(skip)]
+    text: String,
+}
+
+#[derive(Debug, Serialize)]
+struct EffectInfo {
+    effect: String,
+    enabled: bool,
+    forced: bool,
+    reason: String,
 }
 
 #[derive(Debug, Serialize)]
@@ -64,7 +85,26 @@ struct CameraInfo {
 }
 
 pub(crate) fn run(args: &InfoArgs) -> Result<()> {
-    let LoadedScene { scene, name, .. } = load_scene(args.scene.as_deref())?;
+    let LoadedScene { mut scene, name, .. } = load_scene(args.scene.as_deref())?;
+    let mut settings = RenderSettings::default();
+    apply_lighting(&args.lighting, &mut scene, &mut settings)?;
+    let plan = EffectPlan::new(&scene, &settings);
+    let plan = PlanInfo {
+        integrator: plan.integrator.to_string(),
+        max_depth: plan.max_depth,
+        default_environment: plan.default_environment,
+        effects: plan
+            .effects
+            .iter()
+            .map(|e| EffectInfo {
+                effect: e.effect.to_string(),
+                enabled: e.enabled,
+                forced: e.forced,
+                reason: e.reason.clone(),
+            })
+            .collect(),
+        text: plan.to_string(),
+    };
     let mut per_material = vec![0usize; scene.materials.len()];
     for t in &scene.triangles {
         per_material[t.material as usize] += 1;
@@ -138,6 +178,7 @@ pub(crate) fn run(args: &InfoArgs) -> Result<()> {
             .collect(),
         extensions_used: scene.extensions_used.clone(),
         warnings: scene.warnings.clone(),
+        plan,
     };
     if args.json {
         println!("{}", serde_json::to_string_pretty(&info)?);
@@ -193,6 +234,7 @@ fn print_text(info: &Info) {
     for e in &info.extensions_unsupported {
         println!("warning: extension {e} is not supported and is ignored");
     }
+    print!("{}", info.plan.text);
 }
 
 /// `rtgi compare`: prints the error of one EXR image against another.

@@ -38,6 +38,10 @@ pub enum Bsdf {
     /// that reflects and refracts by Fresnel's equations; refracted light is
     /// tinted by `tint` (glTF's base colour for transmission).
     Dielectric { ior: f32, tint: Vec3 },
+    /// A thin sheet of a dielectric (glTF's transmission without a volume):
+    /// light reflects by Fresnel's equations, summed over the reflections
+    /// inside the sheet, or passes straight through, tinted.
+    ThinDielectric { ior: f32, tint: Vec3 },
 }
 
 impl Bsdf {
@@ -49,7 +53,7 @@ impl Bsdf {
         }
         match *self {
             Bsdf::Lambert { albedo } => albedo / PI,
-            Bsdf::Mirror { .. } | Bsdf::Dielectric { .. } => Vec3::ZERO,
+            Bsdf::Mirror { .. } | Bsdf::Dielectric { .. } | Bsdf::ThinDielectric { .. } => Vec3::ZERO,
             Bsdf::Glossy { reflectance, alpha } => {
                 let wm = (wo + wi).normalize_or_zero();
                 if wm == Vec3::ZERO {
@@ -79,7 +83,7 @@ impl Bsdf {
         }
         match *self {
             Bsdf::Lambert { .. } => wi.z / PI,
-            Bsdf::Mirror { .. } | Bsdf::Dielectric { .. } => 0.0,
+            Bsdf::Mirror { .. } | Bsdf::Dielectric { .. } | Bsdf::ThinDielectric { .. } => 0.0,
             Bsdf::Glossy { alpha, .. } => ggx_reflection_pdf(wo, wi, alpha),
             Bsdf::MetallicRoughness { metallic, alpha, .. } => {
                 let p_specular = specular_probability(metallic);
@@ -93,8 +97,10 @@ impl Bsdf {
     /// `u.x` also chooses between the lobes of layered models; it is
     /// stretched back to [0, 1) for the chosen lobe.
     pub fn sample(&self, wo: Vec3, u: Vec2) -> Option<BsdfSample> {
-        if let Bsdf::Dielectric { ior, tint } = *self {
-            return Some(sample_dielectric(wo, ior, tint, u.x));
+        match *self {
+            Bsdf::Dielectric { ior, tint } => return Some(sample_dielectric(wo, ior, tint, u.x)),
+            Bsdf::ThinDielectric { ior, tint } => return Some(sample_thin_dielectric(wo, ior, tint, u.x)),
+            _ => {}
         }
         let flip = wo.z < 0.0;
         let local_wo = to_upper(wo);
@@ -102,7 +108,7 @@ impl Bsdf {
         let wi = match *self {
             Bsdf::Lambert { .. } => cosine_hemisphere(u),
             Bsdf::Glossy { alpha, .. } => reflect(local_wo, sample_ggx_visible_normal(local_wo, alpha, u)),
-            Bsdf::Dielectric { .. } => unreachable!("sampled above"),
+            Bsdf::Dielectric { .. } | Bsdf::ThinDielectric { .. } => unreachable!("sampled above"),
             Bsdf::Mirror { reflectance } => {
                 let wi = Vec3::new(-local_wo.x, -local_wo.y, local_wo.z);
                 return Some(BsdfSample { wi: back(wi), value: reflectance / wi.z, pdf: 1.0, delta: true });
@@ -130,7 +136,7 @@ impl Bsdf {
     /// Whether every direction the model scatters to is a Dirac delta, so
     /// that sampling lights from its surfaces is pointless.
     pub fn is_delta(&self) -> bool {
-        matches!(self, Bsdf::Mirror { .. } | Bsdf::Dielectric { .. })
+        matches!(self, Bsdf::Mirror { .. } | Bsdf::Dielectric { .. } | Bsdf::ThinDielectric { .. })
     }
 }
 
@@ -170,6 +176,26 @@ fn sample_dielectric(wo: Vec3, ior: f32, tint: Vec3, u: f32) -> BsdfSample {
     BsdfSample { wi, value, pdf: transmittance, delta: true }
 }
 
+/// Reflects or passes straight through a thin dielectric sheet. The sheet
+/// reflects R + T²R / (1 − R²) of the light, counting the reflections inside
+/// it, with R the Fresnel reflectance and T = 1 − R (pbrt-v4's
+/// `ThinDielectricBxDF`); the rest goes through, tinted, with no change of
+/// direction and so no change of radiance.
+fn sample_thin_dielectric(wo: Vec3, ior: f32, tint: Vec3, u: f32) -> BsdfSample {
+    let cos_i = wo.z.abs();
+    let mut reflectance = fresnel_dielectric(cos_i, ior);
+    if reflectance < 1.0 {
+        let transmittance = 1.0 - reflectance;
+        reflectance += transmittance * transmittance * reflectance / (1.0 - reflectance * reflectance);
+    }
+    if u < reflectance {
+        let wi = Vec3::new(-wo.x, -wo.y, wo.z);
+        return BsdfSample { wi, value: Vec3::splat(reflectance / cos_i), pdf: reflectance, delta: true };
+    }
+    let transmittance = 1.0 - reflectance;
+    BsdfSample { wi: -wo, value: tint * (transmittance / cos_i), pdf: transmittance, delta: true }
+}
+
 impl Bsdf {
     /// The model's reflectance for light from straight above, a cheap
     /// measure of how much it scatters (to choose between lobes).
@@ -178,7 +204,7 @@ impl Bsdf {
             Bsdf::Lambert { albedo } => albedo,
             Bsdf::Mirror { reflectance } | Bsdf::Glossy { reflectance, .. } => reflectance,
             Bsdf::MetallicRoughness { base_color, .. } => base_color,
-            Bsdf::Dielectric { tint, .. } => tint,
+            Bsdf::Dielectric { tint, .. } | Bsdf::ThinDielectric { tint, .. } => tint,
         }
     }
 }
@@ -370,6 +396,23 @@ mod tests {
         let mirror = Bsdf::Mirror { reflectance: Vec3::splat(0.9) }.sample(direction(0.7), Vec2::ZERO).unwrap();
         assert!((mirror.value * mirror.wi.z / mirror.pdf - Vec3::splat(0.9)).abs().max_element() < 1e-6);
         assert!((mirror.wi - Vec3::new(-0.7f32.sin(), 0.0, 0.7f32.cos())).length() < 1e-6);
+    }
+
+    #[test]
+    fn thin_dielectric_passes_light_straight_through_and_loses_none() {
+        let sheet = Bsdf::ThinDielectric { ior: 1.5, tint: Vec3::ONE };
+        for theta in [0.0f32, 0.7, 1.3] {
+            let wo = direction(theta);
+            let through = sheet.sample(wo, Vec2::new(0.999, 0.0)).unwrap();
+            assert!((through.wi + wo).length() < 1e-6);
+            let back = sheet.sample(wo, Vec2::ZERO).unwrap();
+            let weight = |s: &BsdfSample| s.value.x * s.wi.z.abs() / s.pdf;
+            assert!((weight(&through) - 1.0).abs() < 1e-5 && (weight(&back) - 1.0).abs() < 1e-5);
+            // Two surfaces reflect more than one: 2R / (1 + R) at normal incidence.
+            assert!(back.pdf >= fresnel_dielectric(theta.cos(), 1.5));
+        }
+        let normal = sheet.sample(Vec3::Z, Vec2::ZERO).unwrap();
+        assert!((normal.pdf - 2.0 * 0.04 / 1.04).abs() < 1e-6);
     }
 
     #[test]

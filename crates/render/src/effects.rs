@@ -142,6 +142,11 @@ fn names(materials: &[&Material]) -> String {
     if list.len() > 4 { format!("{shown} and {} more", list.len() - 4) } else { shown }
 }
 
+/// `verb` in the singular for one subject, else its plural (the form without the final s).
+fn agree(n: usize, verb: &str) -> &str {
+    if n == 1 { verb } else { verb.strip_suffix('s').unwrap_or(verb) }
+}
+
 fn count(n: usize, what: &str) -> String {
     format!("{n} {what}{}", if n == 1 { "" } else { "s" })
 }
@@ -157,7 +162,10 @@ pub(crate) fn is_glossy(m: &Material) -> bool {
 pub(crate) fn transmits(m: &Material) -> bool {
     match m.model {
         SurfaceModel::DiffuseSpecular => m.transmission > 0.0,
-        SurfaceModel::MetallicRoughness => m.transmission > 0.0 && m.metallic < 1.0,
+        // A metallic-roughness texture can make parts of a "metal" dielectric.
+        SurfaceModel::MetallicRoughness => {
+            m.transmission > 0.0 && (m.metallic < 1.0 || m.metallic_roughness_texture.is_some())
+        }
     }
 }
 
@@ -206,7 +214,12 @@ impl EffectPlan {
         let emission = if !lighting {
             decide(Effect::Emission, false, not_lit())
         } else if emissive_triangles > 0 {
-            let reason = format!("{} of {} emit", count(emissive_triangles, "triangle"), names(&emitters));
+            let reason = format!(
+                "{} of {} {}",
+                count(emissive_triangles, "triangle"),
+                names(&emitters),
+                agree(emissive_triangles, "emits")
+            );
             decide(Effect::Emission, true, reason)
         } else {
             decide(Effect::Emission, false, "no material emits".into())
@@ -214,15 +227,21 @@ impl EffectPlan {
 
         let lights = scene.lights.len();
         let environment_given = settings.environment.is_some();
-        let default_environment = lighting && !environment_given && lights == 0 && emissive_triangles == 0;
+        // Emission through a texture is how glTF models glowing details (a
+        // helmet's displays), not how they light a scene; such scenes are
+        // meant to be seen under an environment.
+        let lit_by_emitters = emitters.iter().any(|m| m.emission_texture.is_none());
+        let default_environment = lighting && !environment_given && lights == 0 && !lit_by_emitters;
         let environment = if !lighting {
             decide(Effect::Environment, false, not_lit())
         } else if environment_given {
             decide(Effect::Environment, true, "an environment is set".into())
         } else if default_environment {
-            let reason = "the scene has no lights or emitters, so a uniform white sky (radiance 1) lights it; \
-                          --environment chooses another";
-            decide(Effect::Environment, true, reason.into())
+            let what = if emissive_triangles > 0 { "lights or untextured emitters" } else { "lights or emitters" };
+            let reason = format!(
+                "the scene has no {what}, so a uniform white sky (radiance 1) lights it; --environment chooses another"
+            );
+            decide(Effect::Environment, true, reason)
         } else {
             decide(Effect::Environment, false, "no environment is set (--environment sets one)".into())
         };
@@ -250,7 +269,7 @@ impl EffectPlan {
         let reflective: Vec<&Material> = used
             .iter()
             .copied()
-            .filter(|m| m.base_color.max_element() > 0.0 || m.specular.max_element() > 0.0)
+            .filter(|m| m.base_color.max_element() > 0.0 || m.specular.max_element() > 0.0 || transmits(m))
             .collect();
         let max_depth = settings.max_depth;
         let indirect = if integrator != Integrator::Path {
@@ -260,7 +279,7 @@ impl EffectPlan {
         } else if !(direct || emission || environment) {
             decide(Effect::Indirect, false, "there is no light to bounce".into())
         } else if reflective.is_empty() {
-            decide(Effect::Indirect, false, "no surface reflects light".into())
+            decide(Effect::Indirect, false, "no surface reflects or transmits light".into())
         } else {
             decide(
                 Effect::Indirect,
@@ -278,7 +297,12 @@ impl EffectPlan {
             decide(
                 Effect::Glossy,
                 true,
-                format!("{} reflect specularly: {}", count(glossy.len(), "material"), names(&glossy)),
+                format!(
+                    "{} {} specularly: {}",
+                    count(glossy.len(), "material"),
+                    agree(glossy.len(), "reflects"),
+                    names(&glossy)
+                ),
             );
         }
 
@@ -288,7 +312,8 @@ impl EffectPlan {
         } else if refracting.is_empty() {
             decide(Effect::Refraction, false, "no material transmits".into());
         } else {
-            let reason = format!("{} transmit: {}", count(refracting.len(), "material"), names(&refracting));
+            let n = refracting.len();
+            let reason = format!("{} {}: {}", count(n, "material"), agree(n, "transmits"), names(&refracting));
             decide(Effect::Refraction, true, reason);
         }
 
@@ -322,7 +347,7 @@ impl EffectPlan {
             decide(
                 Effect::Alpha,
                 true,
-                format!("{} cut out or blend: {}", count(masked.len(), "material"), names(&masked)),
+                format!("{} with alpha (mask or blend): {}", count(masked.len(), "material"), names(&masked)),
             );
         }
 

@@ -7,7 +7,7 @@
 //! as one with the effect forced on: the images agree, which the tests check.
 
 use rtgi_accel::{Accel, Hit};
-use rtgi_math::{Frame, Ray, Rng, SurfacePoint, Vec2, Vec3, Vec4};
+use rtgi_math::{Frame, Ray, Rng, SurfacePoint, Vec2, Vec3, Vec4, geometric_normal};
 use rtgi_scene::{Material, Scene, SurfaceModel, Triangle};
 
 use crate::bsdf::Bsdf;
@@ -104,7 +104,7 @@ impl DirectStrategy {
 rtgi_math::named_choices!(DirectStrategy, "direct-light strategy");
 
 /// Bounces after which Russian roulette may end a path.
-const ROULETTE_AFTER: u32 = 3;
+const ROULETTE_AFTER: u32 = 2;
 
 /// GGX widths below this are treated as perfect mirrors (metals) or clamped
 /// (dielectrics): narrower lobes only add fireflies in f32.
@@ -133,6 +133,8 @@ pub(crate) struct Transport<'a, A: Accel + ?Sized> {
     glossy: bool,
     refraction: bool,
     normal_maps: bool,
+    /// Unit geometric normal of every triangle.
+    normals: Vec<Vec3>,
 }
 
 /// A surface hit, ready to scatter light.
@@ -176,6 +178,11 @@ impl<'a, A: Accel + ?Sized> Transport<'a, A> {
             glossy: plan.has(Effect::Glossy),
             refraction: plan.has(Effect::Refraction),
             normal_maps: plan.has(Effect::NormalMaps),
+            normals: scene
+                .triangles
+                .iter()
+                .map(|t| geometric_normal(&t.vertices.map(|v| scene.vertices[v as usize].position)))
+                .collect(),
         }
     }
 
@@ -204,6 +211,8 @@ impl<'a, A: Accel + ?Sized> Transport<'a, A> {
         // The density of the BSDF sample that produced `ray`; None for the
         // camera ray and specular bounces, whose emitters count in full.
         let mut previous_pdf: Option<f32> = None;
+        // The product of the η² of the refractions so far (pbrt's etaScale).
+        let mut radiance_scale = 1.0f32;
         let mut depth = 0;
         loop {
             let u: [f32; dim::COUNT] = std::array::from_fn(|_| rng.next_f32());
@@ -240,7 +249,7 @@ impl<'a, A: Accel + ?Sized> Transport<'a, A> {
             let interaction = self.interact::<S>(&hit, triangle, material, u[dim::LOBE]);
             let (frame, bsdf) = (&interaction.frame, &interaction.bsdf);
             let wo_local = frame.to_local(wo);
-            let reflects_only = !matches!(bsdf, Bsdf::Dielectric { .. });
+            let reflects_only = !matches!(bsdf, Bsdf::Dielectric { .. } | Bsdf::ThinDielectric { .. });
             let geometric = interaction.point.normal;
             let wo_side = wo.dot(geometric);
 
@@ -278,10 +287,19 @@ impl<'a, A: Accel + ?Sized> Transport<'a, A> {
                 break;
             }
             throughput *= interaction.weight * sample.value * (sample.wi.z.abs() / sample.pdf);
+            if let Bsdf::Dielectric { ior, .. } = *bsdf
+                && sample.wi.z * wo_local.z < 0.0
+            {
+                // Refraction scaled the radiance by 1/η²; the roulette must
+                // not see that, or paths inside glass die for nothing.
+                radiance_scale *= if wo_local.z > 0.0 { ior * ior } else { 1.0 / (ior * ior) };
+            }
             previous_pdf = (!sample.delta).then_some(sample.pdf);
             depth += 1;
-            if depth >= ROULETTE_AFTER {
-                let survival = throughput.max_element().min(0.95);
+            // Russian roulette ends paths that carry little, in proportion;
+            // paths that lose nothing (mirrors, glass) are left to the depth limit.
+            let survival = (throughput * radiance_scale).max_element();
+            if depth >= ROULETTE_AFTER && survival < 1.0 {
                 if u[dim::ROULETTE] >= survival {
                     break;
                 }
@@ -316,7 +334,8 @@ impl<'a, A: Accel + ?Sized> Transport<'a, A> {
     fn interact<const S: u32>(&self, hit: &Hit, triangle: &Triangle, material: &Material, u_lobe: f32) -> Interaction {
         let scene = self.scene;
         let corners = triangle.vertices.map(|v| scene.vertices[v as usize].position);
-        let point = SurfacePoint::on_triangle(&corners, hit.beta, hit.gamma);
+        let point =
+            SurfacePoint::on_triangle_with_normal(&corners, hit.beta, hit.gamma, self.normals[hit.triangle as usize]);
         let mut normal = scene.interpolate(triangle, hit.beta, hit.gamma, |v| v.normal);
         let mut base_color = material.base_color;
         let mut roughness = material.roughness;
@@ -376,11 +395,14 @@ impl<'a, A: Accel + ?Sized> Transport<'a, A> {
             0.0
         };
         if u < transmission {
-            let tint = match material.model {
-                SurfaceModel::DiffuseSpecular => Vec3::ONE,
-                SurfaceModel::MetallicRoughness => base_color,
+            let ior = material.ior.max(1.0 + 1e-4);
+            // MTL's refracting materials are solid glass; glTF's transmission
+            // without KHR_materials_volume is a thin-walled surface.
+            let lobe = match material.model {
+                SurfaceModel::DiffuseSpecular => Bsdf::Dielectric { ior, tint: Vec3::ONE },
+                SurfaceModel::MetallicRoughness => Bsdf::ThinDielectric { ior, tint: base_color },
             };
-            return (Bsdf::Dielectric { ior: material.ior.max(1.0 + 1e-4), tint }, Vec3::ONE);
+            return (lobe, Vec3::ONE);
         }
         if !self.glossy || !is_glossy(material) {
             return lambert;

@@ -407,7 +407,7 @@ impl LightSet {
                 // Uniform on the triangle (the square-root warp of Turk 1990).
                 let s = u.x.sqrt();
                 let (beta, gamma) = (s * (1.0 - u.y), s * u.y);
-                let target = SurfacePoint::on_triangle(&emitter.corners, beta, gamma);
+                let target = SurfacePoint::on_triangle_with_normal(&emitter.corners, beta, gamma, emitter.normal);
                 let offset = target.position - p;
                 let distance2 = offset.length_squared();
                 let wi = offset / distance2.sqrt();

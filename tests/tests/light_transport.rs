@@ -1,0 +1,282 @@
+//! Light transport converges to what physics says: furnaces (closed
+//! emitting spheres and BSDFs under a uniform sky), a point light's
+//! analytic irradiance, and the effects planner's promise that leaving an
+//! effect out changes nothing where the scene does not need it.
+
+use std::f32::consts::PI;
+
+use rtgi_accel::{AccelKind, BuildParams};
+use rtgi_image::HdrImage;
+use rtgi_math::{Vec2, Vec3};
+use rtgi_render::probes::icosphere;
+use rtgi_render::{
+    CameraRays, DirectStrategy, Effect, EffectOverrides, EffectPlan, Environment, Integrator, PixelSampler,
+    RenderSettings, render,
+};
+use rtgi_scene::{Camera, Light, LightKind, Material, MeshBuilder, Scene, SurfaceModel};
+
+/// A unit icosphere of one material with flat normals, its faces wound to
+/// face outwards or (for a furnace seen from inside) inwards.
+fn sphere_scene(material: Material, inward: bool) -> Scene {
+    let sphere = icosphere(3);
+    let mut scene = Scene { materials: vec![material], ..Scene::default() };
+    let mut builder = MeshBuilder::new(sphere.vertices.clone(), Vec::new(), Vec::new()).with_flat_normals();
+    for face in &sphere.faces {
+        let [a, b, c] = face.map(|i| sphere.vertices[i as usize]);
+        let outward = (b - a).cross(c - a).dot(a + b + c) > 0.0;
+        let face = if outward == inward { [face[0], face[2], face[1]] } else { *face };
+        builder.push(face, None, None, 0);
+    }
+    builder.finish_into(&mut scene);
+    scene
+}
+
+fn render_scene(scene: &Scene, camera: &Camera, settings: &RenderSettings) -> HdrImage {
+    let accel = AccelKind::Sah.build(&scene.triangle_positions(), &BuildParams::default());
+    render(scene, accel.as_ref(), camera, settings, &|_| {}).0
+}
+
+fn mean_and_extremes(image: &HdrImage) -> (f32, f32, f32) {
+    let values: Vec<f32> = image.pixels().iter().map(|p| p.x).collect();
+    let mean = values.iter().sum::<f32>() / values.len() as f32;
+    let min = values.iter().copied().fold(f32::INFINITY, f32::min);
+    let max = values.iter().copied().fold(f32::NEG_INFINITY, f32::max);
+    (mean, min, max)
+}
+
+#[test]
+fn white_furnace_converges_to_emission_over_one_minus_albedo() {
+    // Inside a closed sphere whose walls reflect ρ and emit Le, radiance is
+    // Le (1 + ρ + ρ² + ...) = Le / (1 - ρ) everywhere, whatever the
+    // direct-light strategy.
+    let (albedo, emitted) = (0.6, 0.4);
+    let expected = emitted / (1.0 - albedo);
+    let wall = Material {
+        name: "furnace".into(),
+        base_color: Vec3::splat(albedo),
+        emission: Vec3::splat(emitted),
+        ..Material::default()
+    };
+    let scene = sphere_scene(wall, true);
+    let camera = Camera::look_at(Vec3::new(0.1, -0.2, 0.05), Vec3::new(1.0, 0.3, -2.0), Vec3::Y, 1.2);
+    for strategy in DirectStrategy::ALL.iter().copied() {
+        let settings = RenderSettings {
+            width: 24,
+            height: 24,
+            samples_per_pixel: 64,
+            sampler: PixelSampler::Stratified,
+            max_depth: 1000,
+            direct_strategy: strategy,
+            ..RenderSettings::default()
+        };
+        let (mean, min, max) = mean_and_extremes(&render_scene(&scene, &camera, &settings));
+        println!("furnace, {strategy}: mean {mean}, pixels {min}..{max}, expected {expected}");
+        assert!((mean - expected).abs() < 0.01 * expected, "{strategy}: mean {mean}, expected {expected}");
+        // Single pixels are noisy (64 samples); the check is for gross failures (black, NaN, doubled).
+        assert!(min > 0.6 * expected && max < 1.4 * expected, "{strategy}: pixels {min}..{max}");
+    }
+}
+
+#[test]
+fn every_bsdf_passes_a_furnace_under_a_white_sky() {
+    // A convex object under a uniform sky of radiance 1 looks like the sky
+    // when its BSDF loses no energy: lossless models give 1 everywhere,
+    // rough GGX less by its single-scattering loss (a few per cent at this
+    // roughness), never more.
+    let white = Vec3::ONE;
+    let gltf = |metallic: f32, roughness: f32, transmission: f32| Material {
+        model: SurfaceModel::MetallicRoughness,
+        base_color: white,
+        metallic,
+        roughness,
+        transmission,
+        ..Material::default()
+    };
+    // (name, material, lowest and highest mean): lossless models give 1;
+    // rough GGX loses its single-scattering share (about 6% for a white
+    // metal at roughness 0.5); glTF's dielectric model, a Lambert base under
+    // a Fresnel-weighted GGX lobe, balances energy only approximately.
+    let lossless = (0.99, 1.005);
+    let cases: Vec<(&str, Material, (f32, f32))> = vec![
+        ("lambert", Material { base_color: white, ..Material::default() }, lossless),
+        (
+            "mirror",
+            Material { base_color: Vec3::ZERO, specular: white, roughness: 0.0, ..Material::default() },
+            lossless,
+        ),
+        (
+            "solid glass",
+            Material { base_color: Vec3::ZERO, transmission: 1.0, ior: 1.5, ..Material::default() },
+            lossless,
+        ),
+        ("thin glass", gltf(0.0, 0.0, 1.0), lossless),
+        ("smooth metal", gltf(1.0, 0.0, 0.0), lossless),
+        ("rough metal", gltf(1.0, 0.5, 0.0), (0.9, 1.005)),
+        ("rough dielectric", gltf(0.0, 0.5, 0.0), (0.95, 1.02)),
+    ];
+    let camera = Camera::look_at(Vec3::new(0.0, 0.5, 4.0), Vec3::ZERO, Vec3::Y, 0.6);
+    for (name, material, (lowest, highest)) in cases {
+        let scene = sphere_scene(material, false);
+        let settings = RenderSettings {
+            width: 24,
+            height: 24,
+            samples_per_pixel: 32,
+            sampler: PixelSampler::Stratified,
+            max_depth: 64,
+            environment: Some(Environment::Uniform(Vec3::ONE)),
+            ..RenderSettings::default()
+        };
+        let (mean, min, max) = mean_and_extremes(&render_scene(&scene, &camera, &settings));
+        println!("{name}: mean {mean}, pixels {min}..{max}");
+        assert!(mean >= lowest && mean <= highest, "{name}: mean {mean}, expected {lowest}..{highest}");
+        // Single pixels of 32 samples are noisy; this catches gross failures.
+        assert!(min > lowest - 0.35 && max < highest + 0.35, "{name}: pixels {min}..{max}");
+    }
+}
+
+#[test]
+fn diffuse_plane_under_a_point_light_matches_the_analytic_irradiance() {
+    // L = ρ/π · I cos θ / d² at every pixel; with a point light and pixel
+    // centres nothing is random, so the match is to rounding.
+    let albedo = 0.6;
+    let light_position = Vec3::new(0.3, -0.2, 2.0);
+    let intensity = 5.0;
+    let mut scene = Scene {
+        materials: vec![Material { base_color: Vec3::splat(albedo), ..Material::default() }],
+        lights: vec![Light {
+            name: "bulb".into(),
+            kind: LightKind::Point,
+            position: light_position,
+            direction: Vec3::NEG_Z,
+            color: Vec3::ONE,
+            intensity,
+            range: None,
+        }],
+        ..Scene::default()
+    };
+    let corners = vec![
+        Vec3::new(-10.0, -10.0, 0.0),
+        Vec3::new(10.0, -10.0, 0.0),
+        Vec3::new(10.0, 10.0, 0.0),
+        Vec3::new(-10.0, 10.0, 0.0),
+    ];
+    let mut builder = MeshBuilder::new(corners, Vec::new(), Vec::new());
+    builder.push([0, 1, 2], None, None, 0);
+    builder.push([0, 2, 3], None, None, 0);
+    builder.finish_into(&mut scene);
+    let camera = Camera::look_at(Vec3::new(0.0, 0.0, 5.0), Vec3::ZERO, Vec3::Y, 1.0);
+    let (width, height) = (32, 32);
+    for integrator in [Integrator::Direct, Integrator::Path] {
+        let settings =
+            RenderSettings { width, height, integrator, sampler: PixelSampler::Center, ..RenderSettings::default() };
+        let image = render_scene(&scene, &camera, &settings);
+        let rays = CameraRays::new(&camera, width, height);
+        let mut worst = 0.0f32;
+        for y in 0..height {
+            for x in 0..width {
+                let ray = rays.ray(x, y, Vec2::splat(0.5));
+                let p = ray.at(-ray.origin.z / ray.direction.z);
+                let to_light = light_position - p;
+                let irradiance = intensity * to_light.normalize().z / to_light.length_squared();
+                let expected = albedo / PI * irradiance;
+                let error = (image.get(x, y).x - expected).abs() / expected;
+                worst = worst.max(error);
+            }
+        }
+        println!("{integrator}: largest relative error {worst}");
+        assert!(worst < 1e-4, "{integrator}: relative error {worst}");
+    }
+}
+
+fn cornell_box() -> (Scene, Camera) {
+    let scene = Scene::load(&rtgi_tests::workspace_root().join("scenes/cornell-box.toml")).unwrap();
+    let camera = scene.cameras[0];
+    (scene, camera)
+}
+
+/// Renders with the plan and with each effect the plan leaves out forced
+/// on; the images must agree (the same paths, the same random numbers).
+fn assert_omissions_change_nothing(scene: &Scene, camera: &Camera, settings: &RenderSettings) -> usize {
+    let planned = render_scene(scene, camera, settings);
+    let plan = EffectPlan::new(scene, settings);
+    let omitted: Vec<Effect> = plan.omitted().collect();
+    for &effect in &omitted {
+        if effect == Effect::Indirect && settings.integrator != Integrator::Path {
+            continue;
+        }
+        let forced = RenderSettings { effects: EffectOverrides { on: vec![effect], off: vec![] }, ..settings.clone() };
+        assert!(EffectPlan::new(scene, &forced).has(effect));
+        let image = render_scene(scene, camera, &forced);
+        let worst = planned
+            .pixels()
+            .iter()
+            .zip(image.pixels())
+            .map(|(a, b)| ((*a - *b).abs() / a.abs().max(Vec3::splat(1e-3))).max_element())
+            .fold(0.0f32, f32::max);
+        println!("+{effect}: largest relative difference {worst}");
+        assert!(worst < 1e-4, "forcing {effect} on changed the image by {worst}");
+    }
+    omitted.len()
+}
+
+#[test]
+fn effects_the_plan_omits_change_nothing_when_forced_on() {
+    let (scene, camera) = cornell_box();
+    for integrator in [Integrator::Path, Integrator::Direct] {
+        let settings = RenderSettings {
+            width: 40,
+            height: 40,
+            samples_per_pixel: 4,
+            sampler: PixelSampler::Stratified,
+            integrator,
+            ..RenderSettings::default()
+        };
+        let omitted = assert_omissions_change_nothing(&scene, &camera, &settings);
+        assert!(omitted >= 5, "the Cornell box needs no textures, alpha, glossy, refraction or environment");
+    }
+    // A textured glTF model: different omissions (no emission, no alpha...).
+    if let Some(path) = rtgi_tests::shared_scene("gltf/BoxTextured/glTF/BoxTextured.gltf") {
+        let scene = Scene::load(&path).unwrap();
+        let camera = Camera::look_at(Vec3::new(1.5, 1.2, 2.5), Vec3::ZERO, Vec3::Y, 0.8);
+        let settings = RenderSettings { width: 32, height: 32, samples_per_pixel: 4, ..RenderSettings::default() };
+        assert!(EffectPlan::new(&scene, &settings).has(Effect::Textures));
+        assert_omissions_change_nothing(&scene, &camera, &settings);
+        // Forcing a needed effect off does change the image.
+        let untextured =
+            RenderSettings { effects: EffectOverrides { on: vec![], off: vec![Effect::Textures] }, ..settings.clone() };
+        let a = render_scene(&scene, &camera, &settings);
+        let b = render_scene(&scene, &camera, &untextured);
+        assert!(rtgi_image::compare(&a, &b).unwrap().max_abs > 0.05);
+    }
+}
+
+#[test]
+fn plans_name_what_each_scene_needs() {
+    let (scene, _) = cornell_box();
+    let plan = EffectPlan::new(&scene, &RenderSettings::default());
+    for effect in [Effect::Emission, Effect::DirectLight, Effect::Indirect] {
+        assert!(plan.has(effect), "{plan}");
+    }
+    for effect in [Effect::Glossy, Effect::Refraction, Effect::Textures, Effect::Alpha, Effect::Environment] {
+        assert!(!plan.has(effect), "{plan}");
+    }
+    let text = plan.to_string();
+    assert!(text.contains("+ emission") && text.contains("'light'"), "{text}");
+    assert!(text.contains("- glossy        every material is diffuse"), "{text}");
+    // The primary integrator needs no light at all.
+    let primary = EffectPlan::new(&scene, &RenderSettings { integrator: Integrator::Primary, ..Default::default() });
+    assert!(!primary.has(Effect::DirectLight) && !primary.has(Effect::Indirect));
+    // Without lights or emitters, a white sky lights the scene, and says so.
+    let mut dark = scene.clone();
+    for m in &mut dark.materials {
+        m.emission = Vec3::ZERO;
+    }
+    let plan = EffectPlan::new(&dark, &RenderSettings::default());
+    assert!(plan.default_environment && plan.has(Effect::Environment), "{plan}");
+    assert!(plan.to_string().contains("uniform white sky"));
+    // Forcing shows in the plan.
+    let forced = RenderSettings { effects: "+glossy,-indirect".parse().unwrap(), ..Default::default() };
+    let plan = EffectPlan::new(&scene, &forced);
+    assert!(plan.has(Effect::Glossy) && !plan.has(Effect::Indirect) && plan.max_depth == 1);
+    assert!(plan.to_string().contains("+!glossy"), "{plan}");
+}
