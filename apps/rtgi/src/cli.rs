@@ -36,6 +36,43 @@ pub(crate) enum Command {
     Info(InfoArgs),
     /// Measure how far an EXR image is from a reference EXR image (RMSE, relative MSE, max)
     Compare(CompareArgs),
+    /// Measure what each effect costs: render time with effects forced on and off, and how the image changes
+    BenchEffects(BenchEffectsArgs),
+}
+
+/// `rtgi bench-effects`: the time each effect of the plan costs or saves.
+#[derive(Debug, Args)]
+pub(crate) struct BenchEffectsArgs {
+    /// Scene file (.obj, .gltf, .glb or .toml); the built-in Cornell box when omitted
+    pub(crate) scene: Option<PathBuf>,
+
+    #[command(flatten)]
+    pub(crate) size: ImageSize,
+
+    /// Samples per pixel of each render
+    #[arg(long, default_value_t = 8, value_parser = clap::value_parser!(u32).range(1..=1_048_576))]
+    pub(crate) spp: u32,
+
+    /// Timed renders per row; the median is reported
+    #[arg(long, default_value_t = 3, value_parser = clap::value_parser!(u32).range(1..=1000))]
+    pub(crate) repeats: u32,
+
+    /// Worker threads [default: one per core]
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1024))]
+    pub(crate) threads: Option<u32>,
+
+    #[command(flatten)]
+    pub(crate) lighting: LightingArgs,
+
+    #[command(flatten)]
+    pub(crate) accel: AccelArgs,
+
+    #[command(flatten)]
+    pub(crate) camera: CameraArgs,
+
+    /// Also write the results as JSON to this file
+    #[arg(long)]
+    pub(crate) json: Option<PathBuf>,
 }
 
 /// `rtgi compare`: the error of an image against a reference.

@@ -8,6 +8,7 @@ mod cli;
 mod common;
 mod debug_cmd;
 mod default_scene;
+mod effects_cmd;
 mod info_cmd;
 mod render_cmd;
 mod trace_cmd;
@@ -30,6 +31,7 @@ pub fn main() -> ExitCode {
         cli::Command::Heatmap(args) => debug_cmd::heatmap(&args),
         cli::Command::Info(args) => info_cmd::run(&args),
         cli::Command::Compare(args) => info_cmd::compare(&args),
+        cli::Command::BenchEffects(args) => effects_cmd::run(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -280,7 +280,13 @@ impl LightSet {
         }
         let mut source_of_triangle = Vec::new();
         if emission {
-            let texture_mean: Vec<Vec3> = scene.textures.iter().map(|t| t.average().truncate()).collect();
+            // Mean emission textures, for the lights' power: only those of emitters (averaging is a pass over every texel).
+            let mut texture_mean: Vec<Option<Vec3>> = vec![None; scene.textures.len()];
+            for m in scene.materials.iter().filter(|m| m.is_emissive()) {
+                if let Some(t) = m.emission_texture {
+                    texture_mean[t.0 as usize] = Some(scene.textures[t.0 as usize].average().truncate());
+                }
+            }
             for (index, triangle) in scene.triangles.iter().enumerate() {
                 let material = &scene.materials[triangle.material as usize];
                 if !material.is_emissive() {
@@ -292,7 +298,7 @@ impl LightSet {
                 if !(area > 0.0 && area.is_finite()) {
                     continue;
                 }
-                let mean = material.emission_texture.map_or(Vec3::ONE, |t| texture_mean[t.0 as usize]);
+                let mean = material.emission_texture.and_then(|t| texture_mean[t.0 as usize]).unwrap_or(Vec3::ONE);
                 // Emitters shine from their front face (by winding), as in pbrt and
                 // Mitsuba; glTF's double-sided materials shine from both.
                 let two_sided = material.double_sided && material.model == SurfaceModel::MetallicRoughness;

@@ -1,0 +1,131 @@
+//! `rtgi bench-effects`: what the effects planner's decisions are worth.
+//!
+//! The scene is rendered with its plan, then once per effect with that
+//! effect's decision reversed: omitted effects forced on (the time that
+//! specialising saves; the image must not change) and simulated effects
+//! forced off (the time the effect costs, and how much the image changes
+//! without it). Every render uses the same seed, so differences are the
+//! effects', not noise.
+
+use std::time::Instant;
+
+use anyhow::Result;
+use rtgi_image::{Difference, HdrImage, compare};
+use rtgi_render::{Effect, EffectPlan, RenderSettings, render};
+use serde::Serialize;
+
+use crate::cli::BenchEffectsArgs;
+use crate::common::{LoadedScene, apply_lighting, check_output_folder, choose_camera, load_scene, thread_pool};
+
+#[derive(Debug, Serialize)]
+struct Row {
+    /// `plan`, `+effect` or `-effect`.
+    label: String,
+    median_ms: f64,
+    /// Median time over the plan's median time.
+    relative_time: f64,
+    /// Difference from the planned render (same seed); None for the plan itself.
+    difference: Option<Difference>,
+}
+
+#[derive(Debug, Serialize)]
+struct Report {
+    scene: String,
+    width: u32,
+    height: u32,
+    samples_per_pixel: u32,
+    threads: usize,
+    repeats: u32,
+    plan: String,
+    rows: Vec<Row>,
+}
+
+pub(crate) fn run(args: &BenchEffectsArgs) -> Result<()> {
+    if let Some(json) = &args.json {
+        check_output_folder(json)?;
+    }
+    let LoadedScene { mut scene, name, .. } = load_scene(args.scene.as_deref())?;
+    let mut settings = RenderSettings {
+        width: args.size.width,
+        height: args.size.height,
+        samples_per_pixel: args.spp,
+        sampler: rtgi_render::PixelSampler::Stratified,
+        ..RenderSettings::default()
+    };
+    apply_lighting(&args.lighting, &mut scene, &mut settings)?;
+    let plan = EffectPlan::new(&scene, &settings);
+    print!("{plan}");
+
+    let pool = thread_pool(args.threads)?;
+    let accel = pool.install(|| args.accel.build(&scene));
+    let camera = choose_camera(&scene, accel.as_ref(), &args.camera, args.size.aspect())?;
+    let measure = |settings: &RenderSettings| -> (f64, HdrImage) {
+        let mut times = Vec::new();
+        let mut image = None;
+        for _ in 0..args.repeats {
+            let start = Instant::now();
+            let (rendered, _) = pool.install(|| render(&scene, accel.as_ref(), &camera, settings, &|_| {}));
+            times.push(start.elapsed().as_secs_f64() * 1e3);
+            image = Some(rendered);
+        }
+        times.sort_by(f64::total_cmp);
+        (times[times.len() / 2], image.expect("at least one repeat"))
+    };
+
+    eprintln!("measuring the plan ...");
+    let (planned_ms, planned) = measure(&settings);
+    let mut rows = vec![Row { label: "plan".into(), median_ms: planned_ms, relative_time: 1.0, difference: None }];
+    // Effects the user forced stay as forced; every other decision is reversed once.
+    for entry in plan.effects.iter().filter(|e| !e.forced) {
+        let effect: Effect = entry.effect;
+        let mut overrides = settings.effects.clone();
+        let label = if entry.enabled {
+            overrides.off.push(effect);
+            format!("-{effect}")
+        } else {
+            overrides.on.push(effect);
+            format!("+{effect}")
+        };
+        let reversed = RenderSettings { effects: overrides, ..settings.clone() };
+        // Reversing an effect that depends on another may change nothing (normal maps without textures).
+        if EffectPlan::new(&scene, &reversed).has(effect) == entry.enabled {
+            continue;
+        }
+        eprintln!("measuring {label} ...");
+        let (ms, image) = measure(&reversed);
+        rows.push(Row { label, median_ms: ms, relative_time: ms / planned_ms, difference: compare(&image, &planned) });
+    }
+
+    println!(
+        "{name}: {}x{} at {} spp, {} threads, median of {}",
+        settings.width,
+        settings.height,
+        settings.samples_per_pixel,
+        pool.current_num_threads(),
+        args.repeats
+    );
+    println!("{:<16} {:>10} {:>9} {:>12} {:>12}", "render", "ms", "x plan", "rmse", "max diff");
+    for row in &rows {
+        let (rmse, max) = row
+            .difference
+            .map_or(("-".into(), "-".into()), |d| (format!("{:.3e}", d.rmse), format!("{:.3e}", d.max_abs)));
+        println!("{:<16} {:>10.1} {:>9.2} {:>12} {:>12}", row.label, row.median_ms, row.relative_time, rmse, max);
+    }
+    println!("+effect: an effect the plan omits, forced on (its difference must be 0: specialising only saves time)");
+    println!("-effect: an effect the plan simulates, forced off (what it costs, and what the image loses without it)");
+
+    if let Some(json) = &args.json {
+        let report = Report {
+            scene: name,
+            width: settings.width,
+            height: settings.height,
+            samples_per_pixel: settings.samples_per_pixel,
+            threads: pool.current_num_threads(),
+            repeats: args.repeats,
+            plan: plan.to_string(),
+            rows,
+        };
+        crate::common::write_atomically(json, serde_json::to_string_pretty(&report)?.as_bytes())?;
+    }
+    Ok(())
+}
