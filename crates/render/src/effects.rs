@@ -4,7 +4,7 @@
 //! Each effect is either needed by the scene (there are lights to shadow,
 //! materials that refract, textures to look up...) or not; the user can
 //! force any effect on or off with [`EffectOverrides`]. The renderer then
-//! runs code specialised to the plan ([`EffectPlan::specialisation`]):
+//! runs code specialised to the plan (one compiled version per set of effects):
 //! what the plan leaves out is compiled out, not skipped by a test per sample.
 
 use std::fmt;
