@@ -119,6 +119,11 @@ pub(crate) struct LightingArgs {
     #[arg(long, default_value = "mis")]
     pub(crate) direct_strategy: DirectStrategy,
 
+    /// Clamp the light each path brings in after two or more bounces to this value: fewer
+    /// fireflies (caustics), at the price of a bias [default: no clamp]
+    #[arg(long, value_parser = parse_positive)]
+    pub(crate) clamp_indirect: Option<f32>,
+
     /// Light from far away: a radiance R,G,B or an equirectangular .exr image
     #[arg(long, value_parser = parse_environment)]
     pub(crate) environment: Option<EnvironmentArg>,
@@ -139,6 +144,13 @@ pub(crate) struct LightingArgs {
 pub(crate) enum EnvironmentArg {
     Uniform(Vec3),
     File(PathBuf),
+}
+
+fn parse_positive(text: &str) -> Result<f32, String> {
+    text.parse::<f32>()
+        .ok()
+        .filter(|v| v.is_finite() && *v > 0.0)
+        .ok_or_else(|| format!("expected a positive number (got '{text}')"))
 }
 
 fn parse_environment(text: &str) -> Result<EnvironmentArg, String> {

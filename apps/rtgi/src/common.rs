@@ -123,6 +123,7 @@ pub(crate) fn apply_lighting(args: &LightingArgs, scene: &mut Scene, settings: &
     settings.integrator = args.integrator;
     settings.max_depth = args.max_depth;
     settings.direct_strategy = args.direct_strategy;
+    settings.indirect_clamp = args.clamp_indirect;
     settings.effects = args.effects.clone();
     settings.environment = match &args.environment {
         None => None,

@@ -130,6 +130,7 @@ pub(crate) struct Transport<'a, A: Accel + ?Sized> {
     background: Vec3,
     max_depth: u32,
     strategy: DirectStrategy,
+    indirect_clamp: Option<f32>,
     glossy: bool,
     refraction: bool,
     normal_maps: bool,
@@ -165,6 +166,7 @@ impl<'a, A: Accel + ?Sized> Transport<'a, A> {
         environment: Option<&'a Environment>,
         background: Vec3,
         strategy: DirectStrategy,
+        indirect_clamp: Option<f32>,
     ) -> Self {
         let environment = environment.filter(|_| plan.has(Effect::Environment));
         Self {
@@ -175,6 +177,7 @@ impl<'a, A: Accel + ?Sized> Transport<'a, A> {
             background,
             max_depth: plan.max_depth,
             strategy,
+            indirect_clamp,
             glossy: plan.has(Effect::Glossy),
             refraction: plan.has(Effect::Refraction),
             normal_maps: plan.has(Effect::NormalMaps),
@@ -223,7 +226,7 @@ impl<'a, A: Accel + ?Sized> Transport<'a, A> {
                         let direction = ray.direction.normalize();
                         let weight = self
                             .emitted_weight::<S>(previous_pdf, || self.lights.pdf_environment(environment, direction));
-                        radiance += throughput * environment.radiance(direction) * weight;
+                        radiance += self.clamp(depth, throughput * environment.radiance(direction) * weight);
                     }
                     _ if depth == 0 => radiance += self.background,
                     _ => {}
@@ -241,7 +244,7 @@ impl<'a, A: Accel + ?Sized> Transport<'a, A> {
                 let weight = self.emitted_weight::<S>(previous_pdf, || {
                     self.lights.pdf_emitter(hit.triangle, wo, hit.t * direction_length)
                 });
-                radiance += throughput * emitted * weight;
+                radiance += self.clamp(depth, throughput * emitted * weight);
             }
             if depth == self.max_depth {
                 break;
@@ -269,11 +272,12 @@ impl<'a, A: Accel + ?Sized> Transport<'a, A> {
                             } else {
                                 power_heuristic(light.pdf, bsdf.pdf(wo_local, wi_local))
                             };
-                            radiance += throughput
+                            let contribution = throughput
                                 * interaction.weight
                                 * f
                                 * light.radiance
                                 * (wi_local.z.abs() * weight / light.pdf);
+                            radiance += self.clamp(depth + 1, contribution);
                         }
                     }
                 }
@@ -311,6 +315,18 @@ impl<'a, A: Accel + ?Sized> Transport<'a, A> {
             ray = interaction.point.spawn_ray(wi);
         }
         radiance
+    }
+
+    /// Limits the light a path brings in after `depth` bounces (≥ 2 is
+    /// indirect light) to `indirect_clamp` in its brightest channel, if set.
+    #[inline]
+    fn clamp(&self, depth: u32, contribution: Vec3) -> Vec3 {
+        match self.indirect_clamp {
+            Some(limit) if depth >= 2 && contribution.max_element() > limit => {
+                contribution * (limit / contribution.max_element())
+            }
+            _ => contribution,
+        }
     }
 
     /// The weight of emitted light found by a BSDF-sampled ray, given the

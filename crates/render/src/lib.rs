@@ -71,6 +71,10 @@ pub struct RenderSettings {
     /// Bounces a path may take after the camera ray (1 = direct light only).
     pub max_depth: u32,
     pub direct_strategy: DirectStrategy,
+    /// Largest value (brightest channel) of the light one path brings in
+    /// after two or more bounces: removes the fireflies of caustics at the
+    /// price of a bias (darker caustics and highlights). `None` keeps every path exact.
+    pub indirect_clamp: Option<f32>,
     /// Light from far away; `None` leaves it to the planner (a white sky
     /// when the scene has no light of its own).
     pub environment: Option<Environment>,
@@ -90,6 +94,7 @@ impl Default for RenderSettings {
             integrator: Integrator::Path,
             max_depth: 8,
             direct_strategy: DirectStrategy::Mis,
+            indirect_clamp: None,
             environment: None,
             effects: EffectOverrides::default(),
         }
@@ -186,7 +191,15 @@ fn render_transport<A: Accel + ?Sized>(
     let plan = EffectPlan::new(scene, settings);
     let white_sky = Environment::Uniform(Vec3::ONE);
     let environment = if plan.default_environment { Some(&white_sky) } else { settings.environment.as_ref() };
-    let transport = Transport::new(scene, accel, &plan, environment, settings.background, settings.direct_strategy);
+    let transport = Transport::new(
+        scene,
+        accel,
+        &plan,
+        environment,
+        settings.background,
+        settings.direct_strategy,
+        settings.indirect_clamp,
+    );
     fn run<const S: u32, A: Accel + ?Sized>(
         transport: &Transport<'_, A>,
         camera: &Camera,
