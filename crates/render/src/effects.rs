@@ -170,7 +170,10 @@ pub(crate) fn transmits(m: &Material) -> bool {
 }
 
 fn is_textured(m: &Material) -> bool {
-    m.base_color_texture.is_some() || m.metallic_roughness_texture.is_some() || m.emission_texture.is_some()
+    m.base_color_texture.is_some()
+        || m.metallic_roughness_texture.is_some()
+        || m.emission_texture.is_some()
+        || m.transmission_texture.is_some()
 }
 
 impl EffectPlan {

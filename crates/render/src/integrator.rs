@@ -356,6 +356,7 @@ impl<'a, A: Accel + ?Sized> Transport<'a, A> {
         let mut base_color = material.base_color;
         let mut roughness = material.roughness;
         let mut metallic = material.metallic;
+        let mut transmission = material.transmission;
         if S & bits::TEXTURES != 0 {
             let uv = scene.interpolate(triangle, hit.beta, hit.gamma, |v| v.uv);
             let texture = |id: rtgi_scene::TextureId| scene.textures[id.0 as usize].sample(uv);
@@ -366,6 +367,9 @@ impl<'a, A: Accel + ?Sized> Transport<'a, A> {
                 let t = texture(id);
                 roughness *= t.y;
                 metallic *= t.z;
+            }
+            if let Some(id) = material.transmission_texture {
+                transmission *= texture(id).x;
             }
             if self.normal_maps
                 && let Some((id, scale)) = material.normal_texture
@@ -384,28 +388,23 @@ impl<'a, A: Accel + ?Sized> Transport<'a, A> {
         if !normal.is_finite() {
             normal = point.normal;
         }
-        let (bsdf, weight) = self.choose_bsdf::<S>(material, base_color, roughness, metallic, u_lobe);
+        let surface = SurfaceValues { base_color, roughness, metallic, transmission };
+        let (bsdf, weight) = self.choose_bsdf::<S>(material, &surface, u_lobe);
         Interaction { point, frame: Frame::from_z(normal), bsdf, weight }
     }
 
     /// The material's BSDF; layered materials choose one lobe at random
     /// (by `u`), with the weight that keeps the estimate unbiased.
-    fn choose_bsdf<const S: u32>(
-        &self,
-        material: &Material,
-        base_color: Vec3,
-        roughness: f32,
-        metallic: f32,
-        u: f32,
-    ) -> (Bsdf, Vec3) {
+    fn choose_bsdf<const S: u32>(&self, material: &Material, surface: &SurfaceValues, u: f32) -> (Bsdf, Vec3) {
+        let SurfaceValues { base_color, roughness, metallic, transmission } = *surface;
         let lambert = (Bsdf::Lambert { albedo: base_color }, Vec3::ONE);
         if S & bits::SPECULAR == 0 {
             return lambert;
         }
         let transmission = if self.refraction && transmits(material) {
             match material.model {
-                SurfaceModel::DiffuseSpecular => material.transmission,
-                SurfaceModel::MetallicRoughness => material.transmission * (1.0 - metallic),
+                SurfaceModel::DiffuseSpecular => transmission,
+                SurfaceModel::MetallicRoughness => transmission * (1.0 - metallic),
             }
         } else {
             0.0
@@ -449,6 +448,14 @@ impl<'a, A: Accel + ?Sized> Transport<'a, A> {
             }
         }
     }
+}
+
+/// A material's parameters at one point, after its textures.
+struct SurfaceValues {
+    base_color: Vec3,
+    roughness: f32,
+    metallic: f32,
+    transmission: f32,
 }
 
 /// The shading normal bent by a tangent-space normal map texel (glTF:

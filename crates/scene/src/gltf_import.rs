@@ -269,6 +269,7 @@ impl TextureTable {
             want(m.emissive_texture().map(|i| i.texture()), true);
             want(pbr.metallic_roughness_texture().map(|i| i.texture()), false);
             want(m.normal_texture().map(|n| n.texture()), false);
+            want(m.transmission().and_then(|t| t.transmission_texture()).map(|i| i.texture()), false);
         }
         let images: Vec<gltf::Image<'_>> = document.images().collect();
         let decoded: Vec<Result<Texture, String>> = wanted
@@ -330,6 +331,10 @@ fn convert_material(m: &gltf::Material<'_>, textures: &TextureTable) -> Material
         emission_texture: m.emissive_texture().and_then(|i| textures.get(i.texture(), true)),
         normal_texture: m.normal_texture().and_then(|n| textures.get(n.texture(), false).map(|t| (t, n.scale()))),
         transmission: m.transmission().map_or(0.0, |t| t.transmission_factor()),
+        transmission_texture: m
+            .transmission()
+            .and_then(|t| t.transmission_texture())
+            .and_then(|i| textures.get(i.texture(), false)),
         alpha_mode: match m.alpha_mode() {
             gltf::material::AlphaMode::Opaque => AlphaMode::Opaque,
             gltf::material::AlphaMode::Mask => AlphaMode::Mask { cutoff: m.alpha_cutoff().unwrap_or(0.5) },

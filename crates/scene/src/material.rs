@@ -20,7 +20,7 @@ use crate::TextureId;
 /// and texture, metallic and roughness factors and texture, normal map and
 /// scale, emissive factor (times KHR_materials_emissive_strength) and
 /// texture, alpha mode and cutoff, double-sided, KHR_materials_transmission
-/// and KHR_materials_ior; `specular` and `shininess` stay zero.
+/// (factor and texture) and KHR_materials_ior; `specular` and `shininess` stay zero.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Material {
     pub name: String,
@@ -51,6 +51,8 @@ pub struct Material {
     pub normal_texture: Option<(TextureId, f32)>,
     /// Fraction of light transmitted through the surface (KHR_materials_transmission).
     pub transmission: f32,
+    /// Multiplies `transmission` by its red channel (linear).
+    pub transmission_texture: Option<TextureId>,
     pub alpha_mode: AlphaMode,
     /// Whether the back side is lit as the front (glTF); OBJ surfaces are two-sided.
     pub double_sided: bool,
@@ -96,6 +98,7 @@ impl Default for Material {
             emission_texture: None,
             normal_texture: None,
             transmission: 0.0,
+            transmission_texture: None,
             alpha_mode: AlphaMode::Opaque,
             double_sided: true,
         }
@@ -110,9 +113,14 @@ impl Material {
 
     /// Shifts texture references when scenes are merged.
     pub(crate) fn offset_textures(&mut self, base: u32) {
-        for t in [&mut self.base_color_texture, &mut self.metallic_roughness_texture, &mut self.emission_texture]
-            .into_iter()
-            .flatten()
+        for t in [
+            &mut self.base_color_texture,
+            &mut self.metallic_roughness_texture,
+            &mut self.emission_texture,
+            &mut self.transmission_texture,
+        ]
+        .into_iter()
+        .flatten()
         {
             t.0 += base;
         }
