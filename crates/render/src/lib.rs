@@ -143,31 +143,28 @@ pub fn render<A: Accel + ?Sized>(
     progress: &(dyn Fn(u64) + Sync),
 ) -> (HdrImage, RenderStats) {
     let start = Instant::now();
+    // The views of the closest hit follow the plan for alpha and textures too.
+    let plan = EffectPlan::new(scene, settings);
+    let (alpha, textures) = (plan.has(Effect::Alpha), plan.has(Effect::Textures));
     let (image, rays) = match settings.integrator {
-        Integrator::Primary => {
-            let alpha = has_alpha(scene);
-            render_samples(camera, settings, progress, |ray, rng, rays| {
-                *rays += 1;
-                let hit = if alpha {
-                    let u = rng.next_f32();
-                    accel.intersect_filtered(&ray, &|t, b, g| alpha_accepts(scene, t, b, g, u))
-                } else {
-                    accel.intersect(&ray)
-                };
-                match hit {
-                    Some(hit) => shade_primary(scene, &ray, &hit),
-                    None => settings.background,
-                }
-            })
-        }
+        Integrator::Primary => render_samples(camera, settings, progress, |ray, rng, rays| {
+            *rays += 1;
+            let hit = if alpha {
+                let u = rng.next_f32();
+                accel.intersect_filtered(&ray, &|t, b, g| alpha_accepts(scene, t, b, g, u))
+            } else {
+                accel.intersect(&ray)
+            };
+            match hit {
+                Some(hit) => shade_primary(scene, &ray, &hit, textures),
+                None => settings.background,
+            }
+        }),
         Integrator::Direct | Integrator::Path => render_transport(scene, accel, camera, settings, progress),
-        aov => {
-            let alpha = has_alpha(scene);
-            render_samples(camera, settings, progress, |ray, rng, rays| {
-                *rays += 1;
-                shade::aov(aov, scene, accel, alpha, &ray, rng)
-            })
-        }
+        aov => render_samples(camera, settings, progress, |ray, rng, rays| {
+            *rays += 1;
+            shade::aov(aov, scene, accel, (alpha, textures), &ray, rng)
+        }),
     };
     let stats = RenderStats {
         width: settings.width,

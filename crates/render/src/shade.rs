@@ -11,26 +11,27 @@ const AMBIENT: f32 = 0.2;
 /// Shades the closest hit for the primary-hit view: the surface's albedo
 /// (material colour times texture) scaled by the cosine between the
 /// interpolated normal and the direction back to the viewer, plus the
-/// surface's own emission (times its texture). Both sides of a surface are lit.
-pub fn shade_primary(scene: &Scene, ray: &Ray, hit: &Hit) -> Vec3 {
+/// surface's own emission (times its texture). Both sides of a surface are
+/// lit. `textures` says whether to look textures up (the plan's choice).
+pub fn shade_primary(scene: &Scene, ray: &Ray, hit: &Hit, textures: bool) -> Vec3 {
     let triangle = &scene.triangles[hit.triangle as usize];
     let material = &scene.materials[triangle.material as usize];
     let emission = material.emission
-        * material.emission_texture.map_or(Vec3::ONE, |t| {
+        * material.emission_texture.filter(|_| textures).map_or(Vec3::ONE, |t| {
             let uv = scene.interpolate(triangle, hit.beta, hit.gamma, |v| v.uv);
             scene.textures[t.0 as usize].sample(uv).truncate()
         });
-    let albedo = albedo(scene, hit);
+    let albedo = albedo(scene, hit, textures);
     let normal = shading_normal(scene, hit);
     let cosine = normal.dot(-ray.direction.normalize()).abs();
     albedo * (AMBIENT + (1.0 - AMBIENT) * cosine) + emission
 }
 
-/// The surface colour at the hit: base colour times texture.
-pub fn albedo(scene: &Scene, hit: &Hit) -> Vec3 {
+/// The surface colour at the hit: base colour times texture (if `textures`).
+pub fn albedo(scene: &Scene, hit: &Hit, textures: bool) -> Vec3 {
     let triangle = &scene.triangles[hit.triangle as usize];
     let material = &scene.materials[triangle.material as usize];
-    let texture = material.base_color_texture.map_or(Vec3::ONE, |t| {
+    let texture = material.base_color_texture.filter(|_| textures).map_or(Vec3::ONE, |t| {
         let uv = scene.interpolate(triangle, hit.beta, hit.gamma, |v| v.uv);
         scene.textures[t.0 as usize].sample(uv).truncate()
     });
@@ -43,7 +44,7 @@ pub(crate) fn aov<A: Accel + ?Sized>(
     kind: Integrator,
     scene: &Scene,
     accel: &A,
-    alpha: bool,
+    (alpha, textures): (bool, bool),
     ray: &Ray,
     rng: &mut Rng,
 ) -> Vec3 {
@@ -61,7 +62,7 @@ pub(crate) fn aov<A: Accel + ?Sized>(
     }
     let Some(hit) = hit else { return Vec3::ZERO };
     match kind {
-        Integrator::Albedo => albedo(scene, &hit),
+        Integrator::Albedo => albedo(scene, &hit, textures),
         Integrator::Normal => shading_normal(scene, &hit),
         Integrator::Depth => Vec3::splat(hit.t * ray.direction.length()),
         Integrator::Position => ray.at(hit.t),
