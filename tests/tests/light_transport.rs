@@ -247,6 +247,11 @@ fn effects_the_plan_omits_change_nothing_when_forced_on() {
         let a = render_scene(&scene, &camera, &settings);
         let b = render_scene(&scene, &camera, &untextured);
         assert!(rtgi_image::compare(&a, &b).unwrap().max_abs > 0.05);
+        // The preview integrator follows the same decision.
+        let primary = RenderSettings { integrator: Integrator::Primary, ..settings.clone() };
+        let a = render_scene(&scene, &camera, &primary);
+        let b = render_scene(&scene, &camera, &RenderSettings { integrator: Integrator::Primary, ..untextured });
+        assert!(rtgi_image::compare(&a, &b).unwrap().max_abs > 0.05);
     }
 }
 
