@@ -110,6 +110,8 @@ fn every_bsdf_passes_a_furnace_under_a_white_sky() {
             lossless,
         ),
         ("thin glass", gltf(0.0, 0.0, 1.0), lossless),
+        // Through a sphere of rough sheets light meets two rough surfaces, each losing its share.
+        ("rough thin glass", gltf(0.0, 0.5, 1.0), (0.85, 1.005)),
         ("smooth metal", gltf(1.0, 0.0, 0.0), lossless),
         ("rough metal", gltf(1.0, 0.5, 0.0), (0.9, 1.005)),
         ("rough dielectric", gltf(0.0, 0.5, 0.0), (0.95, 1.02)),

@@ -42,18 +42,32 @@ pub enum Bsdf {
     /// light reflects by Fresnel's equations, summed over the reflections
     /// inside the sheet, or passes straight through, tinted.
     ThinDielectric { ior: f32, tint: Vec3 },
+    /// A rough thin sheet (glTF's transmission with roughness): GGX
+    /// microfacets of width `alpha` reflect as [`Bsdf::ThinDielectric`]
+    /// does, and transmit into the mirror image of the reflected lobe
+    /// below the sheet, so what lies behind is seen blurred. Not a delta.
+    RoughThinDielectric { ior: f32, tint: Vec3, alpha: f32 },
 }
 
 impl Bsdf {
     /// The BSDF's value for the pair of directions (zero for specular models).
     pub fn eval(&self, wo: Vec3, wi: Vec3) -> Vec3 {
+        if let Bsdf::RoughThinDielectric { ior, tint, alpha } = *self {
+            return rough_thin(wo, wi, ior, alpha).map_or(Vec3::ZERO, |lobe| {
+                let f = lobe.fresnel_weight * lobe.microfacet_value;
+                if lobe.transmitted { tint * f } else { Vec3::splat(f) }
+            });
+        }
         let (wo, wi) = (to_upper(wo), to_upper_with(wi, wo));
         if wi.z <= 0.0 || wo.z <= 0.0 {
             return Vec3::ZERO;
         }
         match *self {
             Bsdf::Lambert { albedo } => albedo / PI,
-            Bsdf::Mirror { .. } | Bsdf::Dielectric { .. } | Bsdf::ThinDielectric { .. } => Vec3::ZERO,
+            Bsdf::Mirror { .. }
+            | Bsdf::Dielectric { .. }
+            | Bsdf::ThinDielectric { .. }
+            | Bsdf::RoughThinDielectric { .. } => Vec3::ZERO,
             Bsdf::Glossy { reflectance, alpha } => {
                 let wm = (wo + wi).normalize_or_zero();
                 if wm == Vec3::ZERO {
@@ -77,13 +91,19 @@ impl Bsdf {
 
     /// The density with which [`Bsdf::sample`] draws `wi` (zero for specular models).
     pub fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
+        if let Bsdf::RoughThinDielectric { ior, alpha, .. } = *self {
+            return rough_thin(wo, wi, ior, alpha).map_or(0.0, |lobe| lobe.choice * lobe.reflection_pdf);
+        }
         let (wo, wi) = (to_upper(wo), to_upper_with(wi, wo));
         if wi.z <= 0.0 || wo.z <= 0.0 {
             return 0.0;
         }
         match *self {
             Bsdf::Lambert { .. } => wi.z / PI,
-            Bsdf::Mirror { .. } | Bsdf::Dielectric { .. } | Bsdf::ThinDielectric { .. } => 0.0,
+            Bsdf::Mirror { .. }
+            | Bsdf::Dielectric { .. }
+            | Bsdf::ThinDielectric { .. }
+            | Bsdf::RoughThinDielectric { .. } => 0.0,
             Bsdf::Glossy { alpha, .. } => ggx_reflection_pdf(wo, wi, alpha),
             Bsdf::MetallicRoughness { metallic, alpha, .. } => {
                 let p_specular = specular_probability(metallic);
@@ -100,6 +120,26 @@ impl Bsdf {
         match *self {
             Bsdf::Dielectric { ior, tint } => return Some(sample_dielectric(wo, ior, tint, u.x)),
             Bsdf::ThinDielectric { ior, tint } => return Some(sample_thin_dielectric(wo, ior, tint, u.x)),
+            Bsdf::RoughThinDielectric { ior, alpha, .. } => {
+                // Reflect or transmit with the sheet's reflectance at the
+                // macroscopic normal (clamped so neither is starved), then
+                // draw a visible microfacet normal with the stretched number.
+                let upper = to_upper(wo);
+                let p_reflect = thin_reflectance(upper.z, ior).clamp(0.02, 0.98);
+                let (transmit, u0) = if u.x < p_reflect {
+                    (false, u.x / p_reflect)
+                } else {
+                    (true, (u.x - p_reflect) / (1.0 - p_reflect))
+                };
+                let reflected = reflect(upper, sample_ggx_visible_normal(upper, alpha, Vec2::new(u0, u.y)));
+                if reflected.z <= 0.0 {
+                    return None;
+                }
+                let side = if transmit { -1.0 } else { 1.0 } * if wo.z < 0.0 { -1.0 } else { 1.0 };
+                let wi = Vec3::new(reflected.x, reflected.y, reflected.z * side);
+                let pdf = self.pdf(wo, wi);
+                return (pdf > 0.0).then(|| BsdfSample { wi, value: self.eval(wo, wi), pdf, delta: false });
+            }
             _ => {}
         }
         let flip = wo.z < 0.0;
@@ -108,7 +148,9 @@ impl Bsdf {
         let wi = match *self {
             Bsdf::Lambert { .. } => cosine_hemisphere(u),
             Bsdf::Glossy { alpha, .. } => reflect(local_wo, sample_ggx_visible_normal(local_wo, alpha, u)),
-            Bsdf::Dielectric { .. } | Bsdf::ThinDielectric { .. } => unreachable!("sampled above"),
+            Bsdf::Dielectric { .. } | Bsdf::ThinDielectric { .. } | Bsdf::RoughThinDielectric { .. } => {
+                unreachable!("sampled above")
+            }
             Bsdf::Mirror { reflectance } => {
                 let wi = Vec3::new(-local_wo.x, -local_wo.y, local_wo.z);
                 return Some(BsdfSample { wi: back(wi), value: reflectance / wi.z, pdf: 1.0, delta: true });
@@ -183,17 +225,56 @@ fn sample_dielectric(wo: Vec3, ior: f32, tint: Vec3, u: f32) -> BsdfSample {
 /// direction and so no change of radiance.
 fn sample_thin_dielectric(wo: Vec3, ior: f32, tint: Vec3, u: f32) -> BsdfSample {
     let cos_i = wo.z.abs();
-    let mut reflectance = fresnel_dielectric(cos_i, ior);
-    if reflectance < 1.0 {
-        let transmittance = 1.0 - reflectance;
-        reflectance += transmittance * transmittance * reflectance / (1.0 - reflectance * reflectance);
-    }
+    let reflectance = thin_reflectance(cos_i, ior);
     if u < reflectance {
         let wi = Vec3::new(-wo.x, -wo.y, wo.z);
         return BsdfSample { wi, value: Vec3::splat(reflectance / cos_i), pdf: reflectance, delta: true };
     }
     let transmittance = 1.0 - reflectance;
     BsdfSample { wi: -wo, value: tint * (transmittance / cos_i), pdf: transmittance, delta: true }
+}
+
+/// The reflectance of a thin dielectric sheet, counting the reflections
+/// inside it: R + T²R / (1 − R²) with R the Fresnel reflectance, T = 1 − R.
+fn thin_reflectance(cos_i: f32, ior: f32) -> f32 {
+    let r = fresnel_dielectric(cos_i, ior);
+    if r < 1.0 { r + (1.0 - r) * (1.0 - r) * r / (1.0 - r * r) } else { 1.0 }
+}
+
+/// The pieces of a rough thin sheet's value and density for a pair of
+/// directions; `None` where the sheet sends nothing from `wi` to `wo`.
+struct RoughThinLobe {
+    transmitted: bool,
+    /// GGX's D G2 / (4 cos cos) for the reflected direction.
+    microfacet_value: f32,
+    /// The share reflected (or transmitted) at the microfacet.
+    fresnel_weight: f32,
+    /// The probability that sampling chooses this side.
+    choice: f32,
+    reflection_pdf: f32,
+}
+
+fn rough_thin(wo: Vec3, wi: Vec3, ior: f32, alpha: f32) -> Option<RoughThinLobe> {
+    let upper = to_upper(wo);
+    let same_side = wi.z * wo.z > 0.0;
+    // Transmitted directions mirror to the reflected ones above the sheet.
+    let reflected = Vec3::new(wi.x, wi.y, wi.z.abs());
+    if upper.z <= 0.0 || reflected.z <= 0.0 {
+        return None;
+    }
+    let wm = (upper + reflected).normalize_or_zero();
+    if wm == Vec3::ZERO {
+        return None;
+    }
+    let reflectance = thin_reflectance(upper.dot(wm).clamp(0.0, 1.0), ior);
+    let p_reflect = thin_reflectance(upper.z, ior).clamp(0.02, 0.98);
+    Some(RoughThinLobe {
+        transmitted: !same_side,
+        microfacet_value: ggx_d(wm, alpha) * ggx_g2(upper, reflected, alpha) / (4.0 * upper.z * reflected.z),
+        fresnel_weight: if same_side { reflectance } else { 1.0 - reflectance },
+        choice: if same_side { p_reflect } else { 1.0 - p_reflect },
+        reflection_pdf: ggx_reflection_pdf(upper, reflected, alpha),
+    })
 }
 
 impl Bsdf {
@@ -204,7 +285,9 @@ impl Bsdf {
             Bsdf::Lambert { albedo } => albedo,
             Bsdf::Mirror { reflectance } | Bsdf::Glossy { reflectance, .. } => reflectance,
             Bsdf::MetallicRoughness { base_color, .. } => base_color,
-            Bsdf::Dielectric { tint, .. } | Bsdf::ThinDielectric { tint, .. } => tint,
+            Bsdf::Dielectric { tint, .. }
+            | Bsdf::ThinDielectric { tint, .. }
+            | Bsdf::RoughThinDielectric { tint, .. } => tint,
         }
     }
 }
@@ -299,6 +382,7 @@ mod tests {
             Bsdf::MetallicRoughness { base_color: Vec3::new(0.9, 0.6, 0.3), metallic: 0.0, alpha: 0.5 },
             Bsdf::MetallicRoughness { base_color: Vec3::ONE, metallic: 0.5, alpha: 0.05 },
             Bsdf::Glossy { reflectance: Vec3::new(0.9, 0.9, 0.5), alpha: 0.2 },
+            Bsdf::RoughThinDielectric { ior: 1.5, tint: Vec3::new(0.9, 0.8, 0.7), alpha: 0.3 },
         ]
     }
 
@@ -316,7 +400,8 @@ mod tests {
                     wo.z *= side;
                     for _ in 0..2000 {
                         let Some(s) = bsdf.sample(wo, Vec2::new(rng.next_f32(), rng.next_f32())) else { continue };
-                        assert!(s.wi.z * wo.z > 0.0, "{bsdf:?}: sampled through the surface");
+                        let transmits = matches!(bsdf, Bsdf::RoughThinDielectric { .. });
+                        assert!(transmits || s.wi.z * wo.z > 0.0, "{bsdf:?}: sampled through the surface");
                         assert!((s.pdf - bsdf.pdf(wo, s.wi)).abs() <= 1e-3 * s.pdf.max(1.0), "{bsdf:?}");
                         assert!(
                             (s.value - bsdf.eval(wo, s.wi)).abs().max_element()

@@ -252,7 +252,10 @@ impl<'a, A: Accel + ?Sized> Transport<'a, A> {
             let interaction = self.interact::<S>(&hit, triangle, material, u[dim::LOBE]);
             let (frame, bsdf) = (&interaction.frame, &interaction.bsdf);
             let wo_local = frame.to_local(wo);
-            let reflects_only = !matches!(bsdf, Bsdf::Dielectric { .. } | Bsdf::ThinDielectric { .. });
+            let reflects_only = !matches!(
+                bsdf,
+                Bsdf::Dielectric { .. } | Bsdf::ThinDielectric { .. } | Bsdf::RoughThinDielectric { .. }
+            );
             let geometric = interaction.point.normal;
             let wo_side = wo.dot(geometric);
 
@@ -260,7 +263,7 @@ impl<'a, A: Accel + ?Sized> Transport<'a, A> {
                 let u_light = Vec2::new(u[dim::LIGHT], u[dim::LIGHT + 1]);
                 if let Some(light) =
                     self.lights.sample(scene, self.environment, &interaction.point, u[dim::LIGHT_CHOICE], u_light)
-                    && light.wi.dot(geometric) * wo_side > 0.0
+                    && (!reflects_only || light.wi.dot(geometric) * wo_side > 0.0)
                 {
                     let wi_local = frame.to_local(light.wi);
                     let f = bsdf.eval(wo_local, wi_local);
@@ -415,6 +418,9 @@ impl<'a, A: Accel + ?Sized> Transport<'a, A> {
             // without KHR_materials_volume is a thin-walled surface.
             let lobe = match material.model {
                 SurfaceModel::DiffuseSpecular => Bsdf::Dielectric { ior, tint: Vec3::ONE },
+                SurfaceModel::MetallicRoughness if self.glossy && roughness * roughness >= MIN_ALPHA => {
+                    Bsdf::RoughThinDielectric { ior, tint: base_color, alpha: roughness * roughness }
+                }
                 SurfaceModel::MetallicRoughness => Bsdf::ThinDielectric { ior, tint: base_color },
             };
             return (lobe, Vec3::ONE);
