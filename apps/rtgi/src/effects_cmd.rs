@@ -36,7 +36,7 @@ struct Report {
     samples_per_pixel: u32,
     threads: usize,
     repeats: u32,
-    plan: String,
+    plan: EffectPlan,
     rows: Vec<Row>,
 }
 
@@ -122,7 +122,7 @@ pub(crate) fn run(args: &BenchEffectsArgs) -> Result<()> {
             samples_per_pixel: settings.samples_per_pixel,
             threads: pool.current_num_threads(),
             repeats: args.repeats,
-            plan: plan.to_string(),
+            plan,
             rows,
         };
         crate::common::write_atomically(json, serde_json::to_string_pretty(&report)?.as_bytes())?;

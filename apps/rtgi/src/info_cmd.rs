@@ -23,25 +23,7 @@ struct Info {
     extensions_unsupported: Vec<String>,
     warnings: Vec<String>,
     /// What `rtgi render` with the given options would simulate, and why.
-    plan: PlanInfo,
-}
-
-#[derive(Debug, Serialize)]
-struct PlanInfo {
-    integrator: String,
-    max_depth: u32,
-    default_environment: bool,
-    effects: Vec<EffectInfo>,
-    #[serde(skip)]
-    text: String,
-}
-
-#[derive(Debug, Serialize)]
-struct EffectInfo {
-    effect: String,
-    enabled: bool,
-    forced: bool,
-    reason: String,
+    plan: EffectPlan,
 }
 
 #[derive(Debug, Serialize)]
@@ -89,22 +71,6 @@ pub(crate) fn run(args: &InfoArgs) -> Result<()> {
     let mut settings = RenderSettings::default();
     apply_lighting(&args.lighting, &mut scene, &mut settings)?;
     let plan = EffectPlan::new(&scene, &settings);
-    let plan = PlanInfo {
-        integrator: plan.integrator.to_string(),
-        max_depth: plan.max_depth,
-        default_environment: plan.default_environment,
-        effects: plan
-            .effects
-            .iter()
-            .map(|e| EffectInfo {
-                effect: e.effect.to_string(),
-                enabled: e.enabled,
-                forced: e.forced,
-                reason: e.reason.clone(),
-            })
-            .collect(),
-        text: plan.to_string(),
-    };
     let mut per_material = vec![0usize; scene.materials.len()];
     for t in &scene.triangles {
         per_material[t.material as usize] += 1;
@@ -234,7 +200,7 @@ fn print_text(info: &Info) {
     for e in &info.extensions_unsupported {
         println!("warning: extension {e} is not supported and is ignored");
     }
-    print!("{}", info.plan.text);
+    print!("{}", info.plan);
 }
 
 /// `rtgi compare`: prints the error of one EXR image against another.

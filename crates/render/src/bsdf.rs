@@ -18,6 +18,9 @@ pub struct BsdfSample {
     pub value: Vec3,
     pub pdf: f32,
     pub delta: bool,
+    /// The relative index of refraction crossed (n transmitted / n incident):
+    /// radiance was scaled by 1/η² on the way. 1 where nothing refracted.
+    pub eta: f32,
 }
 
 /// The reflectance models of the renderer.
@@ -138,7 +141,7 @@ impl Bsdf {
                 let side = if transmit { -1.0 } else { 1.0 } * if wo.z < 0.0 { -1.0 } else { 1.0 };
                 let wi = Vec3::new(reflected.x, reflected.y, reflected.z * side);
                 let pdf = self.pdf(wo, wi);
-                return (pdf > 0.0).then(|| BsdfSample { wi, value: self.eval(wo, wi), pdf, delta: false });
+                return (pdf > 0.0).then(|| BsdfSample { wi, value: self.eval(wo, wi), pdf, delta: false, eta: 1.0 });
             }
             _ => {}
         }
@@ -153,7 +156,7 @@ impl Bsdf {
             }
             Bsdf::Mirror { reflectance } => {
                 let wi = Vec3::new(-local_wo.x, -local_wo.y, local_wo.z);
-                return Some(BsdfSample { wi: back(wi), value: reflectance / wi.z, pdf: 1.0, delta: true });
+                return Some(BsdfSample { wi: back(wi), value: reflectance / wi.z, pdf: 1.0, delta: true, eta: 1.0 });
             }
             Bsdf::MetallicRoughness { metallic, alpha, .. } => {
                 let p_specular = specular_probability(metallic);
@@ -172,7 +175,7 @@ impl Bsdf {
         }
         let wi = back(wi);
         let pdf = self.pdf(wo, wi);
-        (pdf > 0.0).then(|| BsdfSample { wi, value: self.eval(wo, wi), pdf, delta: false })
+        (pdf > 0.0).then(|| BsdfSample { wi, value: self.eval(wo, wi), pdf, delta: false, eta: 1.0 })
     }
 
     /// Whether every direction the model scatters to is a Dirac delta, so
@@ -207,7 +210,7 @@ fn sample_dielectric(wo: Vec3, ior: f32, tint: Vec3, u: f32) -> BsdfSample {
     let reflectance = fresnel_dielectric(cos_i, eta);
     if u < reflectance {
         let wi = Vec3::new(-wo.x, -wo.y, wo.z);
-        return BsdfSample { wi, value: Vec3::splat(reflectance / cos_i), pdf: reflectance, delta: true };
+        return BsdfSample { wi, value: Vec3::splat(reflectance / cos_i), pdf: reflectance, delta: true, eta: 1.0 };
     }
     let sin2_t = (1.0 - cos_i * cos_i).max(0.0) / (eta * eta);
     let cos_t = (1.0 - sin2_t).max(0.0).sqrt();
@@ -215,7 +218,7 @@ fn sample_dielectric(wo: Vec3, ior: f32, tint: Vec3, u: f32) -> BsdfSample {
     let wi = (-wo / eta + (cos_i / eta - cos_t) * normal).normalize();
     let transmittance = 1.0 - reflectance;
     let value = tint * (transmittance / (eta * eta) / cos_t.max(1e-8));
-    BsdfSample { wi, value, pdf: transmittance, delta: true }
+    BsdfSample { wi, value, pdf: transmittance, delta: true, eta }
 }
 
 /// Reflects or passes straight through a thin dielectric sheet. The sheet
@@ -228,10 +231,10 @@ fn sample_thin_dielectric(wo: Vec3, ior: f32, tint: Vec3, u: f32) -> BsdfSample 
     let reflectance = thin_reflectance(cos_i, ior);
     if u < reflectance {
         let wi = Vec3::new(-wo.x, -wo.y, wo.z);
-        return BsdfSample { wi, value: Vec3::splat(reflectance / cos_i), pdf: reflectance, delta: true };
+        return BsdfSample { wi, value: Vec3::splat(reflectance / cos_i), pdf: reflectance, delta: true, eta: 1.0 };
     }
     let transmittance = 1.0 - reflectance;
-    BsdfSample { wi: -wo, value: tint * (transmittance / cos_i), pdf: transmittance, delta: true }
+    BsdfSample { wi: -wo, value: tint * (transmittance / cos_i), pdf: transmittance, delta: true, eta: 1.0 }
 }
 
 /// The reflectance of a thin dielectric sheet, counting the reflections

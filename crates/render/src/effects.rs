@@ -11,6 +11,7 @@ use std::fmt;
 use std::str::FromStr;
 
 use rtgi_scene::{AlphaMode, Material, Scene, SurfaceModel};
+use serde::Serialize;
 
 use crate::{Integrator, RenderSettings};
 
@@ -99,9 +100,15 @@ impl FromStr for EffectOverrides {
     }
 }
 
+/// Serialises a named choice by its name, as the command line spells it.
+fn as_name<S: serde::Serializer>(value: &impl fmt::Display, serializer: S) -> Result<S::Ok, S::Error> {
+    serializer.collect_str(value)
+}
+
 /// One line of a plan.
-#[derive(Clone, Debug, PartialEq, Eq)]
+#[derive(Clone, Debug, PartialEq, Eq, Serialize)]
 pub struct PlannedEffect {
+    #[serde(serialize_with = "as_name")]
     pub effect: Effect,
     pub enabled: bool,
     /// Whether the user's override decided, against what the scene needs.
@@ -111,8 +118,9 @@ pub struct PlannedEffect {
 }
 
 /// Which effects a render simulates, and why.
-#[derive(Clone, Debug, PartialEq, Eq)]
+#[derive(Clone, Debug, PartialEq, Eq, Serialize)]
 pub struct EffectPlan {
+    #[serde(serialize_with = "as_name")]
     pub integrator: Integrator,
     pub effects: Vec<PlannedEffect>,
     /// The scene has no light of its own, so a uniform white environment

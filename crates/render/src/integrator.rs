@@ -13,7 +13,7 @@ use rtgi_scene::{Material, Scene, SurfaceModel, Triangle};
 use crate::bsdf::Bsdf;
 use crate::effects::{Effect, EffectPlan, bits, is_glossy, transmits};
 use crate::lights::{Environment, LightSet};
-use crate::shade::alpha_accepts;
+use crate::shade::{alpha_accepts, closest_hit};
 
 /// What the renderer computes for each pixel.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -190,11 +190,7 @@ impl<'a, A: Accel + ?Sized> Transport<'a, A> {
     }
 
     fn closest<const S: u32>(&self, ray: &Ray, u_alpha: f32) -> Option<Hit> {
-        if S & bits::ALPHA != 0 {
-            self.accel.intersect_filtered(ray, &|t, b, g| alpha_accepts(self.scene, t, b, g, u_alpha))
-        } else {
-            self.accel.intersect(ray)
-        }
+        closest_hit(self.scene, self.accel, ray, (S & bits::ALPHA != 0).then_some(u_alpha))
     }
 
     fn occluded<const S: u32>(&self, ray: &Ray, u_alpha: f32) -> bool {
@@ -294,13 +290,9 @@ impl<'a, A: Accel + ?Sized> Transport<'a, A> {
                 break;
             }
             throughput *= interaction.weight * sample.value * (sample.wi.z.abs() / sample.pdf);
-            if let Bsdf::Dielectric { ior, .. } = *bsdf
-                && sample.wi.z * wo_local.z < 0.0
-            {
-                // Refraction scaled the radiance by 1/η²; the roulette must
-                // not see that, or paths inside glass die for nothing.
-                radiance_scale *= if wo_local.z > 0.0 { ior * ior } else { 1.0 / (ior * ior) };
-            }
+            // Refraction scaled the radiance by 1/η²; the roulette must not
+            // see that, or paths inside glass die for nothing.
+            radiance_scale *= sample.eta * sample.eta;
             previous_pdf = (!sample.delta).then_some(sample.pdf);
             depth += 1;
             // Russian roulette ends paths that carry little, in proportion;

@@ -149,18 +149,12 @@ pub fn render<A: Accel + ?Sized>(
     let (image, rays) = match settings.integrator {
         Integrator::Primary => render_samples(camera, settings, progress, |ray, rng, rays| {
             *rays += 1;
-            let hit = if alpha {
-                let u = rng.next_f32();
-                accel.intersect_filtered(&ray, &|t, b, g| alpha_accepts(scene, t, b, g, u))
-            } else {
-                accel.intersect(&ray)
-            };
-            match hit {
+            match shade::closest_hit(scene, accel, &ray, alpha.then(|| rng.next_f32())) {
                 Some(hit) => shade_primary(scene, &ray, &hit, textures),
                 None => settings.background,
             }
         }),
-        Integrator::Direct | Integrator::Path => render_transport(scene, accel, camera, settings, progress),
+        Integrator::Direct | Integrator::Path => render_transport(scene, accel, camera, settings, &plan, progress),
         aov => render_samples(camera, settings, progress, |ray, rng, rays| {
             *rays += 1;
             shade::aov(aov, scene, accel, (alpha, textures), &ray, rng)
@@ -183,15 +177,15 @@ fn render_transport<A: Accel + ?Sized>(
     accel: &A,
     camera: &Camera,
     settings: &RenderSettings,
+    plan: &EffectPlan,
     progress: &(dyn Fn(u64) + Sync),
 ) -> (HdrImage, u64) {
-    let plan = EffectPlan::new(scene, settings);
     let white_sky = Environment::Uniform(Vec3::ONE);
     let environment = if plan.default_environment { Some(&white_sky) } else { settings.environment.as_ref() };
     let transport = Transport::new(
         scene,
         accel,
-        &plan,
+        plan,
         environment,
         settings.background,
         settings.direct_strategy,

@@ -165,18 +165,12 @@ fn direction_of(uv: Vec2) -> Vec3 {
 /// One light that [`LightSet`] samples.
 #[derive(Clone, Debug, PartialEq)]
 enum Source {
+    /// A point or, with a cone, a spot light.
     Point {
         position: Vec3,
         intensity: Vec3,
         range: Option<f32>,
-    },
-    Spot {
-        position: Vec3,
-        direction: Vec3,
-        intensity: Vec3,
-        cos_inner: f32,
-        cos_outer: f32,
-        range: Option<f32>,
+        cone: Option<Cone>,
     },
     /// `direction` is the way the light travels.
     Directional {
@@ -185,6 +179,15 @@ enum Source {
     },
     Triangle(EmissiveTriangle),
     Environment,
+}
+
+/// A spot light's cone: its axis (the way light travels) and the cosines
+/// of its inner and outer half-angles.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Cone {
+    direction: Vec3,
+    cos_inner: f32,
+    cos_outer: f32,
 }
 
 /// An emissive triangle, as an area light.
@@ -253,22 +256,13 @@ impl LightSet {
         let mut powers = Vec::new();
         for light in &scene.lights {
             let intensity = light.color * light.intensity;
+            let point = |cone| Source::Point { position: light.position, intensity, range: light.range, cone };
             let (source, power) = match light.kind {
-                LightKind::Point => (
-                    Source::Point { position: light.position, intensity, range: light.range },
-                    4.0 * PI * luminance(intensity),
-                ),
+                LightKind::Point => (point(None), 4.0 * PI * luminance(intensity)),
                 LightKind::Spot { inner_cone, outer_cone } => {
                     let (cos_inner, cos_outer) = (inner_cone.cos(), outer_cone.cos());
-                    let source = Source::Spot {
-                        position: light.position,
-                        direction: light.direction.normalize(),
-                        intensity,
-                        cos_inner,
-                        cos_outer,
-                        range: light.range,
-                    };
-                    (source, 2.0 * PI * (1.0 - 0.5 * (cos_inner + cos_outer)) * luminance(intensity))
+                    let cone = Cone { direction: light.direction.normalize(), cos_inner, cos_outer };
+                    (point(Some(cone)), 2.0 * PI * (1.0 - 0.5 * (cos_inner + cos_outer)) * luminance(intensity))
                 }
                 LightKind::Directional => (
                     Source::Directional { direction: light.direction.normalize(), irradiance: intensity },
@@ -373,27 +367,15 @@ impl LightSet {
         let (index, p_choice, _) = self.choice.as_ref()?.sample(u_choice);
         let p = at.position;
         match &self.sources[index] {
-            Source::Point { position, intensity, range } => {
+            Source::Point { position, intensity, range, cone } => {
                 let (wi, window) = toward_point(p, *position, *range)?;
-                let radiance = *intensity * window;
-                Some(LightSample {
-                    wi,
-                    radiance,
-                    pdf: p_choice,
-                    delta: true,
-                    shadow_ray: at.spawn_ray_to_point(*position),
-                })
-            }
-            Source::Spot { position, direction, intensity, cos_inner, cos_outer, range } => {
-                let (wi, window) = toward_point(p, *position, *range)?;
-                let cone = spot_falloff(direction.dot(-wi), *cos_inner, *cos_outer);
-                if cone <= 0.0 {
+                let falloff = cone.map_or(1.0, |c| spot_falloff(c.direction.dot(-wi), c.cos_inner, c.cos_outer));
+                if falloff <= 0.0 {
                     return None;
                 }
-                let radiance = *intensity * (window * cone);
                 Some(LightSample {
                     wi,
-                    radiance,
+                    radiance: *intensity * (window * falloff),
                     pdf: p_choice,
                     delta: true,
                     shadow_ray: at.spawn_ray_to_point(*position),

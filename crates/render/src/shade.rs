@@ -38,6 +38,16 @@ pub fn albedo(scene: &Scene, hit: &Hit, textures: bool) -> Vec3 {
     material.base_color * texture
 }
 
+/// The closest hit of `ray`; with `alpha` set to the sample's uniform
+/// number, surfaces with alpha let it through ([`alpha_accepts`]).
+#[inline]
+pub(crate) fn closest_hit<A: Accel + ?Sized>(scene: &Scene, accel: &A, ray: &Ray, alpha: Option<f32>) -> Option<Hit> {
+    match alpha {
+        Some(u) => accel.intersect_filtered(ray, &|t, b, g| alpha_accepts(scene, t, b, g, u)),
+        None => accel.intersect(ray),
+    }
+}
+
 /// One sample of an arbitrary output variable (an AOV integrator) for a
 /// camera ray; zero where the ray hits nothing.
 pub(crate) fn aov<A: Accel + ?Sized>(
@@ -51,11 +61,8 @@ pub(crate) fn aov<A: Accel + ?Sized>(
     let mut counters = TraversalCounters::default();
     let hit = if kind == Integrator::Cost {
         accel.intersect_counted(ray, &mut counters)
-    } else if alpha {
-        let u = rng.next_f32();
-        accel.intersect_filtered(ray, &|t, b, g| alpha_accepts(scene, t, b, g, u))
     } else {
-        accel.intersect(ray)
+        closest_hit(scene, accel, ray, alpha.then(|| rng.next_f32()))
     };
     if kind == Integrator::Cost {
         return Vec3::new(counters.nodes_visited as f32, counters.triangles_tested as f32, hit.is_some() as u32 as f32);
