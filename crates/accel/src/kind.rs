@@ -80,11 +80,12 @@ impl AccelKind {
 rtgi_math::named_choices!(AccelKind, "acceleration structure");
 
 impl AccelKind {
-    /// Every variant with a spread of build parameters (leaf sizes 1, 3 and
-    /// 8; for the binned SAH also 2 and 32 bins), each with both
+    /// Every variant with a spread of build parameters (leaf sizes 1, 2, 4,
+    /// 8 and 16; for the binned SAH also 2 and 32 bins), each with both
     /// intersectors, all with the robust traversal: the configurations that
     /// tests run each case over, so that a new variant is tested as soon as
-    /// it is added to [`AccelKind::ALL`].
+    /// it is added to [`AccelKind::ALL`]. The exactness contract (see the
+    /// crate's documentation) holds for every one of them.
     pub fn all_configurations() -> Vec<(AccelKind, BuildParams)> {
         let mut configurations = Vec::new();
         for &intersector in Intersector::ALL {
@@ -94,7 +95,7 @@ impl AccelKind {
                     configurations.push((kind, base.clone()));
                     continue;
                 }
-                for max_leaf_size in [1, 3, 8] {
+                for max_leaf_size in [1, 2, 4, 8, 16] {
                     configurations.push((kind, BuildParams { max_leaf_size, ..base.clone() }));
                 }
                 if kind == AccelKind::Sah {

@@ -22,12 +22,16 @@
 
 mod boxa;
 mod bvh;
+mod contract;
 mod counters;
 mod kind;
 mod linear;
+mod slab;
 mod triangle;
+pub mod verify;
 
 pub use bvh::{Bvh, BvhNode, SplitMethod, Traversal};
+pub use contract::is_hittable;
 pub use counters::{Counter, NoCounter, TraversalCounters};
 pub use kind::{AccelKind, BuildParams};
 pub use linear::LinearScan;
@@ -101,26 +105,4 @@ pub trait Accel: Send + Sync + std::fmt::Debug {
 
     /// The statistics of the build.
     fn build_stats(&self) -> &BuildStats;
-}
-
-/// Decides whether a candidate hit counts; monomorphised, so the default
-/// [`AcceptAll`] costs nothing.
-pub(crate) trait HitFilter {
-    fn accept(&self, triangle: u32, beta: f32, gamma: f32) -> bool;
-}
-
-pub(crate) struct AcceptAll;
-
-impl HitFilter for AcceptAll {
-    #[inline(always)]
-    fn accept(&self, _triangle: u32, _beta: f32, _gamma: f32) -> bool {
-        true
-    }
-}
-
-impl HitFilter for &dyn Fn(u32, f32, f32) -> bool {
-    #[inline(always)]
-    fn accept(&self, triangle: u32, beta: f32, gamma: f32) -> bool {
-        self(triangle, beta, gamma)
-    }
 }

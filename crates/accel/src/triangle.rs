@@ -3,6 +3,9 @@
 use rtgi_math::glam::{Mat3A, Vec3Swizzles};
 use rtgi_math::{Vec3, Vec3A};
 
+use crate::contract::hit_triangle;
+use crate::slab::BoxRay;
+
 /// Where a ray hits a triangle: distance and barycentric coordinates of
 /// the second and third corners (the first corner's is `1 - beta - gamma`).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -35,10 +38,12 @@ impl Intersector {
         }
     }
 
-    /// Intersects one ray with one triangle: the hit if its `t` lies in
-    /// `[t_min, t_max]` and the point is inside the triangle, edges
-    /// included. Both sides are hit; triangles of zero area and rays in a
-    /// triangle's plane never are.
+    /// Intersects one ray with one triangle under the structures' hit rule
+    /// (see the crate's exactness contract): the hit if the triangle can be
+    /// hit at all ([`crate::is_hittable`]), its `t` lies in `[t_min, t_max]`
+    /// and the point is inside the triangle, edges included, with exactly
+    /// the bits every structure reports for it. Both sides are hit;
+    /// triangles of zero area and rays in a triangle's plane never are.
     pub fn intersect(
         self,
         origin: Vec3,
@@ -47,14 +52,22 @@ impl Intersector {
         t_max: f32,
         v: &[Vec3; 3],
     ) -> Option<TriangleHit> {
+        let ray = rtgi_math::Ray::with_range(origin, direction, t_min, t_max);
+        if !ray.is_valid() || !crate::is_hittable(v) {
+            return None;
+        }
+        let box_ray = BoxRay::new(&ray);
         let v = v.map(Vec3A::from);
         match self {
             Intersector::Watertight => {
-                Watertight::intersect(&Watertight::prepare(origin.into(), direction.into()), t_min, t_max, &v)
+                hit_triangle::<Watertight>(&Watertight::prepare(origin.into(), direction.into()), &box_ray, &v, t_max)
             }
-            Intersector::MollerTrumbore => {
-                MollerTrumbore::intersect(&MollerTrumbore::prepare(origin.into(), direction.into()), t_min, t_max, &v)
-            }
+            Intersector::MollerTrumbore => hit_triangle::<MollerTrumbore>(
+                &MollerTrumbore::prepare(origin.into(), direction.into()),
+                &box_ray,
+                &v,
+                t_max,
+            ),
         }
     }
 }
@@ -63,6 +76,10 @@ rtgi_math::named_choices!(Intersector, "intersector");
 
 /// A ray/triangle test with per-ray precomputation, for the structures'
 /// inner loops (monomorphised, so the choice costs nothing per triangle).
+///
+/// `intersect` must compute `t` without looking at `t_max` and then keep
+/// the hit exactly when `t_min <= t <= t_max`: structures lower `t_max` to
+/// the best hit so far, and that must never turn away a hit that ties it.
 pub(crate) trait TriangleTest {
     type Ray;
     fn prepare(origin: Vec3A, direction: Vec3A) -> Self::Ray;
@@ -106,7 +123,7 @@ impl TriangleTest for MollerTrumbore {
             return None;
         }
         let t = edge2.dot(q) * inv_det;
-        (t >= t_min && t <= t_max).then_some(TriangleHit { t, beta, gamma })
+        (t >= t_min && t <= t_max && t.is_finite()).then_some(TriangleHit { t, beta, gamma })
     }
 }
 
@@ -178,16 +195,11 @@ impl TriangleTest for Watertight {
         if det == 0.0 || !det.is_finite() {
             return None;
         }
-        // Scaled distance, compared against the range scaled by the
-        // determinant so that only hits pay for the division.
-        let t_scaled = uvw.dot(z * sz);
-        let (t_scaled, abs_det) = if det < 0.0 { (-t_scaled, -det) } else { (t_scaled, det) };
-        if t_scaled < t_min * abs_det || t_scaled > t_max * abs_det {
-            return None;
-        }
-        let t = t_scaled / abs_det;
-        // Rounding of the division can move t just outside the range checked above.
-        if t < t_min || t > t_max {
+        // The distance is computed in full before it is compared with the
+        // range (see `TriangleTest`): comparing the scaled distance with the
+        // scaled range first would round differently for different `t_max`.
+        let t = uvw.dot(z * sz) / det;
+        if !(t >= t_min && t <= t_max && t.is_finite()) {
             return None;
         }
         let [_, beta, gamma] = (uvw / det).to_array();

@@ -36,6 +36,14 @@ impl Frame {
     }
 }
 
+/// A direction uniformly distributed on the unit sphere from two uniform numbers.
+pub fn uniform_sphere(u: f32, v: f32) -> Vec3 {
+    let z = 1.0 - 2.0 * u;
+    let r = (1.0 - z * z).max(0.0).sqrt();
+    let phi = 2.0 * std::f32::consts::PI * v;
+    Vec3::new(r * phi.cos(), r * phi.sin(), z)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

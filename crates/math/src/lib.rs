@@ -24,7 +24,7 @@ mod spawn;
 
 pub use aabb::Aabb;
 pub use float::{gamma, next_float_down, next_float_up};
-pub use frame::Frame;
+pub use frame::{Frame, uniform_sphere};
 pub use glam;
 pub use glam::{BVec3A, Mat3, Mat4, Vec2, Vec3, Vec3A, Vec4, vec2, vec3};
 pub use ray::{Ray, RayWithInverse};

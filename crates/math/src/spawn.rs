@@ -79,14 +79,14 @@ impl SurfacePoint {
 }
 
 /// The unit normal of a triangle by the right-hand rule, or zero for a
-/// degenerate one. Edges are scaled to unit size first, so that the cross
-/// product of tiny triangles (edges of 1e-20) does not underflow.
+/// degenerate one. It is computed in double precision, where the edges of
+/// single-precision corners are (nearly always) exact and their cross
+/// product neither underflows nor overflows, so it is accurate even for
+/// slivers: rays spawned from a sliver move off its true plane.
 pub fn geometric_normal(corners: &[Vec3; 3]) -> Vec3 {
-    let unit = |e: Vec3| {
-        let size = e.abs().max_element();
-        if size > 0.0 { e / size } else { Vec3::ZERO }
-    };
-    unit(corners[1] - corners[0]).cross(unit(corners[2] - corners[0])).normalize_or_zero()
+    let [a, b, c] = corners.map(|v| v.as_dvec3());
+    let n = (b - a).cross(c - a).normalize_or_zero();
+    if n.is_finite() { n.as_vec3() } else { Vec3::ZERO }
 }
 
 /// Spawned rays exclude `t = 0` (the smallest normal float is their

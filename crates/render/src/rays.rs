@@ -64,13 +64,7 @@ pub fn box_rays(scene: &Scene, count: usize, seed: u64) -> Vec<Ray> {
         .collect()
 }
 
-/// A direction uniformly distributed on the unit sphere from two uniform numbers.
-pub fn uniform_sphere(u: f32, v: f32) -> Vec3 {
-    let z = 1.0 - 2.0 * u;
-    let r = (1.0 - z * z).max(0.0).sqrt();
-    let phi = 2.0 * std::f32::consts::PI * v;
-    Vec3::new(r * phi.cos(), r * phi.sin(), z)
-}
+pub use rtgi_math::uniform_sphere;
 
 /// The camera of the peer measurements: looking at the bounding sphere's
 /// centre along -Z with a 40 degree vertical field of view, at the distance

@@ -22,7 +22,8 @@ use rayon::prelude::*;
 use rtgi_math::{Aabb, Vec3, Vec3A, Vec4};
 
 use crate::boxa::BoxA;
-use crate::{Accel, AcceptAll, BuildParams, BuildStats, Hit, NoCounter, TraversalCounters};
+use crate::contract::{HitFilter, QueryKind, Structure, is_hittable};
+use crate::{BuildParams, BuildStats, Counter, Hit};
 
 /// A node of the flattened tree: its box, and either the index of its first
 /// child (the second follows it) or, for a leaf, the range of its triangles
@@ -111,9 +112,8 @@ pub struct Bvh {
 impl Bvh {
     /// Builds a hierarchy over `triangles` with the given split method.
     ///
-    /// Triangles with a non-finite coordinate or zero area are left out of
-    /// the tree (they can never be hit) and counted in
-    /// [`BuildStats::excluded_triangles`].
+    /// Triangles that can never be hit ([`crate::is_hittable`]) are left
+    /// out of the tree and counted in [`BuildStats::excluded_triangles`].
     pub fn new(triangles: &[[Vec3; 3]], method: SplitMethod, params: &BuildParams) -> Self {
         let start = Instant::now();
         let all_hittable = triangles.par_iter().all(is_hittable);
@@ -189,39 +189,17 @@ impl Bvh {
     }
 }
 
-/// Whether a triangle can ever be hit: finite corners and a non-zero area.
-pub(crate) fn is_hittable(t: &[Vec3; 3]) -> bool {
-    t.iter().all(|v| v.is_finite()) && (t[1] - t[0]).cross(t[2] - t[0]) != Vec3::ZERO
-}
-
-impl Accel for Bvh {
-    fn intersect(&self, ray: &rtgi_math::Ray) -> Option<Hit> {
-        self.closest(ray, &mut NoCounter, &AcceptAll)
+impl Structure for Bvh {
+    fn query<Q: QueryKind, C: Counter, F: HitFilter>(
+        &self,
+        ray: &rtgi_math::Ray,
+        counter: &mut C,
+        filter: &F,
+    ) -> Option<Hit> {
+        self.traverse::<Q, C, F>(ray, counter, filter)
     }
 
-    fn occluded(&self, ray: &rtgi_math::Ray) -> bool {
-        self.any(ray, &mut NoCounter, &AcceptAll)
-    }
-
-    fn intersect_counted(&self, ray: &rtgi_math::Ray, counters: &mut TraversalCounters) -> Option<Hit> {
-        counters.rays += 1;
-        self.closest(ray, counters, &AcceptAll)
-    }
-
-    fn occluded_counted(&self, ray: &rtgi_math::Ray, counters: &mut TraversalCounters) -> bool {
-        counters.rays += 1;
-        self.any(ray, counters, &AcceptAll)
-    }
-
-    fn intersect_filtered(&self, ray: &rtgi_math::Ray, accept: &dyn Fn(u32, f32, f32) -> bool) -> Option<Hit> {
-        self.closest(ray, &mut NoCounter, &accept)
-    }
-
-    fn occluded_filtered(&self, ray: &rtgi_math::Ray, accept: &dyn Fn(u32, f32, f32) -> bool) -> bool {
-        self.any(ray, &mut NoCounter, &accept)
-    }
-
-    fn build_stats(&self) -> &BuildStats {
+    fn stats(&self) -> &BuildStats {
         &self.stats
     }
 }
@@ -229,7 +207,7 @@ impl Accel for Bvh {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::AccelKind;
+    use crate::{Accel, AccelKind};
     use rtgi_math::{Ray, Rng};
 
     fn random_soup(count: usize, seed: u64) -> Vec<[Vec3; 3]> {

@@ -1,0 +1,197 @@
+//! The exactness contract, implemented once for every structure.
+//!
+//! Every structure answers a query with the same triangle, and the same
+//! bits of `t`, `beta` and `gamma`, as the linear scan:
+//!
+//! - **Hittable.** Only triangles for which [`is_hittable`] holds can be
+//!   hit (finite corners, non-zero area); structures may leave the others
+//!   out, and the linear scan skips them too.
+//! - **The hit rule.** Whether a ray hits a triangle, and where, is a pure
+//!   function of the ray and the triangle ([`hit_triangle`]): the
+//!   triangle test's answer within `[t_min, t_max]`, kept only if the ray
+//!   also passes the robust slab test of the triangle's own bounding box,
+//!   with `t` raised to that box's entry distance if rounding put it
+//!   below. Because the slab test is monotone in the box, a node box that
+//!   holds the triangle is then entered no later than the hit and not left
+//!   before it, so culling a box whose entry lies beyond the best hit so
+//!   far never loses a hit, nor a tie (boxes entered at exactly the best
+//!   `t` are still visited).
+//! - **Closest hit.** Among the hittable triangles hit, the smallest `t`;
+//!   at equal `t`, the lowest triangle index ([`Best::offer`]).
+//! - **Any hit.** True exactly when the closest hit would return a hit.
+//!
+//! This holds for the linear scan, every BVH variant, leaf size and bin
+//! count with the robust traversal, at any thread count, with either
+//! intersector, and for rays in every direction, including axis-parallel
+//! ones and directions with zero or negative-zero components. (The fast
+//! traversal drops boxes that rays graze and is outside the contract.)
+//!
+//! Structures implement [`Structure`], one traversal generic over the
+//! [`QueryKind`]; the [`Accel`] methods come from one blanket
+//! implementation.
+
+use rtgi_math::{Ray, Vec3, Vec3A};
+
+use crate::slab::{BoxRay, RobustSlabs, SlabTest};
+use crate::triangle::{TriangleHit, TriangleTest};
+use crate::{Accel, BuildStats, Counter, Hit, NoCounter, TraversalCounters};
+
+/// Whether a triangle can ever be hit: all corners finite and a non-zero
+/// area. The area is measured in double precision, where the cross product
+/// of single-precision edges neither underflows nor overflows, so a
+/// triangle counts as degenerate only when its corners are (very nearly
+/// exactly) collinear or repeated.
+pub fn is_hittable(triangle: &[Vec3; 3]) -> bool {
+    if !triangle.iter().all(|v| v.is_finite()) {
+        return false;
+    }
+    let [a, b, c] = triangle.map(|v| v.as_dvec3());
+    (b - a).cross(c - a) != rtgi_math::glam::DVec3::ZERO
+}
+
+/// The hit rule: where `ray` hits `triangle` with the triangle test `T`,
+/// or `None`. `t_max` may be lowered below the ray's own to skip hits that
+/// cannot win, which never changes a hit that is reported: the answer
+/// within the ray's range is a function of the ray and the triangle alone.
+#[inline(always)]
+pub(crate) fn hit_triangle<T: TriangleTest>(
+    test_ray: &T::Ray,
+    box_ray: &BoxRay,
+    triangle: &[Vec3A; 3],
+    t_max: f32,
+) -> Option<TriangleHit> {
+    let hit = T::intersect(test_ray, box_ray.t_min, t_max, triangle)?;
+    let [a, b, c] = *triangle;
+    let enter = RobustSlabs::enter(box_ray, a.min(b).min(c), a.max(b).max(c), t_max);
+    // `enter` is +∞ when the box is missed; otherwise it lies in [t_min, t_max].
+    (enter != f32::INFINITY).then_some(TriangleHit { t: hit.t.max(enter), ..hit })
+}
+
+/// Closest hit or any hit: the one difference between the two queries is
+/// whether the first accepted hit ends the search.
+pub(crate) trait QueryKind {
+    const STOP_AT_FIRST_HIT: bool;
+}
+
+/// The closest hit.
+pub(crate) struct Closest;
+
+impl QueryKind for Closest {
+    const STOP_AT_FIRST_HIT: bool = false;
+}
+
+/// Any hit.
+pub(crate) struct AnyHit;
+
+impl QueryKind for AnyHit {
+    const STOP_AT_FIRST_HIT: bool = true;
+}
+
+/// The best hit found so far, and the distance beyond which nothing can
+/// beat it.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Best {
+    pub(crate) hit: Option<Hit>,
+    pub(crate) t_max: f32,
+}
+
+impl Best {
+    #[inline(always)]
+    pub(crate) fn new(ray: &Ray) -> Self {
+        Self { hit: None, t_max: ray.t_max }
+    }
+
+    /// Takes `hit` on triangle `triangle` if it comes first in the order
+    /// `(t, triangle index)` and the filter accepts it; returns whether it did.
+    #[inline(always)]
+    pub(crate) fn offer<F: HitFilter>(&mut self, triangle: u32, hit: TriangleHit, filter: &F) -> bool {
+        let precedes = self.hit.is_none_or(|b| hit.t < b.t || (hit.t == b.t && triangle < b.triangle));
+        if precedes && filter.accept(triangle, hit.beta, hit.gamma) {
+            self.t_max = hit.t;
+            self.hit = Some(Hit { t: hit.t, triangle, beta: hit.beta, gamma: hit.gamma });
+            true
+        } else {
+            false
+        }
+    }
+}
+
+/// Decides whether a candidate hit counts; monomorphised, so the default
+/// [`AcceptAll`] costs nothing.
+pub(crate) trait HitFilter {
+    fn accept(&self, triangle: u32, beta: f32, gamma: f32) -> bool;
+}
+
+pub(crate) struct AcceptAll;
+
+impl HitFilter for AcceptAll {
+    #[inline(always)]
+    fn accept(&self, _triangle: u32, _beta: f32, _gamma: f32) -> bool {
+        true
+    }
+}
+
+impl HitFilter for &dyn Fn(u32, f32, f32) -> bool {
+    #[inline(always)]
+    fn accept(&self, triangle: u32, beta: f32, gamma: f32) -> bool {
+        self(triangle, beta, gamma)
+    }
+}
+
+/// A ray query structure: one traversal for both query kinds, from which
+/// the [`Accel`] methods follow.
+pub(crate) trait Structure: Send + Sync + std::fmt::Debug {
+    /// The closest hit, or with [`AnyHit`] the first hit found.
+    fn query<Q: QueryKind, C: Counter, F: HitFilter>(&self, ray: &Ray, counter: &mut C, filter: &F) -> Option<Hit>;
+
+    fn stats(&self) -> &BuildStats;
+}
+
+impl<S: Structure> Accel for S {
+    fn intersect(&self, ray: &Ray) -> Option<Hit> {
+        self.query::<Closest, _, _>(ray, &mut NoCounter, &AcceptAll)
+    }
+
+    fn occluded(&self, ray: &Ray) -> bool {
+        self.query::<AnyHit, _, _>(ray, &mut NoCounter, &AcceptAll).is_some()
+    }
+
+    fn intersect_counted(&self, ray: &Ray, counters: &mut TraversalCounters) -> Option<Hit> {
+        counters.rays += 1;
+        self.query::<Closest, _, _>(ray, counters, &AcceptAll)
+    }
+
+    fn occluded_counted(&self, ray: &Ray, counters: &mut TraversalCounters) -> bool {
+        counters.rays += 1;
+        self.query::<AnyHit, _, _>(ray, counters, &AcceptAll).is_some()
+    }
+
+    fn intersect_filtered(&self, ray: &Ray, accept: &dyn Fn(u32, f32, f32) -> bool) -> Option<Hit> {
+        self.query::<Closest, _, _>(ray, &mut NoCounter, &accept)
+    }
+
+    fn occluded_filtered(&self, ray: &Ray, accept: &dyn Fn(u32, f32, f32) -> bool) -> bool {
+        self.query::<AnyHit, _, _>(ray, &mut NoCounter, &accept).is_some()
+    }
+
+    fn build_stats(&self) -> &BuildStats {
+        self.stats()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn hittable_means_finite_with_area() {
+        let good = [Vec3::ZERO, Vec3::X, Vec3::Y];
+        assert!(is_hittable(&good));
+        // Tiny, but not degenerate: its area underflows in single precision.
+        assert!(is_hittable(&good.map(|v| v * 1e-30)));
+        assert!(!is_hittable(&[Vec3::ZERO, Vec3::X, 2.0 * Vec3::X]));
+        assert!(!is_hittable(&[Vec3::ZERO, Vec3::ZERO, Vec3::Y]));
+        assert!(!is_hittable(&[Vec3::new(f32::NAN, 0.0, 0.0), Vec3::X, Vec3::Y]));
+        assert!(!is_hittable(&[Vec3::new(0.0, f32::INFINITY, 0.0), Vec3::X, Vec3::Y]));
+    }
+}

@@ -1,0 +1,273 @@
+//! The built-in adversarial scenes: each class of input on which a
+//! structure that is not exact gives itself away.
+
+use rtgi_math::{Ray, Rng, SurfacePoint, Vec3, uniform_sphere};
+
+use super::shapes::{ClosedMesh, cylinder, icosphere, quad, rays_through_diagonal, tessellated_cube};
+use super::{Expect, ProbeRay, RayKind};
+
+/// One adversarial scene: its triangles, and rays made for it on top of
+/// the generic [`RayKind`]s.
+#[derive(Clone, Debug)]
+pub struct Case {
+    pub name: String,
+    pub triangles: Vec<[Vec3; 3]>,
+    /// Rays made for this scene, by kind (for example rays aimed inside
+    /// closed meshes, which must all hit).
+    pub special_rays: Vec<(&'static str, Vec<ProbeRay>)>,
+}
+
+impl Case {
+    /// The special rays and `per_kind` rays of every generic kind, by kind name.
+    pub fn rays(&self, per_kind: usize, seed: u64) -> Vec<(&'static str, Vec<ProbeRay>)> {
+        let mut rays = self.special_rays.clone();
+        for &kind in RayKind::ALL {
+            rays.push((kind.name(), kind.rays(&self.triangles, per_kind, seed)));
+        }
+        rays
+    }
+}
+
+/// The built-in adversarial set, with about `special` case-specific rays
+/// per case: coincident triangles, exact copies of meshes, closed meshes
+/// far from the origin and at extreme scales, degenerate triangles mixed
+/// in, a huge plane beside small objects, rays exactly through shared
+/// edges and vertices, and touching axis-aligned boxes.
+pub fn adversarial_cases(special: usize, seed: u64) -> Vec<Case> {
+    let mut cases = vec![coincident(seed), copies()];
+    cases.extend(closed_meshes(special, seed));
+    cases.push(degenerate(seed));
+    cases.push(mixed_scales(special, seed));
+    cases.push(shared_edges(special, seed));
+    cases.push(touching_boxes());
+    cases
+}
+
+/// Quads given twice, split along either diagonal, plus exact duplicates
+/// with their corners rotated, random and axis-aligned (as the walls of the
+/// Cornell box, whose file has such pairs).
+fn coincident(seed: u64) -> Case {
+    let mut rng = Rng::new(seed, 1);
+    let mut point = |s: f32| (Vec3::new(rng.next_f32(), rng.next_f32(), rng.next_f32()) * 2.0 - 1.0) * s;
+    let mut triangles = Vec::new();
+    for k in 0..48 {
+        let a = point(8.0);
+        let (u, v) = if k % 2 == 0 {
+            (point(3.0), point(3.0))
+        } else {
+            // Axis-aligned, with exactly representable corners.
+            let axis = k % 3;
+            let (mut u, mut v) = ([0.0; 3], [0.0; 3]);
+            u[(axis + 1) % 3] = 2.0;
+            v[(axis + 2) % 3] = 1.5;
+            (Vec3::from(u), Vec3::from(v))
+        };
+        let a = if k % 2 == 0 { a } else { a.round() };
+        let (b, c, d) = (a + u, a + u + v, a + v);
+        triangles.extend([[a, b, c], [a, c, d], [a, b, d], [b, c, d], [b, c, a]]);
+    }
+    Case { name: "coincident".into(), triangles, special_rays: Vec::new() }
+}
+
+/// Twelve exact copies each of a sphere and a cube, in the same place.
+fn copies() -> Case {
+    let mut triangles = Vec::new();
+    let (sphere, cube) = (icosphere(2).triangles(), tessellated_cube(3).placed(0.75, Vec3::splat(0.5)).triangles());
+    for _ in 0..12 {
+        triangles.extend_from_slice(&sphere);
+        triangles.extend_from_slice(&cube);
+    }
+    Case { name: "copies".into(), triangles, special_rays: Vec::new() }
+}
+
+/// A closed mesh and the points strictly inside it that rays are aimed at.
+struct Solid {
+    mesh: ClosedMesh,
+    /// A point inside the unit-sized shape, from two to three uniform numbers.
+    inside: fn(&mut Rng) -> Vec3,
+}
+
+fn solids() -> [(&'static str, Solid); 3] {
+    fn in_ball(rng: &mut Rng) -> Vec3 {
+        uniform_sphere(rng.next_f32(), rng.next_f32()) * 0.8 * rng.next_f32().cbrt()
+    }
+    fn in_cube(rng: &mut Rng) -> Vec3 {
+        (Vec3::new(rng.next_f32(), rng.next_f32(), rng.next_f32()) * 2.0 - 1.0) * 0.9
+    }
+    fn in_cylinder(rng: &mut Rng) -> Vec3 {
+        let (r, phi) = (0.85 * rng.next_f32().sqrt(), std::f32::consts::TAU * rng.next_f32());
+        Vec3::new(r * phi.cos(), r * phi.sin(), (rng.next_f32() * 2.0 - 1.0) * 0.9)
+    }
+    [
+        ("sphere", Solid { mesh: icosphere(2), inside: in_ball }),
+        ("cube", Solid { mesh: tessellated_cube(4), inside: in_cube }),
+        ("cylinder", Solid { mesh: cylinder(24, 3), inside: in_cylinder }),
+    ]
+}
+
+/// Rays from random points around a placed solid (`scale`, `offset`)
+/// aimed at random points inside it: every one must hit by the point.
+fn rays_inside(solid: &Solid, scale: f32, offset: Vec3, count: usize, rng: &mut Rng) -> Vec<ProbeRay> {
+    (0..count)
+        .map(|_| {
+            let origin = offset + uniform_sphere(rng.next_f32(), rng.next_f32()) * (2.0 + 6.0 * rng.next_f32()) * scale;
+            let target = offset + (solid.inside)(rng) * scale;
+            ProbeRay { ray: Ray::new(origin, target - origin), expect: Expect::HitBy(1.0 + 1e-3) }
+        })
+        .collect()
+}
+
+/// The ulp of `x`: the gap between it and the next float up.
+fn ulp(x: f32) -> f32 {
+    rtgi_math::next_float_up(x.abs()) - x.abs()
+}
+
+/// Each solid at offsets 2^0 … 2^23 from the origin (sizes of at least
+/// 2^6 ulps there, so that its shape survives rounding) and at scales
+/// 2^-20 … 2^20 near the origin.
+fn closed_meshes(count: usize, seed: u64) -> Vec<Case> {
+    let mut placements = Vec::new();
+    for exponent in [0, 4, 8, 12, 16, 20, 23] {
+        let offset = Vec3::new(1.0, 0.75, -0.5) * 2f32.powi(exponent);
+        for scale in [1.0f32, 16.0, 256.0] {
+            if scale >= 64.0 * ulp(offset.abs().max_element()) {
+                placements.push((scale, offset));
+            }
+        }
+    }
+    for exponent in [-20, -10, 10, 20] {
+        let scale = 2f32.powi(exponent);
+        placements.push((scale, Vec3::new(3.0, -1.0, 2.0) * scale));
+    }
+    let per_placement = count.div_ceil(placements.len()).max(1);
+    let mut rng = Rng::new(seed, 2);
+    solids()
+        .into_iter()
+        .map(|(name, solid)| {
+            let mut triangles = Vec::new();
+            let mut rays = Vec::new();
+            for &(scale, offset) in &placements {
+                // Solids placed far apart relative to their size: a ray aimed
+                // into one meets no other first.
+                triangles.extend(solid.mesh.placed(scale, offset).triangles());
+                rays.extend(rays_inside(&solid, scale, offset, per_placement, &mut rng));
+            }
+            Case { name: format!("closed-{name}"), triangles, special_rays: vec![("inside", rays)] }
+        })
+        .collect()
+}
+
+/// A random soup with unhittable triangles mixed in: collinear, repeated
+/// corners, NaN and infinite coordinates, and tiny and huge (but hittable)
+/// ones.
+fn degenerate(seed: u64) -> Case {
+    let mut rng = Rng::new(seed, 3);
+    let mut point = |s: f32| (Vec3::new(rng.next_f32(), rng.next_f32(), rng.next_f32()) * 2.0 - 1.0) * s;
+    let mut triangles = Vec::new();
+    for k in 0..300 {
+        let a = point(10.0);
+        let (e1, e2) = (point(2.0), point(2.0));
+        triangles.push(match k % 8 {
+            0 => [a, a + e1, a + 2.0 * e1],
+            1 => [a, a, a + e2],
+            2 => [a, a + e1, Vec3::new(f32::NAN, a.y, a.z)],
+            3 => [a, Vec3::new(f32::INFINITY, 0.0, 0.0), a + e2],
+            4 => [a, a + e1 * 1e-30, a + e2 * 1e-30],
+            5 => [a, a + e1 * 1e-6, a + e1 * 2e-6 + e2 * 1e-12],
+            6 => [a * 1e30, (a + e1) * 1e30, (a + e2) * 1e30],
+            _ => [a, a + e1, a + e2],
+        });
+    }
+    Case { name: "degenerate".into(), triangles, special_rays: Vec::new() }
+}
+
+/// A ground plane 2^15 wide, as an 8 × 8 grid of quads, with spheres of
+/// radius 1 resting on it near its centre; rays leave the plane at grazing
+/// angles and skim it from just above.
+fn mixed_scales(count: usize, seed: u64) -> Case {
+    let mut triangles = Vec::new();
+    let half = 16384.0f32;
+    for i in 0..8 {
+        for j in 0..8 {
+            let corner = Vec3::new(-half + i as f32 * 4096.0, -half + j as f32 * 4096.0, 0.0);
+            triangles.extend(quad(4096.0, corner));
+        }
+    }
+    let plane = triangles.len() as u32;
+    let mut rng = Rng::new(seed, 4);
+    let sphere = icosphere(2);
+    for _ in 0..20 {
+        let centre = Vec3::new(rng.next_f32() * 100.0 - 50.0, rng.next_f32() * 100.0 - 50.0, 1.0);
+        triangles.extend(sphere.placed(1.0, centre).triangles());
+    }
+    let mut rays = Vec::new();
+    for k in 0..count {
+        let index = rng.next_below(plane);
+        let t = triangles[index as usize];
+        let (mut u, mut v) = (rng.next_f32(), rng.next_f32());
+        if u + v > 1.0 {
+            (u, v) = (1.0 - u, 1.0 - v);
+        }
+        let phi = std::f32::consts::TAU * rng.next_f32();
+        let rise = 10f32.powf(-1.0 - 5.0 * rng.next_f32());
+        let direction = Vec3::new(phi.cos(), phi.sin(), rise);
+        if k % 2 == 0 {
+            // Leaving the plane, barely upwards.
+            let point = SurfacePoint::on_triangle(&t, u, v);
+            rays.push(ProbeRay { ray: point.spawn_ray(direction), expect: Expect::NotTriangle(index) });
+        } else {
+            // Skimming it from just above, near the spheres.
+            let origin = Vec3::new(rng.next_f32() * 200.0 - 100.0, rng.next_f32() * 200.0 - 100.0, rise);
+            rays.push(ProbeRay { ray: Ray::new(origin, -direction), expect: Expect::Nothing });
+        }
+    }
+    Case { name: "mixed-scales".into(), triangles, special_rays: vec![("grazing", rays)] }
+}
+
+/// Squares whose shared diagonal rays pass exactly through, at unit size,
+/// far from the origin and tiny, and fans of eight triangles around a
+/// shared vertex that rays pass exactly through.
+fn shared_edges(count: usize, seed: u64) -> Case {
+    let mut triangles = Vec::new();
+    let mut rays = Vec::new();
+    let setups = [
+        (1.0, Vec3::new(8.0, 8.0, 0.0), 20),
+        (1024.0, Vec3::splat(1_048_576.0), 13),
+        (65536.0, Vec3::splat(16_777_216.0), 15),
+        (2f32.powi(-40), Vec3::ZERO, 20),
+    ];
+    let per_setup = count.div_ceil(2 * setups.len()).max(1);
+    for (size, offset, bits) in setups {
+        triangles.extend(quad(size, offset));
+        let through = rays_through_diagonal(size, offset, bits, per_setup, seed ^ size.to_bits() as u64);
+        rays.extend(through.into_iter().map(|ray| ProbeRay { ray, expect: Expect::HitBy(1.0 + 1e-3) }));
+    }
+    let mut rng = Rng::new(seed, 5);
+    let ring = [(1.0, 0.0), (1.0, 1.0), (0.0, 1.0), (-1.0, 1.0), (-1.0, 0.0), (-1.0, -1.0), (0.0, -1.0), (1.0, -1.0)];
+    for (size, centre) in [(1.0f32, Vec3::new(-8.0, -8.0, 0.0)), (16.0, Vec3::new(-1_048_576.0, 1_048_576.0, 4096.0))] {
+        let p = |(x, y): (f32, f32)| centre + Vec3::new(x, y, 0.0) * size;
+        triangles.extend((0..8).map(|i| [centre, p(ring[i]), p(ring[(i + 1) % 8])]));
+        for _ in 0..per_setup {
+            let (i, j) = (rng.next_below(13) as f32 - 6.0, rng.next_below(13) as f32 - 6.0);
+            let height = if rng.next_f32() < 0.5 { 1.0 } else { -3.0 };
+            let origin = centre + Vec3::new(i * 0.25, j * 0.5, height) * size;
+            rays.push(ProbeRay { ray: Ray::new(origin, centre - origin), expect: Expect::HitBy(1.0 + 1e-3) });
+        }
+    }
+    Case { name: "shared-edges".into(), triangles, special_rays: vec![("through-edge", rays)] }
+}
+
+/// A 4 × 4 × 4 block of unit cubes that touch: neighbouring faces coincide,
+/// and every face lies on box planes that axis-parallel rays start on.
+fn touching_boxes() -> Case {
+    let cube = tessellated_cube(1);
+    let mut triangles = Vec::new();
+    for x in 0..4 {
+        for y in 0..4 {
+            for z in 0..4 {
+                triangles.extend(cube.placed(0.5, Vec3::new(x as f32, y as f32, z as f32) + 0.5).triangles());
+            }
+        }
+    }
+    Case { name: "touching-boxes".into(), triangles, special_rays: Vec::new() }
+}
