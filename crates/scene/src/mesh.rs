@@ -4,10 +4,18 @@ use rtgi_math::{Frame, Vec2, Vec3, Vec4};
 
 use crate::{Scene, Triangle, Vertex};
 
-/// Normals of faces meeting at a vertex are averaged only if they differ by
-/// less than this angle, so that smooth surfaces shade smoothly while the
-/// corners of boxes stay sharp.
+/// Faces sharing an edge are smoothed together only if their normals differ
+/// by at most this angle, so that smooth surfaces shade smoothly while the
+/// edges of boxes stay sharp.
 const CREASE_ANGLE_DEGREES: f32 = 60.0;
+
+/// How many faces of different directions one edge remembers when forming
+/// smoothing groups (see [`MeshBuilder::smoothing_groups`]); a plain edge
+/// needs one, the edge of a two-sided sheet two.
+const DIRECTIONS_PER_EDGE: usize = 4;
+
+/// An empty place in an edge's list of faces.
+const NO_FACE: u32 = u32::MAX;
 
 /// One triangle as an importer sees it: indices into the builder's attribute
 /// arrays, the normal and texture indices optional.
@@ -20,8 +28,9 @@ struct Face {
 }
 
 /// Collects indexed triangles from an importer and turns them into scene
-/// vertices: missing normals are computed (area-weighted, within a crease
-/// angle), and each distinct (position, uv, normal) becomes one vertex.
+/// vertices: missing normals are computed (area-weighted, over smoothing
+/// groups bounded by a crease angle), and each distinct (position, uv,
+/// normal) becomes one vertex.
 #[derive(Debug, Default)]
 pub struct MeshBuilder {
     positions: Vec<Vec3>,
@@ -73,8 +82,8 @@ impl MeshBuilder {
                 (b - a).cross(c - a)
             })
             .collect();
-        let adjacency = self.faces_by_position(&face_normals);
-        let cos_crease = self.crease_angle_degrees.to_radians().cos();
+        let smooth = self.smooth_corner_normals(&face_normals);
+        let mean_at_position = self.mean_normals_by_position(&face_normals);
 
         let mut vertex_of: HashMap<(u32, u32, [u32; 3]), u32> = HashMap::new();
         let first_vertex = scene.vertices.len();
@@ -87,17 +96,13 @@ impl MeshBuilder {
             let mut vertices = [0u32; 3];
             for corner in 0..3 {
                 let position_index = face.positions[corner];
-                let neighbours = || adjacency.faces_at(position_index).iter().map(|&g| face_normals[g as usize]);
                 let normal = match face.normals {
                     Some(n) => self.normals[n[corner] as usize].normalize_or_zero(),
-                    None => neighbours()
-                        .filter(|n| n.normalize_or_zero().dot(own) >= cos_crease)
-                        .sum::<Vec3>()
-                        .normalize_or_zero(),
+                    None => smooth[3 * face_index + corner],
                 };
                 // Zero-length file normals and degenerate faces still get a unit
                 // normal: the face's own, else its neighbours' mean, else +Z.
-                let normal = [normal, own, neighbours().sum::<Vec3>().normalize_or_zero(), Vec3::Z]
+                let normal = [normal, own, mean_at_position[position_index as usize], Vec3::Z]
                     .into_iter()
                     .find(|n| *n != Vec3::ZERO)
                     .unwrap_or(Vec3::Z);
@@ -120,29 +125,88 @@ impl MeshBuilder {
         compute_tangents(scene, first_vertex, first_triangle, &given_tangent);
     }
 
-    /// For each position, the faces using it, in compressed-row form. Faces
-    /// with their own normals are left out: they never need computed ones.
-    fn faces_by_position(&self, face_normals: &[Vec3]) -> Adjacency {
-        let mut offsets = vec![0u32; self.positions.len() + 1];
-        let needed = |f: &Face| f.normals.is_none();
-        for face in self.faces.iter().filter(|f| needed(f)) {
-            for p in face.positions {
-                offsets[p as usize + 1] += 1;
+    /// The computed normal of every corner (corner `c` of face `f` at index
+    /// `3 f + c`) of the faces without file normals: the normalised sum of
+    /// the area-weighted normals of the faces in its smoothing group (see
+    /// [`MeshBuilder::smoothing_groups`]); zero where that sum is zero.
+    /// Corners of faces with file normals are left zero.
+    fn smooth_corner_normals(&self, face_normals: &[Vec3]) -> Vec<Vec3> {
+        let mut groups = self.smoothing_groups(face_normals);
+        let computed = |corner: usize| self.faces[corner / 3].normals.is_none();
+        let mut sums = vec![Vec3::ZERO; 3 * self.faces.len()];
+        for corner in (0..sums.len()).filter(|&c| computed(c)) {
+            sums[groups.find(corner)] += face_normals[corner / 3];
+        }
+        (0..sums.len())
+            .map(|corner| if computed(corner) { sums[groups.find(corner)].normalize_or_zero() } else { Vec3::ZERO })
+            .collect()
+    }
+
+    /// The smoothing groups of the corners of faces without file normals,
+    /// by the "auto smooth" rule of Blender and most modelling tools: around
+    /// each position, two faces sharing an edge (the same two position
+    /// indices) join when their normals differ by at most the crease angle,
+    /// and joins chain, so a finely tessellated curved surface is one group
+    /// however far its ends turn. Faces that meet only at the position, or
+    /// across a sharper bend, stay apart.
+    ///
+    /// The edges are found through a hash map and the groups kept in a
+    /// union-find over corners, so the work is linear in the number of
+    /// faces (expected), whatever the valence of a position; comparing each
+    /// corner with every face at its position was quadratic in the valence.
+    ///
+    /// An edge remembers the first face of each direction met on it, up to
+    /// [`DIRECTIONS_PER_EDGE`], and a later face joins the first of those
+    /// within the crease angle, else is remembered itself (if there is
+    /// room). A manifold edge so joins its two faces; the front and back of
+    /// a two-sided sheet sharing positions each stay smooth without joining
+    /// each other; and an edge shared by many faces (non-manifold) costs
+    /// constant time per face. Degenerate faces join nothing.
+    fn smoothing_groups(&self, face_normals: &[Vec3]) -> UnionFind {
+        let cos_crease = self.crease_angle_degrees.to_radians().cos();
+        let unit: Vec<Vec3> = face_normals.iter().map(|n| n.normalize_or_zero()).collect();
+        let bend_gently =
+            |f: usize, g: usize| unit[f] != Vec3::ZERO && unit[g] != Vec3::ZERO && unit[f].dot(unit[g]) >= cos_crease;
+        let mut groups = UnionFind::new(3 * self.faces.len());
+        let mut faces_on_edge: HashMap<(u32, u32), [u32; DIRECTIONS_PER_EDGE]> = HashMap::new();
+        for (f, face) in self.faces.iter().enumerate().filter(|(_, f)| f.normals.is_none()) {
+            for corner in 0..3 {
+                let (p, q) = (face.positions[corner], face.positions[(corner + 1) % 3]);
+                let remembered = faces_on_edge.entry((p.min(q), p.max(q))).or_insert([NO_FACE; DIRECTIONS_PER_EDGE]);
+                let known = remembered.iter().position(|&g| g == NO_FACE).unwrap_or(DIRECTIONS_PER_EDGE);
+                match remembered[..known].iter().copied().find(|&g| bend_gently(f, g as usize)) {
+                    Some(g) => {
+                        for position in [p, q] {
+                            groups.union(self.corner_at(f, position), self.corner_at(g as usize, position));
+                        }
+                    }
+                    None if known < DIRECTIONS_PER_EDGE => remembered[known] = f as u32,
+                    // The edge remembers no more directions: the face stays apart across it.
+                    None => {}
+                }
             }
         }
-        for i in 1..offsets.len() {
-            offsets[i] += offsets[i - 1];
-        }
-        let mut fill = offsets.clone();
-        let mut faces = vec![0u32; *offsets.last().unwrap_or(&0) as usize];
-        for (index, face) in self.faces.iter().enumerate().filter(|(_, f)| needed(f)) {
-            debug_assert!(index < face_normals.len());
+        groups
+    }
+
+    /// The index (`3 f + c`) of the corner of face `f` at `position`, which
+    /// the face must use.
+    fn corner_at(&self, f: usize, position: u32) -> usize {
+        let corner = self.faces[f].positions.iter().position(|&p| p == position);
+        3 * f + corner.expect("the face uses the position")
+    }
+
+    /// For each position, the normalised sum of the normals of the faces
+    /// without file normals that use it: the fallback for corners whose own
+    /// face is degenerate.
+    fn mean_normals_by_position(&self, face_normals: &[Vec3]) -> Vec<Vec3> {
+        let mut sums = vec![Vec3::ZERO; self.positions.len()];
+        for (face, normal) in self.faces.iter().zip(face_normals).filter(|(f, _)| f.normals.is_none()) {
             for p in face.positions {
-                faces[fill[p as usize] as usize] = index as u32;
-                fill[p as usize] += 1;
+                sums[p as usize] += *normal;
             }
         }
-        Adjacency { offsets, faces }
+        sums.iter().map(|s| s.normalize_or_zero()).collect()
     }
 }
 
@@ -183,20 +247,44 @@ fn compute_tangents(scene: &mut Scene, first_vertex: usize, first_triangle: usiz
     }
 }
 
-struct Adjacency {
-    offsets: Vec<u32>,
-    faces: Vec<u32>,
+/// Disjoint sets of the indices `0..n`, with path halving and union by
+/// size, so that any sequence of operations takes nearly linear time.
+struct UnionFind {
+    parent: Vec<u32>,
+    size: Vec<u32>,
 }
 
-impl Adjacency {
-    fn faces_at(&self, position: u32) -> &[u32] {
-        let p = position as usize;
-        &self.faces[self.offsets[p] as usize..self.offsets[p + 1] as usize]
+impl UnionFind {
+    fn new(n: usize) -> Self {
+        Self { parent: (0..n as u32).collect(), size: vec![1; n] }
+    }
+
+    /// The representative of `i`'s set.
+    fn find(&mut self, mut i: usize) -> usize {
+        while self.parent[i] as usize != i {
+            let grandparent = self.parent[self.parent[i] as usize];
+            self.parent[i] = grandparent;
+            i = grandparent as usize;
+        }
+        i
+    }
+
+    /// Merges the sets of `a` and `b`.
+    fn union(&mut self, a: usize, b: usize) {
+        let (a, b) = (self.find(a), self.find(b));
+        if a == b {
+            return;
+        }
+        let (small, large) = if self.size[a] < self.size[b] { (a, b) } else { (b, a) };
+        self.parent[small] = large as u32;
+        self.size[large] += self.size[small];
     }
 }
 
 #[cfg(test)]
 mod tests {
+    use std::time::{Duration, Instant};
+
     use super::*;
 
     /// A unit cube's 8 corners and 12 outward-facing triangles.
@@ -258,5 +346,137 @@ mod tests {
         let shared = scene.vertices[scene.triangles[0].vertices[0] as usize].normal;
         // About halfway between the two face normals (0 and 20 degrees from +Z).
         assert!(shared.z > 0.98 && shared.x < -0.1 && shared.x > -0.25, "{shared}");
+    }
+
+    /// A closed fan of `count` triangles around position 0, at `centre`,
+    /// whose rim is the unit circle in the xy plane; counter-clockwise seen
+    /// from +z.
+    fn fan(count: u32, centre: Vec3) -> MeshBuilder {
+        let rim = (0..count).map(|i| {
+            let angle = std::f32::consts::TAU * i as f32 / count as f32;
+            Vec3::new(angle.cos(), angle.sin(), 0.0)
+        });
+        let mut b = MeshBuilder::new(std::iter::once(centre).chain(rim).collect(), vec![], vec![]);
+        for i in 0..count {
+            b.push([0, 1 + i, 1 + (i + 1) % count], None, None, 0);
+        }
+        b
+    }
+
+    /// Builds the scene of `b` and checks that it took well under the
+    /// minutes a time quadratic in the valence of a vertex would take.
+    fn finish_in_linear_time(b: MeshBuilder) -> Scene {
+        let start = Instant::now();
+        let mut scene = Scene::default();
+        b.finish_into(&mut scene);
+        let took = start.elapsed();
+        assert!(took < Duration::from_secs(5), "{} triangles took {took:?}", scene.triangles.len());
+        scene
+    }
+
+    /// The one vertex that every triangle of a fan has as its first corner.
+    fn fan_centre(scene: &Scene) -> Vertex {
+        let centre = scene.triangles[0].vertices[0];
+        assert!(scene.triangles.iter().all(|t| t.vertices[0] == centre), "the centre was split");
+        scene.vertices[centre as usize]
+    }
+
+    #[test]
+    fn a_flat_fan_of_100000_triangles_is_smoothed_in_linear_time() {
+        let scene = finish_in_linear_time(fan(100_000, Vec3::ZERO));
+        assert_eq!(scene.triangles.len(), 100_000);
+        assert_eq!(scene.vertices.len(), 100_001);
+        // Every face normal is exactly along +z, and so is their sum.
+        for v in &scene.vertices {
+            assert_eq!((v.normal.x, v.normal.y), (0.0, 0.0), "{}", v.normal);
+            assert!((v.normal.z - 1.0).abs() < 1e-6, "{}", v.normal);
+        }
+        assert_eq!(fan_centre(&scene).position, Vec3::ZERO);
+    }
+
+    #[test]
+    fn a_cone_of_100000_triangles_is_smoothed_in_linear_time() {
+        // Faces tilt 45 degrees out from the axis, so faces on opposite sides
+        // differ by 90 degrees; neighbours differ by a tiny angle and chain
+        // into one smoothing group around the apex.
+        let scene = finish_in_linear_time(fan(100_000, Vec3::Z));
+        assert_eq!(scene.vertices.len(), 100_001);
+        let apex = fan_centre(&scene);
+        assert_eq!(apex.position, Vec3::Z);
+        assert!((apex.normal - Vec3::Z).length() < 1e-4, "{}", apex.normal);
+        // A rim vertex averages its two faces: 45 degrees from the axis.
+        let rim = scene.vertices[scene.triangles[0].vertices[1] as usize];
+        assert!((rim.normal.z - std::f32::consts::FRAC_1_SQRT_2).abs() < 1e-4, "{}", rim.normal);
+    }
+
+    #[test]
+    fn an_edge_shared_by_100000_faces_is_handled_in_linear_time() {
+        // A book of pages around the edge from position 0 to position 1.
+        let count = 100_000u32;
+        let pages = (0..count).map(|i| {
+            let angle = std::f32::consts::TAU * i as f32 / count as f32;
+            Vec3::new(angle.cos(), angle.sin(), 0.5)
+        });
+        let positions = [Vec3::ZERO, Vec3::Z].into_iter().chain(pages).collect();
+        let mut b = MeshBuilder::new(positions, vec![], vec![]);
+        for i in 0..count {
+            b.push([0, 1, 2 + i], None, None, 0);
+        }
+        let scene = finish_in_linear_time(b);
+        assert_eq!(scene.triangles.len(), count as usize);
+        assert!(scene.vertices.iter().all(|v| (v.normal.length() - 1.0).abs() < 1e-5));
+    }
+
+    #[test]
+    fn both_sides_of_a_two_sided_sheet_stay_smooth() {
+        // Two triangles meeting at a 20 degree fold, and the same two wound
+        // the other way, on the same positions: the edge has four faces.
+        let z = 20f32.to_radians().tan();
+        let positions = vec![Vec3::ZERO, Vec3::Y, Vec3::new(-1.0, 0.0, 0.0), Vec3::new(1.0, 0.0, z)];
+        let mut b = MeshBuilder::new(positions, vec![], vec![]);
+        b.push([0, 1, 2], None, None, 0);
+        b.push([0, 2, 1], None, None, 0);
+        b.push([0, 3, 1], None, None, 0);
+        b.push([0, 1, 3], None, None, 0);
+        let mut scene = Scene::default();
+        b.finish_into(&mut scene);
+        let normal_at = |t: usize, corner: usize| scene.vertices[scene.triangles[t].vertices[corner] as usize].normal;
+        // Each side shares one normal on the fold, the back's opposite the front's.
+        assert_eq!(normal_at(0, 0), normal_at(2, 0));
+        assert_eq!(normal_at(1, 0), normal_at(3, 0));
+        assert!((normal_at(0, 0) + normal_at(1, 0)).length() < 1e-6);
+        assert!(normal_at(0, 0).z > 0.98, "{}", normal_at(0, 0));
+    }
+
+    #[test]
+    fn faces_meeting_only_at_a_vertex_are_not_smoothed_together() {
+        // Two triangles 20 degrees apart that share position 0 and no edge.
+        let z = 20f32.to_radians().tan();
+        let positions =
+            vec![Vec3::ZERO, Vec3::Y, Vec3::new(-1.0, 0.0, 0.0), Vec3::new(1.0, 0.0, z), Vec3::new(0.0, -1.0, 0.0)];
+        let mut b = MeshBuilder::new(positions, vec![], vec![]);
+        b.push([0, 1, 2], None, None, 0);
+        b.push([0, 4, 3], None, None, 0);
+        let mut scene = Scene::default();
+        b.finish_into(&mut scene);
+        assert_eq!(scene.vertices.len(), 6);
+        assert_eq!(scene.vertices[scene.triangles[0].vertices[0] as usize].normal, Vec3::Z);
+    }
+
+    #[test]
+    fn degenerate_faces_take_their_neighbours_mean() {
+        // A zero-area triangle (0 1 3) beside a tilted proper one (0 1 2).
+        let positions = vec![Vec3::ZERO, Vec3::X, Vec3::new(0.0, 1.0, 1.0), Vec3::new(2.0, 0.0, 0.0)];
+        let mut b = MeshBuilder::new(positions, vec![], vec![]);
+        b.push([0, 1, 2], None, None, 0);
+        b.push([0, 1, 3], None, None, 0);
+        let mut scene = Scene::default();
+        b.finish_into(&mut scene);
+        let proper = scene.vertices[scene.triangles[0].vertices[0] as usize].normal;
+        assert!((proper - Vec3::new(0.0, -1.0, 1.0).normalize()).length() < 1e-6, "{proper}");
+        let degenerate = scene.triangles[1].vertices.map(|v| scene.vertices[v as usize].normal);
+        // Positions 0 and 1 take the proper face's normal; position 3 has
+        // only the degenerate face: +Z as the last resort.
+        assert_eq!(degenerate, [proper, proper, Vec3::Z]);
     }
 }
