@@ -38,6 +38,50 @@ pub(crate) enum Command {
     Compare(CompareArgs),
     /// Measure what each effect costs: render time with effects forced on and off, and how the image changes
     BenchEffects(BenchEffectsArgs),
+    /// Check that every acceleration structure answers hard rays exactly as the linear scan does,
+    /// bit for bit, and that rays aimed inside closed surfaces never leak
+    Verify(VerifyArgs),
+}
+
+/// `rtgi verify`: the exactness contract, checked on a scene or on the built-in adversarial set.
+#[derive(Debug, Args)]
+pub(crate) struct VerifyArgs {
+    /// Scene file (.obj, .gltf, .glb or .toml); the built-in adversarial scenes when omitted
+    pub(crate) scene: Option<PathBuf>,
+
+    /// Rays in all, shared evenly among the ray kinds (and scenes)
+    #[arg(long, default_value_t = 1_000_000, value_parser = clap::value_parser!(u32).range(1..=1_000_000_000))]
+    pub(crate) rays: u32,
+
+    /// Structures to check against the linear scan: 'all', or names separated by commas
+    #[arg(long, default_value = "all", value_parser = parse_accel_list)]
+    pub(crate) accel: AccelList,
+
+    /// Check every leaf size (1, 2, 4, 8, 16), bin count and intersector, as the tests do,
+    /// instead of the build options below
+    #[arg(long)]
+    pub(crate) exhaustive: bool,
+
+    #[command(flatten)]
+    pub(crate) build: BuildArgs,
+
+    /// Triangle tests the linear scan may spend per ray kind; on big scenes it answers only the
+    /// first rays of each kind within this budget, and the others are compared with the first
+    /// structure checked
+    #[arg(long, default_value_t = 2_000_000_000, value_parser = clap::value_parser!(u64).range(1..))]
+    pub(crate) linear_budget: u64,
+
+    /// Seed of the rays
+    #[arg(long, default_value_t = 1)]
+    pub(crate) seed: u64,
+
+    /// Worker threads [default: one per core]
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1024))]
+    pub(crate) threads: Option<u32>,
+
+    /// Also write the table as JSON to this file
+    #[arg(long)]
+    pub(crate) json: Option<PathBuf>,
 }
 
 /// `rtgi bench-effects`: the time each effect of the plan costs or saves.

@@ -12,6 +12,7 @@ mod effects_cmd;
 mod info_cmd;
 mod render_cmd;
 mod trace_cmd;
+mod verify_cmd;
 
 use std::process::ExitCode;
 
@@ -32,6 +33,7 @@ pub fn main() -> ExitCode {
         cli::Command::Info(args) => info_cmd::run(&args),
         cli::Command::Compare(args) => info_cmd::compare(&args),
         cli::Command::BenchEffects(args) => effects_cmd::run(&args),
+        cli::Command::Verify(args) => verify_cmd::run(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

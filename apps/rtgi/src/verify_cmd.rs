@@ -1,0 +1,235 @@
+//! `rtgi verify`: every chosen structure against the linear scan, bit for
+//! bit, on rays of the kinds that expose inexact structures.
+
+use std::collections::BTreeMap;
+use std::time::Instant;
+
+use anyhow::{Result, bail};
+use rtgi_accel::verify::{Answer, Case, ProbeRay, RayKind, Tally, adversarial_cases};
+use rtgi_accel::{Accel, AccelKind, BuildParams, Intersector, LinearScan, Traversal};
+use serde::Serialize;
+
+use crate::cli::VerifyArgs;
+use crate::common::{check_output_folder, load_scene, thread_pool, write_atomically};
+
+/// One row of the table: a ray kind, summed over scenes and structures.
+#[derive(Debug, Default, Serialize)]
+struct KindRow {
+    kind: String,
+    /// Rays of this kind (per structure).
+    rays: usize,
+    /// Of those, the rays the linear scan answered; the rest were compared
+    /// with the first structure checked.
+    linear_rays: usize,
+    /// Summed over the structures (the linear scan included for leaks and self-hits).
+    tally: Tally,
+}
+
+/// The totals of one structure over every scene and kind.
+#[derive(Debug, Serialize)]
+struct StructureRow {
+    structure: String,
+    /// Whether it claims watertightness (its leaks are failures).
+    watertight: bool,
+    tally: Tally,
+}
+
+#[derive(Debug, Serialize)]
+struct Report {
+    scene: String,
+    seed: u64,
+    kinds: Vec<KindRow>,
+    structures: Vec<StructureRow>,
+}
+
+pub(crate) fn run(args: &VerifyArgs) -> Result<()> {
+    if let Some(json) = &args.json {
+        check_output_folder(json)?;
+    }
+    // Rays are shared evenly among the scenes and, in each, among the kinds:
+    // the generic ones and the scene's own.
+    let kinds_per_case = RayKind::ALL.len() + 1;
+    let (scene_name, cases) = match &args.scene {
+        Some(path) => {
+            let loaded = load_scene(Some(path))?;
+            let per_kind = (args.rays as usize).div_ceil(kinds_per_case);
+            let case =
+                Case { name: loaded.name.clone(), triangles: loaded.scene.triangle_positions(), special_rays: vec![] };
+            (loaded.name, vec![(case, per_kind)])
+        }
+        None => {
+            let count = adversarial_cases(0, args.seed).len();
+            let per_kind = (args.rays as usize).div_ceil(count * kinds_per_case).max(1);
+            let cases = adversarial_cases(per_kind, args.seed).into_iter().map(|c| (c, per_kind)).collect();
+            ("built-in adversarial scenes".to_owned(), cases)
+        }
+    };
+    let configurations = configurations(args);
+    let pool = thread_pool(args.threads)?;
+    let start = Instant::now();
+
+    let mut kinds: BTreeMap<String, KindRow> = BTreeMap::new();
+    let mut structures: Vec<StructureRow> = Vec::new();
+    for (case, per_kind) in &cases {
+        let rays = pool.install(|| case.rays(*per_kind, args.seed));
+        let budget_rays = (args.linear_budget / case.triangles.len().max(1) as u64) as usize;
+        pool.install(|| {
+            check_case(case, &rays, &configurations, budget_rays, &mut kinds, &mut structures);
+        });
+        eprintln!(
+            "{}: {} triangles, {} rays per structure checked ({:.1} s)",
+            case.name,
+            case.triangles.len(),
+            rays.iter().map(|(_, r)| r.len()).sum::<usize>(),
+            start.elapsed().as_secs_f64()
+        );
+    }
+    let report = Report { scene: scene_name, seed: args.seed, kinds: kinds.into_values().collect(), structures };
+    print_report(&report);
+    if let Some(json) = &args.json {
+        write_atomically(json, serde_json::to_string_pretty(&report)?.as_bytes())?;
+    }
+    let failed = report.structures.iter().any(|s| {
+        let t = &s.tally;
+        t.closest_disagreements + t.any_disagreements + t.self_hits > 0 || (s.watertight && t.leaks > 0)
+    });
+    if failed {
+        bail!("the structures do not all answer exactly as the linear scan, or rays leaked (see the table)");
+    }
+    Ok(())
+}
+
+/// The structures to check, each with its build parameters.
+fn configurations(args: &VerifyArgs) -> Vec<(AccelKind, BuildParams)> {
+    let chosen = |kind: &AccelKind| args.accel.0.contains(kind) && *kind != AccelKind::Linear;
+    if args.exhaustive {
+        AccelKind::all_configurations().into_iter().filter(|(kind, _)| chosen(kind)).collect()
+    } else {
+        AccelKind::ALL.iter().filter(|k| chosen(k)).map(|&kind| (kind, args.build.params())).collect()
+    }
+}
+
+fn label(kind: AccelKind, params: &BuildParams) -> String {
+    let mut label = format!("{kind} (leaf {}", params.max_leaf_size);
+    if kind == AccelKind::Sah {
+        label += &format!(", {} bins", params.sah_bins);
+    }
+    label += &format!(", {}", params.intersector);
+    if params.traversal != Traversal::Robust {
+        label += &format!(", {} traversal", params.traversal);
+    }
+    label + ")"
+}
+
+/// Checks every configuration on one scene's rays, adding to the kind rows
+/// and the structure totals.
+fn check_case(
+    case: &Case,
+    rays: &[(&'static str, Vec<ProbeRay>)],
+    configurations: &[(AccelKind, BuildParams)],
+    linear_rays: usize,
+    kinds: &mut BTreeMap<String, KindRow>,
+    structures: &mut Vec<StructureRow>,
+) {
+    let add = |name: String, watertight: bool, tally: &Tally, structures: &mut Vec<StructureRow>| match structures
+        .iter_mut()
+        .find(|s| s.structure == name)
+    {
+        Some(row) => row.tally.add(tally),
+        None => structures.push(StructureRow { structure: name, watertight, tally: tally.clone() }),
+    };
+    let intersectors: Vec<Intersector> = {
+        let mut list: Vec<Intersector> = configurations.iter().map(|(_, p)| p.intersector).collect();
+        list.dedup();
+        list.sort_by_key(|i| i.name());
+        list.dedup();
+        list
+    };
+    for intersector in intersectors {
+        let watertight = intersector == Intersector::Watertight;
+        let linear = LinearScan::new(&case.triangles, intersector);
+        let chosen: Vec<&(AccelKind, BuildParams)> =
+            configurations.iter().filter(|(_, p)| p.intersector == intersector).collect();
+        let built: Vec<(String, Box<dyn Accel>)> =
+            chosen.iter().map(|(kind, params)| (label(*kind, params), kind.build(&case.triangles, params))).collect();
+        for (kind, probes) in rays {
+            let checked = probes.len().min(linear_rays);
+            let linear_answers = Answer::all(&linear, &probes[..checked]);
+            let linear_tally = Tally::of(&probes[..checked], &linear_answers, None);
+            add(format!("linear ({intersector})"), watertight, &linear_tally, structures);
+            // The reference: the linear scan where it answered, else the first structure.
+            let mut reference = linear_answers;
+            if checked < probes.len() {
+                if let Some((_, first)) = built.first() {
+                    reference.extend(Answer::all(first.as_ref(), &probes[checked..]));
+                }
+            }
+            let row = kinds
+                .entry(kind.to_string())
+                .or_insert_with(|| KindRow { kind: kind.to_string(), ..KindRow::default() });
+            row.rays += probes.len();
+            row.linear_rays += checked;
+            let mut linear_counted = linear_tally.clone();
+            linear_counted.rays = 0;
+            if watertight {
+                row.tally.add(&linear_counted);
+            }
+            for (name, accel) in &built {
+                let tally = Tally::of(probes, &Answer::all(accel.as_ref(), probes), Some(&reference));
+                add(name.clone(), watertight, &tally, structures);
+                let mut counted = tally;
+                counted.rays = 0;
+                if !watertight {
+                    // Möller-Trumbore is not watertight: its leaks are reported per structure only.
+                    counted.leaks = 0;
+                }
+                row.tally.add(&counted);
+            }
+        }
+    }
+}
+
+fn print_report(report: &Report) {
+    println!("rtgi verify: {} (seed {})", report.scene, report.seed);
+    println!();
+    println!(
+        "{:<15} {:>10} {:>12} {:>14} {:>14} {:>8} {:>10}",
+        "ray kind", "rays", "linear rays", "closest diff.", "any-hit diff.", "leaks", "self-hits"
+    );
+    for row in &report.kinds {
+        let t = &row.tally;
+        println!(
+            "{:<15} {:>10} {:>12} {:>14} {:>14} {:>8} {:>10}",
+            row.kind, row.rays, row.linear_rays, t.closest_disagreements, t.any_disagreements, t.leaks, t.self_hits
+        );
+    }
+    println!();
+    println!(
+        "{:<44} {:>10} {:>14} {:>14} {:>8} {:>10}",
+        "structure", "rays", "closest diff.", "any-hit diff.", "leaks", "self-hits"
+    );
+    for s in &report.structures {
+        let t = &s.tally;
+        let leaks = if s.watertight || t.leaks == 0 { t.leaks.to_string() } else { format!("({})", t.leaks) };
+        println!(
+            "{:<44} {:>10} {:>14} {:>14} {:>8} {:>10}",
+            s.structure, t.rays, t.closest_disagreements, t.any_disagreements, leaks, t.self_hits
+        );
+    }
+    println!();
+    println!(
+        "Disagreements are differences in any bit of the closest hit (triangle, t, beta, gamma) or in the any-hit \
+         answer, against the linear scan (on big scenes the linear scan answers the first rays of each kind; the \
+         rest are compared with the first structure). Leaks are rays aimed inside a closed surface that hit nothing \
+         by the point aimed at; leaks in parentheses are those of a test that does not claim watertightness \
+         (moller-trumbore). Self-hits are rays leaving a triangle that hit it again."
+    );
+    for s in &report.structures {
+        let t = &s.tally;
+        if t.closest_disagreements + t.any_disagreements + t.self_hits > 0 || (s.watertight && t.leaks > 0) {
+            for example in &t.examples {
+                println!("  {}: {example}", s.structure);
+            }
+        }
+    }
+}
