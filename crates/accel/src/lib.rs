@@ -19,6 +19,34 @@
 //! assert_eq!((hit.t, hit.triangle), (2.0, 0));
 //! assert!(accel.occluded(&ray));
 //! ```
+//!
+//! # The exactness contract
+//!
+//! The structure is a pure speed choice: swapping it changes the time,
+//! never the answer. Every structure (the linear scan, every BVH variant,
+//! leaf size and bin count with the robust traversal, and every structure
+//! added later), at any thread count and with either intersector, returns
+//! for every ray, in any direction including axis-parallel ones and
+//! directions with zero or negative-zero components:
+//!
+//! - **closest hit**: among the *hittable* triangles ([`is_hittable`]:
+//!   finite corners, non-zero area) hit with `t_min <= t <= t_max`, the
+//!   smallest `t`, and at equal `t` the lowest triangle index. `t`, `beta`
+//!   and `gamma` are those of that triangle's own test, so two structures
+//!   that agree on the triangle agree on every bit;
+//! - **any hit**: true exactly when the closest hit would return a hit.
+//!
+//! A triangle's test is the intersector's (watertight by default) followed
+//! by the robust slab test of the triangle's own bounding box, which must
+//! pass, with `t` raised to the box's entry distance if rounding put it
+//! below: the slab test is monotone in the box, so every node box holding
+//! the triangle is entered no later than the hit and left no earlier, and
+//! traversal can cull boxes that lie beyond the best hit without ever
+//! losing a hit or a tie ([`Intersector::intersect`] applies the same rule
+//! to one triangle). The [`verify`] module checks the contract on any
+//! scene, and `rtgi verify` runs it from the command line; the fast
+//! traversal ([`Traversal::Fast`]) drops boxes that rays graze and is
+//! outside the contract.
 
 mod boxa;
 mod bvh;
@@ -83,10 +111,12 @@ pub struct BuildStats {
 /// uncounted methods are used.
 pub trait Accel: Send + Sync + std::fmt::Debug {
     /// The closest hit in `[ray.t_min, ray.t_max]`, or `None`.
-    /// At equal `t`, the triangle with the lower index wins.
+    /// At equal `t`, the triangle with the lower index wins (see the
+    /// exactness contract in the crate's documentation).
     fn intersect(&self, ray: &Ray) -> Option<Hit>;
 
-    /// Whether anything is hit in `[ray.t_min, ray.t_max]`; stops at the first hit found.
+    /// Whether anything is hit in `[ray.t_min, ray.t_max]`: exactly when
+    /// [`Accel::intersect`] would return a hit. Stops at the first hit found.
     fn occluded(&self, ray: &Ray) -> bool;
 
     /// [`Accel::intersect`], adding the work done to `counters`.
