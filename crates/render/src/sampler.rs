@@ -1,14 +1,30 @@
-use rtgi_math::{Rng, Vec2};
+use rtgi_math::{Rng, Vec2, hash_u64, next_float_down, next_float_up};
 
 /// Where inside a pixel the samples go.
+///
+/// Every sampler but `Center` is unbiased for every sample count `n`: over
+/// the pixel's random choices each sample is uniform either over the whole
+/// pixel (uniform, low-discrepancy) or over its own cell of a grid of `n`
+/// cells that tile the pixel (stratified), so the mean of the samples
+/// estimates the mean over the pixel. Sample `i` of `n` depends only on
+/// `i`, `n`, the pixel's [`PixelSample::pixel_shift`] and the sample's own
+/// generator, never on other samples, so images are the same for any
+/// number of threads.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum PixelSampler {
     /// Every sample at the pixel's centre: no antialiasing, no noise.
     Center,
     /// Uniformly random positions in the pixel.
     Uniform,
-    /// Jittered: the pixel is cut into ⌈√n⌉ × ⌈√n⌉ cells, sample `i` falls
-    /// at a random position in cell `i`.
+    /// Correlated multi-jittered sampling (Kensler, "Correlated
+    /// Multi-Jittered Sampling", Pixar technical memo 13-01, 2013) on an
+    /// `m × k` grid with `m · k = n` exactly, `m` the largest divisor of `n`
+    /// not above `√n`: each of the grid's cells, and each of the `n` strips
+    /// across x and the `n` strips across y, holds exactly one sample. The
+    /// permutations that place the samples within their cells are chosen
+    /// per pixel from its shift, the jitter comes from each sample's
+    /// generator. For a prime `n` the grid is `1 × n`: the samples are then
+    /// stratified in x and in y separately (n-rooks), but not in 2D.
     Stratified,
     /// The R2 low-discrepancy sequence (Roberts 2018), shifted by a random
     /// offset per pixel (Cranley-Patterson rotation) so that neighbouring
@@ -22,7 +38,9 @@ pub enum PixelSampler {
 pub struct PixelSample {
     pub index: u32,
     pub count: u32,
-    /// Uniform in `[0, 1)²`, the same for every sample of the pixel.
+    /// Uniform in `[0, 1)²`, the same for every sample of the pixel: the
+    /// low-discrepancy sampler's shift, and the seed of the stratified
+    /// sampler's permutations.
     pub pixel_shift: Vec2,
 }
 
@@ -50,10 +68,17 @@ impl PixelSampler {
             PixelSampler::Center => Vec2::splat(0.5),
             PixelSampler::Uniform => Vec2::new(rng.next_f32(), rng.next_f32()),
             PixelSampler::Stratified => {
-                let side = (sample.count as f32).sqrt().ceil().max(1.0) as u32;
-                let cell = sample.index % (side * side);
-                let corner = Vec2::new((cell % side) as f32, (cell / side) as f32);
-                ((corner + Vec2::new(rng.next_f32(), rng.next_f32())) / side as f32).min(Vec2::splat(ONE_BELOW_ONE))
+                let count = sample.count.max(1);
+                let index = sample.index % count;
+                let (columns, rows) = grid(count);
+                let (column, row) = (index % columns, index / columns);
+                // The pixel's two permutations: of the rows within a column
+                // (which x strip of its column a sample takes) and of the
+                // columns within a row (which y strip of its row).
+                let seed = pixel_seed(sample.pixel_shift);
+                let x_strip = column * rows + permute(row, rows, seed as u32);
+                let y_strip = row * columns + permute(column, columns, (seed >> 32) as u32);
+                Vec2::new(in_strip(x_strip, rng.next_f32(), count), in_strip(y_strip, rng.next_f32(), count))
             }
             PixelSampler::LowDiscrepancy => {
                 // Indices wrap at 2^24 so that the products stay exact in f32.
@@ -63,6 +88,77 @@ impl PixelSampler {
             }
         }
     }
+}
+
+/// The columns and rows of the stratified sampler's grid for `count`
+/// samples: `columns · rows = count`, `columns` the largest divisor not
+/// above `√count` (found by trial division: at most √count steps).
+fn grid(count: u32) -> (u32, u32) {
+    let mut columns = count.isqrt().max(1);
+    while count % columns != 0 {
+        columns -= 1;
+    }
+    (columns, count / columns)
+}
+
+/// A hash of the pixel's shift: its permutations' seeds.
+fn pixel_seed(shift: Vec2) -> u64 {
+    hash_u64(((shift.x.to_bits() as u64) << 32) | shift.y.to_bits() as u64)
+}
+
+/// A position in strip `strip` of `count` equal strips of `[0, 1)`, at
+/// `jitter ∈ [0, 1)` across it, inside the strip exactly despite rounding
+/// (for counts up to 2^24, where strips are still wider than an f32 step).
+fn in_strip(strip: u32, jitter: f32, count: u32) -> f32 {
+    let (strip, count) = (strip as f64, count as f64);
+    let mut x = ((strip + jitter as f64) / count) as f32;
+    // x · count is exact in f64 (24 × 32 bits), so these tests are too.
+    if x as f64 * count >= strip + 1.0 {
+        x = next_float_down(x);
+    } else if (x as f64 * count) < strip {
+        x = next_float_up(x);
+    }
+    x.clamp(0.0, ONE_BELOW_ONE)
+}
+
+/// Element `i` of a pseudo-random permutation of `0..len` chosen by `seed`,
+/// computed on its own (Kensler 2013, listing 3): a hash that is a
+/// bijection on the smallest power of two at least `len`, applied until its
+/// value falls below `len` (cycle walking), then rotated by the seed.
+fn permute(mut i: u32, len: u32, seed: u32) -> u32 {
+    if len <= 1 {
+        return 0;
+    }
+    let mut mask = len - 1;
+    mask |= mask >> 1;
+    mask |= mask >> 2;
+    mask |= mask >> 4;
+    mask |= mask >> 8;
+    mask |= mask >> 16;
+    loop {
+        i ^= seed;
+        i = i.wrapping_mul(0xe170_893d);
+        i ^= seed >> 16;
+        i ^= (i & mask) >> 4;
+        i ^= seed >> 8;
+        i = i.wrapping_mul(0x0929_eb3f);
+        i ^= seed >> 23;
+        i ^= (i & mask) >> 1;
+        i = i.wrapping_mul(1 | seed >> 27);
+        i = i.wrapping_mul(0x6935_fa69);
+        i ^= (i & mask) >> 11;
+        i = i.wrapping_mul(0x74dc_b303);
+        i ^= (i & mask) >> 2;
+        i = i.wrapping_mul(0x9e50_1cc3);
+        i ^= (i & mask) >> 2;
+        i = i.wrapping_mul(0xc860_a3df);
+        i &= mask;
+        i ^= i >> 5;
+        if i < len {
+            break;
+        }
+    }
+    ((i as u64 + seed as u64) % len as u64) as u32
 }
 
 /// The largest f32 below 1, so that offsets stay inside their pixel.
@@ -75,44 +171,198 @@ mod tests {
     use super::*;
 
     fn offsets(sampler: PixelSampler, count: u32, pixel: u64) -> Vec<Vec2> {
+        // As `render` does: the pixel's shift from one generator past every sample's.
         let mut shift_rng = Rng::for_sample(1, pixel, u64::MAX);
         let pixel_shift = Vec2::new(shift_rng.next_f32(), shift_rng.next_f32());
         (0..count)
             .map(|index| {
                 let mut rng = Rng::for_sample(1, pixel, index as u64);
-                sampler.offset(&PixelSample { index, count, pixel_shift }, &mut rng)
+                let p = sampler.offset(&PixelSample { index, count, pixel_shift }, &mut rng);
+                assert!(p.cmpge(Vec2::ZERO).all() && p.cmplt(Vec2::ONE).all(), "{sampler} {index}/{count}: {p}");
+                p
             })
             .collect()
     }
 
+    /// The counts the tests try: every one up to 256, squares or not.
+    const COUNTS: std::ops::RangeInclusive<u32> = 1..=256;
+    const PIXELS: u64 = 128;
+
+    /// Which of `count` equal strips of [0, 1) holds `x`, exactly (the
+    /// product of an f32 and a small integer is exact in f64).
+    fn strip(x: f32, count: u32) -> usize {
+        (x as f64 * count as f64).floor() as usize
+    }
+
     #[test]
-    fn stratified_samples_fill_every_cell_once() {
-        let points = offsets(PixelSampler::Stratified, 16, 3);
-        let mut cells = [0u32; 16];
-        for p in points {
-            assert!(p.cmpge(Vec2::ZERO).all() && p.cmplt(Vec2::ONE).all());
-            cells[(p.y * 4.0) as usize * 4 + (p.x * 4.0) as usize] += 1;
+    fn center_is_the_centre_for_every_count() {
+        for count in COUNTS {
+            assert!(offsets(PixelSampler::Center, count, 7).iter().all(|&p| p == Vec2::splat(0.5)));
         }
-        assert!(cells.iter().all(|&c| c == 1), "{cells:?}");
+    }
+
+    /// The bug of issue 12: with `n` not a square, the old stratified
+    /// sampler cut the pixel into ⌈√n⌉² cells and left the last ones empty,
+    /// which moved the mean of its samples away from the pixel's centre.
+    #[test]
+    fn every_sampler_centres_its_samples_for_every_count() {
+        for &sampler in PixelSampler::ALL.iter().filter(|&&s| s != PixelSampler::Center) {
+            for count in COUNTS {
+                // Each pixel's mean position is one draw; their spread gives the standard error.
+                let means: Vec<[f64; 2]> = (0..PIXELS)
+                    .map(|pixel| {
+                        let points = offsets(sampler, count, pixel);
+                        let sum = points.iter().fold([0.0, 0.0], |s, p| [s[0] + p.x as f64, s[1] + p.y as f64]);
+                        [sum[0] / count as f64, sum[1] / count as f64]
+                    })
+                    .collect();
+                for axis in 0..2 {
+                    let n = PIXELS as f64;
+                    let mean = means.iter().map(|m| m[axis]).sum::<f64>() / n;
+                    let variance = means.iter().map(|m| (m[axis] - mean).powi(2)).sum::<f64>() / (n - 1.0);
+                    let standard_error = (variance / n).sqrt();
+                    // 5σ, and a little for f32 positions (and next_f32's 2^-25 below the centre).
+                    let tolerance = 5.0 * standard_error + 1e-6;
+                    assert!(
+                        (mean - 0.5).abs() < tolerance,
+                        "{sampler}, {count} spp, axis {axis}: mean {mean} is {:.1} standard errors off",
+                        (mean - 0.5).abs() / standard_error
+                    );
+                }
+            }
+        }
+    }
+
+    /// Over many pixels every sampler fills 16 strips across x and across y
+    /// evenly: a chi-square test with 15 degrees of freedom, at its mean
+    /// plus 8 standard deviations (a chance below 10⁻⁶ for a uniform sampler).
+    #[test]
+    fn every_sampler_covers_the_pixel_evenly() {
+        const STRIPS: usize = 16;
+        let limit = (STRIPS - 1) as f64 + 8.0 * (2.0 * (STRIPS - 1) as f64).sqrt();
+        for &sampler in PixelSampler::ALL.iter().filter(|&&s| s != PixelSampler::Center) {
+            for count in COUNTS {
+                let mut counts = [[0u32; STRIPS]; 2];
+                for pixel in 0..PIXELS {
+                    for p in offsets(sampler, count, 1000 + pixel) {
+                        counts[0][strip(p.x, STRIPS as u32)] += 1;
+                        counts[1][strip(p.y, STRIPS as u32)] += 1;
+                    }
+                }
+                let expected = (PIXELS * count as u64) as f64 / STRIPS as f64;
+                for (axis, counts) in counts.iter().enumerate() {
+                    let chi2: f64 = counts.iter().map(|&c| (c as f64 - expected).powi(2) / expected).sum();
+                    assert!(chi2 < limit, "{sampler}, {count} spp, axis {axis}: χ² = {chi2:.1}, strips {counts:?}");
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn stratified_samples_fill_every_strip_and_cell_once() {
+        for count in COUNTS {
+            // m · k = count, m the largest divisor of count not above √count.
+            let columns = (1..=count).filter(|m| count % m == 0 && m * m <= count).max().unwrap();
+            let rows = count / columns;
+            assert_eq!(grid(count), (columns, rows));
+            for pixel in 0..PIXELS {
+                let points = offsets(PixelSampler::Stratified, count, pixel);
+                let mut x_strips = vec![0u32; count as usize];
+                let mut y_strips = vec![0u32; count as usize];
+                let mut cells = vec![0u32; count as usize];
+                for p in points {
+                    x_strips[strip(p.x, count)] += 1;
+                    y_strips[strip(p.y, count)] += 1;
+                    cells[strip(p.y, rows) * columns as usize + strip(p.x, columns)] += 1;
+                }
+                let once = |v: &[u32]| v.iter().all(|&c| c == 1);
+                assert!(once(&x_strips), "{count} spp, pixel {pixel}: x strips {x_strips:?}");
+                assert!(once(&y_strips), "{count} spp, pixel {pixel}: y strips {y_strips:?}");
+                assert!(once(&cells), "{count} spp, pixel {pixel}: {columns}×{rows} cells {cells:?}");
+            }
+        }
+    }
+
+    #[test]
+    fn stratified_patterns_differ_between_pixels() {
+        // The permutations come from the pixel, so neighbours do not repeat a pattern.
+        let strips =
+            |pixel| offsets(PixelSampler::Stratified, 64, pixel).iter().map(|p| strip(p.x, 64)).collect::<Vec<_>>();
+        let patterns: std::collections::HashSet<Vec<usize>> = (0..16).map(strips).collect();
+        assert_eq!(patterns.len(), 16);
+    }
+
+    #[test]
+    fn permutations_are_permutations() {
+        for len in [1, 2, 3, 5, 7, 16, 17, 100, 255, 256, 257, 1000] {
+            for seed in [0, 1, 0xdead_beef, u32::MAX] {
+                let mut seen = vec![false; len as usize];
+                for i in 0..len {
+                    let j = permute(i, len, seed) as usize;
+                    assert!(!seen[j], "permute(_, {len}, {seed}) repeats {j}");
+                    seen[j] = true;
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn strips_hold_their_samples_despite_rounding() {
+        for count in [1, 3, 7, 100, 255, 256, 1000, 65_521, 1 << 20] {
+            for strip_index in [0, 1, count / 3, count - 1].into_iter().filter(|&s| s < count) {
+                for jitter in [0.0, 0.5, 1.0 - f32::EPSILON / 2.0] {
+                    let x = in_strip(strip_index, jitter, count);
+                    assert_eq!(
+                        strip(x, count),
+                        strip_index as usize,
+                        "strip {strip_index} of {count}, jitter {jitter}"
+                    );
+                }
+            }
+        }
+    }
+
+    /// R2's projections are Kronecker sequences {i α}; by the three-distance
+    /// theorem their gaps take at most three lengths, set by the continued
+    /// fractions of α = 1/ρ and 1/ρ². For n ≤ 256 the largest gap of n
+    /// points (on the circle, so for any shift) is 4.21/n, at n = 50; so
+    /// every interval of width 4.5/n holds a sample. (Jittered strips
+    /// guarantee 2/n; n uniform points leave gaps of about ln n / n.)
+    #[test]
+    fn low_discrepancy_samples_leave_no_wide_gap() {
+        for count in 4..=*COUNTS.end() {
+            for pixel in 0..PIXELS / 4 {
+                let points = offsets(PixelSampler::LowDiscrepancy, count, pixel);
+                for axis in 0..2 {
+                    let mut values: Vec<f64> = points.iter().map(|p| p.to_array()[axis] as f64).collect();
+                    values.sort_by(f64::total_cmp);
+                    let gaps = values.windows(2).map(|w| w[1] - w[0]);
+                    let widest = gaps.chain([values[0], 1.0 - values[values.len() - 1]]).fold(0.0, f64::max);
+                    assert!(widest * (count as f64) < 4.5, "{count} spp, pixel {pixel}, axis {axis}: gap {widest}");
+                }
+            }
+        }
     }
 
     #[test]
     fn spread_samplers_integrate_better_than_uniform() {
-        // Mean error of 64-sample estimates of ∫∫ x·y = 1/4 over 200 pixels.
-        let error = |sampler: PixelSampler| {
-            let mut total = 0.0;
-            for pixel in 0..200 {
-                let points = offsets(sampler, 64, pixel);
-                assert!(points.iter().all(|p| p.cmpge(Vec2::ZERO).all() && p.cmplt(Vec2::ONE).all()));
-                let estimate: f32 = points.iter().map(|p| p.x * p.y).sum::<f32>() / 64.0;
-                total += (estimate - 0.25).abs();
+        // Mean error of n-sample estimates of ∫∫ x·y = 1/4 over 200 pixels,
+        // for a square count, a prime and a count of neither kind.
+        for count in [64, 61, 96] {
+            let error = |sampler: PixelSampler| {
+                let mut total = 0.0;
+                for pixel in 0..200 {
+                    let points = offsets(sampler, count, pixel);
+                    let estimate: f32 = points.iter().map(|p| p.x * p.y).sum::<f32>() / count as f32;
+                    total += (estimate - 0.25).abs();
+                }
+                total / 200.0
+            };
+            let uniform = error(PixelSampler::Uniform);
+            for sampler in [PixelSampler::Stratified, PixelSampler::LowDiscrepancy] {
+                let e = error(sampler);
+                assert!(e < 0.5 * uniform, "{sampler}, {count} spp: {e} against uniform {uniform}");
             }
-            total / 200.0
-        };
-        let uniform = error(PixelSampler::Uniform);
-        for sampler in [PixelSampler::Stratified, PixelSampler::LowDiscrepancy] {
-            let e = error(sampler);
-            assert!(e < 0.5 * uniform, "{sampler}: {e} against uniform {uniform}");
         }
     }
 }
