@@ -28,7 +28,8 @@ pub enum PixelSampler {
     Stratified,
     /// The R2 low-discrepancy sequence (Roberts 2018), shifted by a random
     /// offset per pixel (Cranley-Patterson rotation) so that neighbouring
-    /// pixels do not repeat the same pattern.
+    /// pixels do not repeat the same pattern; computed in 64-bit fixed
+    /// point, exact for every index.
     LowDiscrepancy,
 }
 
@@ -44,8 +45,9 @@ pub struct PixelSample {
     pub pixel_shift: Vec2,
 }
 
-/// The plastic number's reciprocals: the R2 sequence's increments.
-const R2: Vec2 = Vec2::new(0.754_877_7, 0.569_840_3);
+/// The plastic number's reciprocals 1/ρ and 1/ρ², the R2 sequence's
+/// increments, in 0.64 fixed point.
+const R2: [u64; 2] = [0xc13f_a9a9_02a6_328f, 0x91e1_0da5_c79e_7b1d];
 
 impl PixelSampler {
     pub const ALL: &'static [PixelSampler] =
@@ -81,10 +83,15 @@ impl PixelSampler {
                 Vec2::new(in_strip(x_strip, rng.next_f32(), count), in_strip(y_strip, rng.next_f32(), count))
             }
             PixelSampler::LowDiscrepancy => {
-                // Indices wrap at 2^24 so that the products stay exact in f32.
-                let i = (sample.index & 0xFF_FFFF) as f32;
-                let point = Vec2::splat(0.5) + R2 * i + sample.pixel_shift;
-                (point - point.floor()).min(Vec2::splat(ONE_BELOW_ONE))
+                let i = sample.index as u64;
+                let shift = sample.pixel_shift.to_array();
+                let coordinate = |axis: usize| {
+                    // 1/2 + i·α + shift, modulo 1: wrapping arithmetic is exact.
+                    let fixed = (1u64 << 63).wrapping_add(i.wrapping_mul(R2[axis])).wrapping_add(to_fixed(shift[axis]));
+                    // The top 24 bits, as `Rng::next_f32` makes them: in [0, 1).
+                    (fixed >> 40) as f32 * (1.0 / 16_777_216.0)
+                };
+                Vec2::new(coordinate(0), coordinate(1))
             }
         }
     }
@@ -119,6 +126,11 @@ fn in_strip(strip: u32, jitter: f32, count: u32) -> f32 {
         x = next_float_up(x);
     }
     x.clamp(0.0, ONE_BELOW_ONE)
+}
+
+/// A value in `[0, 1)` in 0.64 fixed point (exact for an f32).
+fn to_fixed(x: f32) -> u64 {
+    (x.clamp(0.0, 1.0) as f64 * 18_446_744_073_709_551_616.0) as u64
 }
 
 /// Element `i` of a pseudo-random permutation of `0..len` chosen by `seed`,
@@ -340,6 +352,25 @@ mod tests {
                     let widest = gaps.chain([values[0], 1.0 - values[values.len() - 1]]).fold(0.0, f64::max);
                     assert!(widest * (count as f64) < 4.5, "{count} spp, pixel {pixel}, axis {axis}: gap {widest}");
                 }
+            }
+        }
+    }
+
+    #[test]
+    fn low_discrepancy_matches_the_r2_sequence() {
+        // Fixed point against the f64 formula, for small and for large indices.
+        let pixel_shift = Vec2::new(0.25, 0.625);
+        let alpha = [0.754_877_666_246_692_7_f64, 0.569_840_290_998_053_2];
+        for index in [0, 1, 2, 1000, 1 << 24, u32::MAX] {
+            let sample = PixelSample { index, count: u32::MAX, pixel_shift };
+            let p = PixelSampler::LowDiscrepancy.offset(&sample, &mut Rng::new(0, 0));
+            let (got, shift) = (p.to_array(), pixel_shift.to_array());
+            for (axis, alpha) in alpha.into_iter().enumerate() {
+                let exact = (0.5 + index as f64 * alpha + shift[axis] as f64).fract();
+                let difference = (got[axis] as f64 - exact).abs();
+                // Distance on the circle; f64's own error grows with the index: about index · 2^-53.
+                let tolerance = 2.0f64.powi(-23) + index as f64 * 2.0f64.powi(-50);
+                assert!(difference.min(1.0 - difference) < tolerance, "index {index}, axis {axis}");
             }
         }
     }
