@@ -35,6 +35,34 @@ pub fn shared_scene(relative: &str) -> Option<PathBuf> {
     }
 }
 
+/// Side of the renders compared with the Cornell box reference,
+/// `tests/references/cornell-box-path.exr`.
+pub const CORNELL_SIZE: u32 = 64;
+
+/// The shared Cornell box path traced as its reference was
+/// (`tests/cornell_reference.rs`): `CORNELL_SIZE` square, framed as
+/// `rtgi render` frames a scene without a camera (40° field of view),
+/// default settings otherwise.
+pub fn render_cornell_box(
+    scene: &rtgi_scene::Scene,
+    samples_per_pixel: u32,
+    sampler: rtgi_render::PixelSampler,
+    seed: u64,
+) -> rtgi_image::HdrImage {
+    use rtgi_accel::{AccelKind, BuildParams};
+    let accel = AccelKind::Sah.build(&scene.triangle_positions(), &BuildParams::default());
+    let camera = rtgi_render::frame_scene(scene, accel.as_ref(), 40f32.to_radians(), 1.0);
+    let settings = rtgi_render::RenderSettings {
+        width: CORNELL_SIZE,
+        height: CORNELL_SIZE,
+        samples_per_pixel,
+        sampler,
+        seed,
+        ..rtgi_render::RenderSettings::default()
+    };
+    rtgi_render::render(scene, accel.as_ref(), &camera, &settings, &|_| {}).0
+}
+
 /// A fresh empty folder for one test's files.
 pub fn scratch_dir(test: &str) -> PathBuf {
     let dir = std::env::temp_dir().join(format!("rtgi-tests-{}-{test}", std::process::id()));

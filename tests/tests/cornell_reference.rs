@@ -22,30 +22,17 @@
 //! pixel, 5σ is about 0.7% of the whole image's brightness and 6% of an
 //! 8×8 block's: biases larger than that fail.
 
-use rtgi_accel::{AccelKind, BuildParams};
 use rtgi_image::{HdrImage, ToneMap};
-use rtgi_render::{PixelSampler, RenderSettings, frame_scene, render};
+use rtgi_render::PixelSampler;
 use rtgi_scene::Scene;
-use rtgi_tests::{shared_scene, workspace_root};
+use rtgi_tests::{CORNELL_SIZE as SIZE, render_cornell_box, shared_scene, workspace_root};
 
-const SIZE: u32 = 64;
 const REFERENCE_SPP: u32 = 16_384;
 const RUNS: u32 = 16;
 const RUN_SPP: u32 = 16;
 
 fn render_box(scene: &Scene, samples_per_pixel: u32, seed: u64) -> HdrImage {
-    let accel = AccelKind::Sah.build(&scene.triangle_positions(), &BuildParams::default());
-    // The framing `rtgi render` gives a scene without a camera (40° field of view).
-    let camera = frame_scene(scene, accel.as_ref(), 40f32.to_radians(), 1.0);
-    let settings = RenderSettings {
-        width: SIZE,
-        height: SIZE,
-        samples_per_pixel,
-        sampler: PixelSampler::Stratified,
-        seed,
-        ..RenderSettings::default()
-    };
-    render(scene, accel.as_ref(), &camera, &settings, &|_| {}).0
+    render_cornell_box(scene, samples_per_pixel, PixelSampler::Stratified, seed)
 }
 
 #[test]
