@@ -47,12 +47,12 @@ pub(crate) fn run(args: &VerifyArgs) -> Result<()> {
         check_output_folder(json)?;
     }
     // Rays are shared evenly among the scenes and, in each, among the kinds:
-    // the generic ones and the scene's own.
+    // the generic ones and (for the built-in scenes) the scene's own.
     let kinds_per_case = RayKind::ALL.len() + 1;
     let (scene_name, cases) = match &args.scene {
         Some(path) => {
             let loaded = load_scene(Some(path))?;
-            let per_kind = (args.rays as usize).div_ceil(kinds_per_case);
+            let per_kind = (args.rays as usize).div_ceil(RayKind::ALL.len());
             let case =
                 Case { name: loaded.name.clone(), triangles: loaded.scene.triangle_positions(), special_rays: vec![] };
             (loaded.name, vec![(case, per_kind)])
