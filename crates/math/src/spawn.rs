@@ -28,7 +28,11 @@ impl SurfacePoint {
     /// The point with barycentric coordinates `(1 - beta - gamma, beta,
     /// gamma)` on the triangle `corners`, as a ray/triangle test reports
     /// it. The error bound `γ(7) Σ |b_i p_i|` covers the barycentrics' and
-    /// the interpolation's rounding (pbrt-v4, section 6.8.5).
+    /// the interpolation's rounding (pbrt-v4, section 6.8.5); a term of
+    /// `16 ε` times the farthest corner's distance times the triangle's
+    /// [`elongation`] (at most [`MAX_ELONGATION`]) covers the rounding of the
+    /// ray/triangle test's distances, so that rays leaving the point never
+    /// hit the triangle again.
     pub fn on_triangle(corners: &[Vec3; 3], beta: f32, gamma_: f32) -> Self {
         Self::on_triangle_with_normal(corners, beta, gamma_, geometric_normal(corners))
     }
@@ -41,7 +45,20 @@ impl SurfacePoint {
         let alpha = 1.0 - beta - gamma_;
         let [p0, p1, p2] = corners;
         let position = alpha * *p0 + beta * *p1 + gamma_ * *p2;
-        let error = gamma(7) * ((alpha * *p0).abs() + (beta * *p1).abs() + (gamma_ * *p2).abs());
+        let rounding = gamma(7) * ((alpha * *p0).abs() + (beta * *p1).abs() + (gamma_ * *p2).abs());
+        // A ray that leaves the point meets this triangle's plane again, in
+        // the ray/triangle test, a tiny distance behind its origin; the test
+        // must find that distance negative. The watertight test computes it
+        // from the corners relative to the origin, as an average of their
+        // distances along the ray weighted by rounded edge functions, so it
+        // errs by a few ulps of the farthest corner's distance, and by more
+        // for slivers, whose weights round by up to their elongation (longest
+        // edge over altitude) times more. The origin starts farther off the
+        // plane than 16 ε times that distance times the elongation, which is
+        // capped at 64 so that needles do not open gaps that leak light;
+        // needles more elongated than that may still be hit again.
+        let extent = (*p0 - position).abs().max((*p1 - position).abs()).max((*p2 - position).abs()).max_element();
+        let error = rounding + Vec3::splat(16.0 * f32::EPSILON * extent * elongation(corners).min(MAX_ELONGATION));
         Self { position, error, normal }
     }
 
@@ -76,6 +93,19 @@ impl SurfacePoint {
         let from = self.offset_origin(target - self.position);
         Ray::with_range(from, target - from, SPAWN_T_MIN, SHADOW_T_MAX)
     }
+}
+
+/// Elongations up to which rays spawned from a triangle are offset far
+/// enough never to hit it again (see [`SurfacePoint::on_triangle`]).
+pub const MAX_ELONGATION: f32 = 64.0;
+
+/// How elongated a triangle is: its longest edge over its altitude onto
+/// that edge (the square of the longest edge over twice the area); at
+/// least about 1.15 (equilateral), infinite for a degenerate triangle.
+pub fn elongation(corners: &[Vec3; 3]) -> f32 {
+    let [a, b, c] = corners.map(|v| v.as_dvec3());
+    let longest = (b - a).length_squared().max((c - b).length_squared()).max((a - c).length_squared());
+    (longest / (b - a).cross(c - a).length()) as f32
 }
 
 /// The unit normal of a triangle by the right-hand rule, or zero for a

@@ -32,7 +32,8 @@ impl Case {
 /// per case: coincident triangles, exact copies of meshes, closed meshes
 /// far from the origin and at extreme scales, degenerate triangles mixed
 /// in, a huge plane beside small objects, rays exactly through shared
-/// edges and vertices, and touching axis-aligned boxes.
+/// edges and vertices, touching axis-aligned boxes, and large triangles and
+/// needles.
 pub fn adversarial_cases(special: usize, seed: u64) -> Vec<Case> {
     let mut cases = vec![coincident(seed), copies()];
     cases.extend(closed_meshes(special, seed));
@@ -40,6 +41,7 @@ pub fn adversarial_cases(special: usize, seed: u64) -> Vec<Case> {
     cases.push(mixed_scales(special, seed));
     cases.push(shared_edges(special, seed));
     cases.push(touching_boxes());
+    cases.push(walls_and_needles(25 * special, seed));
     cases
 }
 
@@ -255,6 +257,31 @@ fn shared_edges(count: usize, seed: u64) -> Case {
         }
     }
     Case { name: "shared-edges".into(), triangles, special_rays: vec![("through-edge", rays)] }
+}
+
+/// Large triangles around the origin (rays leave them near their corners,
+/// far from their other corners, as on the walls of a Cornell box), and
+/// needles up to 1000 times longer than wide (as the mouldings of Sponza):
+/// where a ray/triangle test's distances round most.
+fn walls_and_needles(count: usize, seed: u64) -> Case {
+    let mut rng = Rng::new(seed, 6);
+    let mut point = |s: f32| (Vec3::new(rng.next_f32(), rng.next_f32(), rng.next_f32()) * 2.0 - 1.0) * s;
+    let mut triangles = Vec::new();
+    for k in 0..200 {
+        let a = point(1.0);
+        let triangle = if k % 2 == 0 {
+            [a, a + point(16.0), a + point(16.0)]
+        } else {
+            let along = point(12.0);
+            let across = along.cross(point(1.0)).normalize_or_zero() * along.length() / [8.0, 64.0, 1000.0][k % 3];
+            [a, a + along, a + 0.5 * along + across]
+        };
+        triangles.push(triangle);
+    }
+    // Self-hits are rare (about one ray in 10^5 on real scenes, were the
+    // offset too small): many secondary rays.
+    let leaving = RayKind::Secondary.rays(&triangles, count, seed ^ 0x5e1f);
+    Case { name: "walls-and-needles".into(), triangles, special_rays: vec![("leaving", leaving)] }
 }
 
 /// A 4 × 4 × 4 block of unit cubes that touch: neighbouring faces coincide,

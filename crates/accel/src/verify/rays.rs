@@ -3,7 +3,7 @@
 
 use std::collections::HashMap;
 
-use rtgi_math::{Aabb, Ray, Rng, SurfacePoint, Vec3, geometric_normal, uniform_sphere};
+use rtgi_math::{Aabb, MAX_ELONGATION, Ray, Rng, SurfacePoint, Vec3, elongation, geometric_normal, uniform_sphere};
 
 use super::{Expect, ProbeRay};
 use crate::is_hittable;
@@ -22,8 +22,8 @@ pub enum RayKind {
     AxisParallel,
     /// Leaving a point on a triangle, as a renderer spawns them: mirrored
     /// about the normal, or towards a point on another triangle. A hit on
-    /// the triangle the ray leaves is a self-hit (counted for triangles
-    /// whose width is more than 1024 ulps of their coordinates).
+    /// the triangle the ray leaves is a self-hit (counted for triangles no
+    /// more elongated than `rtgi_math::MAX_ELONGATION`).
     Secondary,
     /// Aimed inside the silhouette where the surface is closed: at interior
     /// points of triangles, edges shared by two triangles and vertices
@@ -142,13 +142,11 @@ impl<'a> SceneFeatures<'a> {
                     let (_, other) = self.random_triangle(rng);
                     point.spawn_ray_to(&random_surface_point(&other, rng))
                 };
-                // A sliver whose width is within rounding of its coordinates
-                // has no well-defined plane to leave: any test's rounding can
-                // tilt it onto the ray. Its rays are traced, but only
-                // well-shaped triangles are held to never being hit again.
-                let magnitude = t.iter().map(|v| v.abs().max_element()).fold(0.0, f32::max);
-                let well_shaped = altitude(&t) > 1024.0 * f32::EPSILON * magnitude;
-                let expect = if well_shaped { Expect::NotTriangle(index) } else { Expect::Nothing };
+                // Spawned rays are offset far enough for triangles up to an
+                // elongation (see `SurfacePoint::on_triangle`); needles beyond
+                // it are traced, but not held to never being hit again.
+                let expect =
+                    if elongation(&t) <= MAX_ELONGATION { Expect::NotTriangle(index) } else { Expect::Nothing };
                 Some(ProbeRay { ray, expect })
             }
             RayKind::Silhouette => unreachable!("made by silhouette_rays"),
@@ -204,11 +202,25 @@ impl<'a> SceneFeatures<'a> {
             let unit = direction.normalize_or_zero();
             let facing = |f: &u32| geometric_normal(&self.triangles[*f as usize]).dot(unit);
             let first = facing(&faces[0]);
-            if first.abs() < 0.05 || faces.iter().any(|f| facing(f) * first.signum() < 0.05) {
+            let least_facing = faces.iter().map(|f| facing(f) * first.signum()).fold(f32::INFINITY, f32::min);
+            if first.abs() < 0.05 || least_facing < 0.05 {
                 continue;
             }
-            // The aimed point is at t = 1; the crossing is within rounding of it.
-            rays.push(ProbeRay { ray: Ray::new(origin, direction), expect: Expect::HitBy(1.0 + 1e-3) });
+            // The aimed point is at t = 1, and the surface within the aim's
+            // rounding of it: the crossing lies within that distance, over the
+            // cosine of the steepest triangle, of the point aimed at. The
+            // test's own distance rounds by a few ulps of the farthest corner's
+            // distance times the triangle's elongation (long needles round most).
+            let test_error = faces
+                .iter()
+                .map(|&f| {
+                    let t = &self.triangles[f as usize];
+                    let extent = t.iter().map(|v| (*v - origin).abs().max_element()).fold(0.0, f32::max);
+                    16.0 * f32::EPSILON * extent * elongation(t)
+                })
+                .fold(0.0, f32::max);
+            let slack = (4.0 * aim_error / least_facing + test_error) / direction.length();
+            rays.push(ProbeRay { ray: Ray::new(origin, direction), expect: Expect::HitBy(1.0 + slack.max(1e-4)) });
         }
         rays
     }
