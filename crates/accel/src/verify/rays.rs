@@ -23,7 +23,8 @@ pub enum RayKind {
     /// Leaving a point on a triangle, as a renderer spawns them: mirrored
     /// about the normal, or towards a point on another triangle. A hit on
     /// the triangle the ray leaves is a self-hit (counted for triangles no
-    /// more elongated than `rtgi_math::MAX_ELONGATION`).
+    /// more elongated than `rtgi_math::MAX_ELONGATION`, and rays more than
+    /// 0.6° off its plane).
     Secondary,
     /// Aimed inside the silhouette where the surface is closed: at interior
     /// points of triangles, edges shared by two triangles and vertices
@@ -144,9 +145,17 @@ impl<'a> SceneFeatures<'a> {
                 };
                 // Spawned rays are offset far enough for triangles up to an
                 // elongation (see `SurfacePoint::on_triangle`); needles beyond
-                // it are traced, but not held to never being hit again.
-                let expect =
-                    if elongation(&t) <= MAX_ELONGATION { Expect::NotTriangle(index) } else { Expect::Nothing };
+                // it are traced, but not held to never being hit again. Nor
+                // are rays that run along the plane they leave (within 0.6°,
+                // towards a point in that plane): they carry no light, and
+                // the rounding of their direction alone can tilt them back
+                // into it.
+                let leaves = ray.direction.normalize_or_zero().dot(point.normal).abs() >= 0.01;
+                let expect = if elongation(&t) <= MAX_ELONGATION && leaves {
+                    Expect::NotTriangle(index)
+                } else {
+                    Expect::Nothing
+                };
                 Some(ProbeRay { ray, expect })
             }
             RayKind::Silhouette => unreachable!("made by silhouette_rays"),
