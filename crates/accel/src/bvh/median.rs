@@ -2,7 +2,7 @@
 
 use std::cmp::Ordering;
 
-use super::build::{PrimRef, RangeBounds, Split};
+use super::split::{PrimRef, RangeBounds, Split};
 
 /// Orders primitives by centroid along `axis`, ties by index, so that
 /// builds are deterministic.

@@ -10,10 +10,11 @@
 mod build;
 mod median;
 mod sah;
+mod split;
 mod traverse;
 mod validate;
 
-pub use build::SplitMethod;
+pub use split::SplitMethod;
 pub use traverse::Traversal;
 
 use std::time::Instant;

@@ -5,8 +5,8 @@
 
 use rtgi_math::Vec3A;
 
-use super::build::{Context, PrimRef, RangeBounds, Split};
 use super::median::{by_centroid, object_median};
+use super::split::{Context, PrimRef, RangeBounds, Split};
 use crate::boxa::BoxA;
 
 /// Decides between the best split found (its summed `A · N` over both

@@ -1,0 +1,129 @@
+//! What the split methods share: the primitives they reorder
+//! ([`PrimRef`]), the bounds of a range of them ([`RangeBounds`]), the
+//! split they return ([`Split`]), and the read-only inputs of a build
+//! ([`Context`]). `build.rs`, `median.rs` and `sah.rs` all import this
+//! file, and none of them imports another's types.
+
+use rayon::prelude::*;
+use rtgi_math::{Vec3A, Vec4};
+
+use crate::boxa::BoxA;
+
+/// How a node's primitives are divided between its two children.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SplitMethod {
+    /// Equal counts: sort by centroid along the longest axis, split at the median.
+    ObjectMedian,
+    /// Split the longest axis of the node's box at its middle.
+    SpatialMedian,
+    /// Surface area heuristic evaluated at the borders of `BuildParams::sah_bins` bins per axis.
+    BinnedSah,
+    /// Surface area heuristic evaluated between every pair of neighbouring centroids on all three axes.
+    SweepSah,
+}
+
+impl SplitMethod {
+    pub fn name(self) -> &'static str {
+        match self {
+            SplitMethod::ObjectMedian => "object-median",
+            SplitMethod::SpatialMedian => "spatial-median",
+            SplitMethod::BinnedSah => "sah",
+            SplitMethod::SweepSah => "sah-sweep",
+        }
+    }
+}
+
+/// A primitive as the builder sees it: its box, with the primitive's index
+/// in the fourth lane of `min` (stored with bit 30 set, so that the lane is
+/// a normal float and never slows the box arithmetic that also runs on it).
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct PrimRef {
+    min_index: Vec4,
+    max: Vec4,
+}
+
+const INDEX_BIAS: u32 = 1 << 30;
+
+impl PrimRef {
+    pub(crate) fn new(bounds: BoxA, index: u32) -> Self {
+        Self { min_index: bounds.min.extend(f32::from_bits(index | INDEX_BIAS)), max: bounds.max.extend(0.0) }
+    }
+
+    #[inline(always)]
+    pub(crate) fn index(&self) -> u32 {
+        self.min_index.w.to_bits() & !INDEX_BIAS
+    }
+
+    #[inline(always)]
+    pub(crate) fn bounds(&self) -> BoxA {
+        BoxA { min: Vec3A::from_vec4(self.min_index), max: Vec3A::from_vec4(self.max) }
+    }
+
+    /// Twice the centroid: the builder compares centroids only with each
+    /// other, so the halving is left out.
+    #[inline(always)]
+    pub(crate) fn centroid2(&self) -> Vec3A {
+        Vec3A::from_vec4(self.min_index + self.max)
+    }
+}
+
+/// Read-only inputs of every recursion step.
+pub(crate) struct Context {
+    pub(crate) method: SplitMethod,
+    pub(crate) max_leaf_size: usize,
+    pub(crate) sah_bins: usize,
+    pub(crate) traversal_cost: f32,
+}
+
+/// Bounds of a range of primitives and of their (doubled) centroids.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct RangeBounds {
+    pub(crate) bounds: BoxA,
+    pub(crate) centroids: BoxA,
+}
+
+impl RangeBounds {
+    pub(crate) const EMPTY: RangeBounds = RangeBounds { bounds: BoxA::EMPTY, centroids: BoxA::EMPTY };
+
+    #[inline(always)]
+    pub(crate) fn add(&mut self, prim: &PrimRef) {
+        self.bounds = self.bounds.union(prim.bounds());
+        self.centroids = self.centroids.grow(prim.centroid2());
+    }
+
+    fn union(self, other: RangeBounds) -> RangeBounds {
+        RangeBounds { bounds: self.bounds.union(other.bounds), centroids: self.centroids.union(other.centroids) }
+    }
+
+    /// The bounds of a range of primitives; in parallel for long ranges.
+    pub(crate) fn of(prims: &[PrimRef]) -> Self {
+        const CHUNK: usize = 16 * 1024;
+        let of_chunk = |chunk: &[PrimRef]| {
+            let mut r = RangeBounds::EMPTY;
+            for prim in chunk {
+                r.add(prim);
+            }
+            r
+        };
+        if prims.len() <= CHUNK {
+            return of_chunk(prims);
+        }
+        prims.par_chunks(CHUNK).map(of_chunk).reduce(|| RangeBounds::EMPTY, RangeBounds::union)
+    }
+}
+
+/// A split of a node's range: the first `left_count` primitives (after the
+/// split function reordered them) go to the left child.
+pub(crate) struct Split {
+    pub(crate) left_count: usize,
+    pub(crate) left: RangeBounds,
+    pub(crate) right: RangeBounds,
+}
+
+impl Split {
+    /// A split whose children's bounds are measured afresh.
+    pub(crate) fn measured(prims: &[PrimRef], left_count: usize) -> Split {
+        let (left, right) = prims.split_at(left_count);
+        Split { left_count, left: RangeBounds::of(left), right: RangeBounds::of(right) }
+    }
+}
