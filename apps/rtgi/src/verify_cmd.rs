@@ -65,6 +65,14 @@ pub(crate) fn run(args: &VerifyArgs) -> Result<()> {
         }
     };
     let configurations = configurations(args);
+    // The linear scan of each intersector the structures use; with the
+    // linear scan alone, that of the chosen intersector (checked for leaks
+    // and self-hits).
+    let mut intersectors: Vec<Intersector> =
+        Intersector::ALL.iter().copied().filter(|&i| configurations.iter().any(|(_, p)| p.intersector == i)).collect();
+    if intersectors.is_empty() {
+        intersectors.push(args.build.intersector);
+    }
     let pool = thread_pool(args.threads)?;
     let start = Instant::now();
 
@@ -74,7 +82,7 @@ pub(crate) fn run(args: &VerifyArgs) -> Result<()> {
         let rays = pool.install(|| case.rays(*per_kind, args.seed));
         let budget_rays = (args.linear_budget / case.triangles.len().max(1) as u64) as usize;
         pool.install(|| {
-            check_case(case, &rays, &configurations, budget_rays, &mut kinds, &mut structures);
+            check_case(case, &rays, &configurations, &intersectors, budget_rays, &mut kinds, &mut structures);
         });
         eprintln!(
             "{}: {} triangles, {} rays per structure checked ({:.1} s)",
@@ -127,6 +135,7 @@ fn check_case(
     case: &Case,
     rays: &[(&'static str, Vec<ProbeRay>)],
     configurations: &[(AccelKind, BuildParams)],
+    intersectors: &[Intersector],
     linear_rays: usize,
     kinds: &mut BTreeMap<String, KindRow>,
     structures: &mut Vec<StructureRow>,
@@ -138,14 +147,7 @@ fn check_case(
         Some(row) => row.tally.add(tally),
         None => structures.push(StructureRow { structure: name, watertight, tally: tally.clone() }),
     };
-    let intersectors: Vec<Intersector> = {
-        let mut list: Vec<Intersector> = configurations.iter().map(|(_, p)| p.intersector).collect();
-        list.dedup();
-        list.sort_by_key(|i| i.name());
-        list.dedup();
-        list
-    };
-    for intersector in intersectors {
+    for &intersector in intersectors {
         let watertight = intersector == Intersector::Watertight;
         let linear = LinearScan::new(&case.triangles, intersector);
         let chosen: Vec<&(AccelKind, BuildParams)> =
