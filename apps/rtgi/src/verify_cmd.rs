@@ -25,6 +25,16 @@ struct KindRow {
     tally: Tally,
 }
 
+impl KindRow {
+    /// Adds one structure's failures on this kind's rays (the row counts
+    /// its rays itself); leaks only of a test that claims watertightness:
+    /// Möller-Trumbore's are reported per structure.
+    fn add_failures(&mut self, tally: &Tally, watertight: bool) {
+        let leaks = if watertight { tally.leaks } else { 0 };
+        self.tally.add(&Tally { rays: 0, compared: 0, leaks, ..tally.clone() });
+    }
+}
+
 /// The totals of one structure over every scene and kind.
 #[derive(Debug, Serialize)]
 struct StructureRow {
@@ -171,21 +181,11 @@ fn check_case(
                 .or_insert_with(|| KindRow { kind: kind.to_string(), ..KindRow::default() });
             row.rays += probes.len();
             row.linear_rays += checked;
-            let mut linear_counted = linear_tally.clone();
-            linear_counted.rays = 0;
-            if watertight {
-                row.tally.add(&linear_counted);
-            }
+            row.add_failures(&linear_tally, watertight);
             for (name, accel) in &built {
                 let tally = Tally::of(probes, &Answer::all(accel.as_ref(), probes), Some(&reference));
                 add(name.clone(), watertight, &tally, structures);
-                let mut counted = tally;
-                counted.rays = 0;
-                if !watertight {
-                    // Möller-Trumbore is not watertight: its leaks are reported per structure only.
-                    counted.leaks = 0;
-                }
-                row.tally.add(&counted);
+                row.add_failures(&tally, watertight);
             }
         }
     }

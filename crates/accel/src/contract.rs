@@ -49,22 +49,59 @@ pub fn is_hittable(triangle: &[Vec3; 3]) -> bool {
     (b - a).cross(c - a) != rtgi_math::glam::DVec3::ZERO
 }
 
+/// A ray prepared once for the triangle test `T` and for box tests.
+pub(crate) struct PreparedRay<T: TriangleTest> {
+    pub(crate) triangles: T::Ray,
+    pub(crate) boxes: BoxRay,
+}
+
+impl<T: TriangleTest> PreparedRay<T> {
+    #[inline(always)]
+    pub(crate) fn new(ray: &Ray) -> Self {
+        Self { triangles: T::prepare(ray.origin.into(), ray.direction.into()), boxes: BoxRay::new(ray) }
+    }
+}
+
 /// The hit rule: where `ray` hits `triangle` with the triangle test `T`,
 /// or `None`. `t_max` may be lowered below the ray's own to skip hits that
 /// cannot win, which never changes a hit that is reported: the answer
 /// within the ray's range is a function of the ray and the triangle alone.
 #[inline(always)]
 pub(crate) fn hit_triangle<T: TriangleTest>(
-    test_ray: &T::Ray,
-    box_ray: &BoxRay,
+    ray: &PreparedRay<T>,
     triangle: &[Vec3A; 3],
     t_max: f32,
 ) -> Option<TriangleHit> {
-    let hit = T::intersect(test_ray, box_ray.t_min, t_max, triangle)?;
+    let hit = T::intersect(&ray.triangles, ray.boxes.t_min, t_max, triangle)?;
     let [a, b, c] = *triangle;
-    let enter = RobustSlabs::enter(box_ray, a.min(b).min(c), a.max(b).max(c), t_max);
+    let enter = RobustSlabs::enter(&ray.boxes, a.min(b).min(c), a.max(b).max(c), t_max);
     // `enter` is +∞ when the box is missed; otherwise it lies in [t_min, t_max].
     (enter != f32::INFINITY).then_some(TriangleHit { t: hit.t.max(enter), ..hit })
+}
+
+/// Tests `triangles` (whose input indices are `ids`) in order, offering
+/// each hit to `best`, and counts the tests; returns whether the query is
+/// answered (an any-hit query that found a hit). The linear scan runs it
+/// over all triangles, a BVH over each leaf it reaches.
+#[inline(always)]
+pub(crate) fn test_triangles<Q: QueryKind, C: Counter, T: TriangleTest, F: HitFilter>(
+    triangles: &[[Vec3A; 3]],
+    ids: &[u32],
+    ray: &PreparedRay<T>,
+    best: &mut Best,
+    counter: &mut C,
+    filter: &F,
+) -> bool {
+    for (tested, (triangle, &id)) in triangles.iter().zip(ids).enumerate() {
+        if let Some(hit) = hit_triangle(ray, triangle, best.t_max) {
+            if best.offer(id, hit, filter) && Q::STOP_AT_FIRST_HIT {
+                counter.triangles_tested(tested as u32 + 1);
+                return true;
+            }
+        }
+    }
+    counter.triangles_tested(triangles.len() as u32);
+    false
 }
 
 /// Closest hit or any hit: the one difference between the two queries is

@@ -2,8 +2,7 @@ use std::time::Instant;
 
 use rtgi_math::{Ray, Vec3, Vec3A};
 
-use crate::contract::{Best, HitFilter, QueryKind, Structure, hit_triangle, is_hittable};
-use crate::slab::BoxRay;
+use crate::contract::{Best, HitFilter, PreparedRay, QueryKind, Structure, is_hittable, test_triangles};
 use crate::triangle::{MollerTrumbore, TriangleTest, Watertight};
 use crate::{BuildStats, Counter, Hit, Intersector};
 
@@ -51,18 +50,8 @@ impl LinearScan {
         if !ray.is_valid() {
             return None;
         }
-        let test_ray = T::prepare(ray.origin.into(), ray.direction.into());
-        let box_ray = BoxRay::new(ray);
         let mut best = Best::new(ray);
-        for (tested, (triangle, &id)) in self.triangles.iter().zip(&self.ids).enumerate() {
-            if let Some(hit) = hit_triangle::<T>(&test_ray, &box_ray, triangle, best.t_max) {
-                if best.offer(id, hit, filter) && Q::STOP_AT_FIRST_HIT {
-                    counter.triangles_tested(tested as u32 + 1);
-                    return best.hit;
-                }
-            }
-        }
-        counter.triangles_tested(self.triangles.len() as u32);
+        test_triangles::<Q, C, T, F>(&self.triangles, &self.ids, &PreparedRay::new(ray), &mut best, counter, filter);
         best.hit
     }
 }

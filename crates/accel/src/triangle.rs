@@ -3,8 +3,7 @@
 use rtgi_math::glam::{Mat3A, Vec3Swizzles};
 use rtgi_math::{Vec3, Vec3A};
 
-use crate::contract::hit_triangle;
-use crate::slab::BoxRay;
+use crate::contract::{PreparedRay, hit_triangle};
 
 /// Where a ray hits a triangle: distance and barycentric coordinates of
 /// the second and third corners (the first corner's is `1 - beta - gamma`).
@@ -56,18 +55,10 @@ impl Intersector {
         if !ray.is_valid() || !crate::is_hittable(v) {
             return None;
         }
-        let box_ray = BoxRay::new(&ray);
         let v = v.map(Vec3A::from);
         match self {
-            Intersector::Watertight => {
-                hit_triangle::<Watertight>(&Watertight::prepare(origin.into(), direction.into()), &box_ray, &v, t_max)
-            }
-            Intersector::MollerTrumbore => hit_triangle::<MollerTrumbore>(
-                &MollerTrumbore::prepare(origin.into(), direction.into()),
-                &box_ray,
-                &v,
-                t_max,
-            ),
+            Intersector::Watertight => hit_triangle(&PreparedRay::<Watertight>::new(&ray), &v, t_max),
+            Intersector::MollerTrumbore => hit_triangle(&PreparedRay::<MollerTrumbore>::new(&ray), &v, t_max),
         }
     }
 }

@@ -5,7 +5,7 @@
 use rtgi_math::Ray;
 
 use super::{Bvh, BvhNode};
-use crate::contract::{Best, HitFilter, QueryKind, hit_triangle};
+use crate::contract::{Best, HitFilter, PreparedRay, QueryKind, test_triangles};
 use crate::slab::{BoxRay, FastSlabs, RobustSlabs, SlabTest};
 use crate::triangle::{MollerTrumbore, TriangleTest, Watertight};
 use crate::{Counter, Hit, Intersector};
@@ -91,31 +91,26 @@ impl Bvh {
         monomorphise!(self, traverse_with_stack, Q, C, F, ray, counter, filter)
     }
 
-    /// Tests the triangles of a leaf, offering each hit to `best` (which
-    /// keeps the first in `(t, index)` order); returns whether the query
-    /// is answered (an any-hit query that found a hit).
+    /// Tests the triangles of a leaf (see [`test_triangles`]); returns
+    /// whether the query is answered.
     #[inline(always)]
     fn visit_leaf<Q: QueryKind, C: Counter, T: TriangleTest, F: HitFilter>(
         &self,
         leaf: &BvhNode,
-        rays: (&T::Ray, &BoxRay),
+        ray: &PreparedRay<T>,
         best: &mut Best,
         counter: &mut C,
         filter: &F,
     ) -> bool {
         let range = leaf.first() as usize..(leaf.first() + leaf.count()) as usize;
-        let (test_ray, box_ray) = rays;
-        for (tested, (triangle, &id)) in self.triangles[range.clone()].iter().zip(&self.triangle_ids[range]).enumerate()
-        {
-            if let Some(hit) = hit_triangle::<T>(test_ray, box_ray, triangle, best.t_max) {
-                if best.offer(id, hit, filter) && Q::STOP_AT_FIRST_HIT {
-                    counter.triangles_tested(tested as u32 + 1);
-                    return true;
-                }
-            }
-        }
-        counter.triangles_tested(leaf.count());
-        false
+        test_triangles::<Q, C, T, F>(
+            &self.triangles[range.clone()],
+            &self.triangle_ids[range],
+            ray,
+            best,
+            counter,
+            filter,
+        )
     }
 
     fn traverse_with_stack<Q: QueryKind, C: Counter, T: TriangleTest, S: SlabTest, F: HitFilter, const STACK: usize>(
@@ -127,17 +122,16 @@ impl Bvh {
         if !ray.is_valid() || self.nodes.is_empty() {
             return None;
         }
-        let box_ray = BoxRay::new(ray);
-        let test_ray = T::prepare(ray.origin.into(), ray.direction.into());
-        let rays = (&test_ray, &box_ray);
+        let prepared = PreparedRay::<T>::new(ray);
+        let box_ray = &prepared.boxes;
         let mut best = Best::new(ray);
         let root = &self.nodes[0];
         counter.node_visited();
-        if root.enter::<S>(&box_ray, best.t_max) == f32::INFINITY {
+        if root.enter::<S>(box_ray, best.t_max) == f32::INFINITY {
             return None;
         }
         if root.is_leaf() {
-            self.visit_leaf::<Q, C, T, F>(root, rays, &mut best, counter, filter);
+            self.visit_leaf::<Q, C, T, F>(root, &prepared, &mut best, counter, filter);
             return best.hit;
         }
         let mut stack = [0u32; STACK];
@@ -149,14 +143,14 @@ impl Bvh {
             counter.node_visited();
             let (mut near, mut far) = (&pair[0], &pair[1]);
             let (mut enter_near, mut enter_far) =
-                (near.enter::<S>(&box_ray, best.t_max), far.enter::<S>(&box_ray, best.t_max));
+                (near.enter::<S>(box_ray, best.t_max), far.enter::<S>(box_ray, best.t_max));
             if enter_far < enter_near {
                 std::mem::swap(&mut near, &mut far);
                 std::mem::swap(&mut enter_near, &mut enter_far);
             }
             let mut descend_near = enter_near < f32::INFINITY;
             if descend_near && near.is_leaf() {
-                if self.visit_leaf::<Q, C, T, F>(near, rays, &mut best, counter, filter) {
+                if self.visit_leaf::<Q, C, T, F>(near, &prepared, &mut best, counter, filter) {
                     return best.hit;
                 }
                 descend_near = false;
@@ -167,7 +161,7 @@ impl Bvh {
             // +∞, which an unbounded t_max does not exclude.)
             let mut descend_far = enter_far < f32::INFINITY && enter_far <= best.t_max;
             if descend_far && far.is_leaf() {
-                if self.visit_leaf::<Q, C, T, F>(far, rays, &mut best, counter, filter) {
+                if self.visit_leaf::<Q, C, T, F>(far, &prepared, &mut best, counter, filter) {
                     return best.hit;
                 }
                 descend_far = false;

@@ -1,10 +1,11 @@
 //! The built-in adversarial scenes: each class of input on which a
 //! structure that is not exact gives itself away.
 
-use rtgi_math::{Ray, Rng, SurfacePoint, Vec3, uniform_sphere};
+use rtgi_math::{Ray, Rng, Vec3, uniform_sphere};
 
+use super::rays::random_surface_point;
 use super::shapes::{ClosedMesh, cylinder, icosphere, quad, rays_through_diagonal, tessellated_cube};
-use super::{Expect, ProbeRay, RayKind};
+use super::{Expect, ProbeRay, RayKind, point_in_cube};
 
 /// One adversarial scene: its triangles, and rays made for it on top of
 /// the generic [`RayKind`]s.
@@ -50,7 +51,7 @@ pub fn adversarial_cases(special: usize, seed: u64) -> Vec<Case> {
 /// Cornell box, whose file has such pairs).
 fn coincident(seed: u64) -> Case {
     let mut rng = Rng::new(seed, 1);
-    let mut point = |s: f32| (Vec3::new(rng.next_f32(), rng.next_f32(), rng.next_f32()) * 2.0 - 1.0) * s;
+    let mut point = |size: f32| point_in_cube(&mut rng, size);
     let mut triangles = Vec::new();
     for k in 0..48 {
         let a = point(8.0);
@@ -164,7 +165,7 @@ fn closed_meshes(count: usize, seed: u64) -> Vec<Case> {
 /// ones.
 fn degenerate(seed: u64) -> Case {
     let mut rng = Rng::new(seed, 3);
-    let mut point = |s: f32| (Vec3::new(rng.next_f32(), rng.next_f32(), rng.next_f32()) * 2.0 - 1.0) * s;
+    let mut point = |size: f32| point_in_cube(&mut rng, size);
     let mut triangles = Vec::new();
     for k in 0..300 {
         let a = point(10.0);
@@ -205,17 +206,12 @@ fn mixed_scales(count: usize, seed: u64) -> Case {
     let mut rays = Vec::new();
     for k in 0..count {
         let index = rng.next_below(plane);
-        let t = triangles[index as usize];
-        let (mut u, mut v) = (rng.next_f32(), rng.next_f32());
-        if u + v > 1.0 {
-            (u, v) = (1.0 - u, 1.0 - v);
-        }
+        let point = random_surface_point(&triangles[index as usize], &mut rng);
         let phi = std::f32::consts::TAU * rng.next_f32();
         let rise = 10f32.powf(-1.0 - 5.0 * rng.next_f32());
         let direction = Vec3::new(phi.cos(), phi.sin(), rise);
         if k % 2 == 0 {
             // Leaving the plane, barely upwards.
-            let point = SurfacePoint::on_triangle(&t, u, v);
             rays.push(ProbeRay { ray: point.spawn_ray(direction), expect: Expect::NotTriangle(index) });
         } else {
             // Skimming it from just above, near the spheres.
@@ -265,7 +261,7 @@ fn shared_edges(count: usize, seed: u64) -> Case {
 /// where a ray/triangle test's distances round most.
 fn walls_and_needles(count: usize, seed: u64) -> Case {
     let mut rng = Rng::new(seed, 6);
-    let mut point = |s: f32| (Vec3::new(rng.next_f32(), rng.next_f32(), rng.next_f32()) * 2.0 - 1.0) * s;
+    let mut point = |size: f32| point_in_cube(&mut rng, size);
     let mut triangles = Vec::new();
     for k in 0..200 {
         let a = point(1.0);

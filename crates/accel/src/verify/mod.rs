@@ -24,7 +24,7 @@ pub use cases::{Case, adversarial_cases};
 pub use rays::RayKind;
 
 use rayon::prelude::*;
-use rtgi_math::Ray;
+use rtgi_math::{Ray, Rng, Vec3};
 use serde::Serialize;
 
 use crate::{Accel, Hit};
@@ -169,4 +169,15 @@ impl Tally {
     pub fn is_clean(&self) -> bool {
         self.closest_disagreements == 0 && self.any_disagreements == 0 && self.leaks == 0 && self.self_hits == 0
     }
+}
+
+/// Barycentrics `(u, v)` of a uniformly random point on a triangle.
+fn uniform_barycentrics(rng: &mut Rng) -> (f32, f32) {
+    let (u, v) = (rng.next_f32(), rng.next_f32());
+    if u + v > 1.0 { (1.0 - u, 1.0 - v) } else { (u, v) }
+}
+
+/// A uniformly random point of the cube `[-size, size]³`.
+fn point_in_cube(rng: &mut Rng, size: f32) -> Vec3 {
+    (Vec3::new(rng.next_f32(), rng.next_f32(), rng.next_f32()) * 2.0 - 1.0) * size
 }

@@ -5,7 +5,7 @@ use std::collections::HashMap;
 
 use rtgi_math::{Aabb, MAX_ELONGATION, Ray, Rng, SurfacePoint, Vec3, elongation, geometric_normal, uniform_sphere};
 
-use super::{Expect, ProbeRay};
+use super::{Expect, ProbeRay, uniform_barycentrics};
 use crate::is_hittable;
 
 /// The kinds of rays `rtgi verify` traces; each names what it aims at.
@@ -177,10 +177,7 @@ impl<'a> SceneFeatures<'a> {
             let (target, faces): (Vec3, Vec<u32>) = match rng.next_below(3) {
                 0 => {
                     let (index, t) = self.random_triangle(rng);
-                    let (mut u, mut v) = (rng.next_f32(), rng.next_f32());
-                    if u + v > 1.0 {
-                        (u, v) = (1.0 - u, 1.0 - v);
-                    }
+                    let (u, v) = uniform_barycentrics(rng);
                     // At least 5% of the way from every edge.
                     if u.min(v).min(1.0 - u - v) < 0.05 {
                         continue;
@@ -244,11 +241,8 @@ fn altitude(t: &[Vec3; 3]) -> f32 {
 }
 
 /// A uniformly random point on a triangle, as a hit would report it.
-fn random_surface_point(t: &[Vec3; 3], rng: &mut Rng) -> SurfacePoint {
-    let (mut u, mut v) = (rng.next_f32(), rng.next_f32());
-    if u + v > 1.0 {
-        (u, v) = (1.0 - u, 1.0 - v);
-    }
+pub(super) fn random_surface_point(t: &[Vec3; 3], rng: &mut Rng) -> SurfacePoint {
+    let (u, v) = uniform_barycentrics(rng);
     SurfacePoint::on_triangle(t, u, v)
 }
 
