@@ -135,4 +135,31 @@ pub trait Accel: Send + Sync + std::fmt::Debug {
 
     /// The statistics of the build.
     fn build_stats(&self) -> &BuildStats;
+
+    /// Closest hits of many rays at once: `hits[i]` becomes
+    /// `self.intersect(&rays[i])`, bit for bit. Structures that trace
+    /// coherent rays together (packets) override it; the default traces
+    /// one ray at a time. Rays that start close together and point in
+    /// similar directions (a tile of camera rays) gain most.
+    ///
+    /// # Panics
+    /// If the two slices differ in length.
+    fn intersect_batch(&self, rays: &[Ray], hits: &mut [Option<Hit>]) {
+        assert_eq!(rays.len(), hits.len(), "one hit slot per ray");
+        for (ray, hit) in rays.iter().zip(hits) {
+            *hit = self.intersect(ray);
+        }
+    }
+
+    /// Any-hit queries of many rays at once: `occluded[i]` becomes
+    /// `self.occluded(&rays[i])`.
+    ///
+    /// # Panics
+    /// If the two slices differ in length.
+    fn occluded_batch(&self, rays: &[Ray], occluded: &mut [bool]) {
+        assert_eq!(rays.len(), occluded.len(), "one answer slot per ray");
+        for (ray, answer) in rays.iter().zip(occluded) {
+            *answer = self.occluded(ray);
+        }
+    }
 }
