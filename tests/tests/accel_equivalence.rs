@@ -56,7 +56,7 @@ proptest! {
                 }
                 // With a filter that passes through every third triangle.
                 let reference = references_linear.iter().find(|(i, _)| *i == params.intersector).expect("every intersector");
-                let holes = |t: u32, _: f32, _: f32| t % 3 != 0;
+                let holes = |t: u32, _: f32, _: f32| !t.is_multiple_of(3);
                 let (got, expected) = (accel.intersect_filtered(ray, &holes), reference.1.intersect_filtered(ray, &holes));
                 if !same_hit(got, expected) {
                     failures.push(format!("{label}: filtered closest {got:?} != {expected:?}"));

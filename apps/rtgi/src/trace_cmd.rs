@@ -61,7 +61,7 @@ pub(crate) fn run(args: &TraceArgs) -> Result<()> {
 
 /// Rays from the bytes of a ray file.
 pub(crate) fn decode_rays(bytes: &[u8]) -> Result<Vec<Ray>> {
-    if bytes.len() % RAY_BYTES != 0 {
+    if !bytes.len().is_multiple_of(RAY_BYTES) {
         bail!("its size, {} bytes, is not a multiple of {RAY_BYTES} (8 little-endian f32 per ray)", bytes.len());
     }
     Ok(bytes

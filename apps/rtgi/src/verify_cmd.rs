@@ -171,10 +171,10 @@ fn check_case(
             add(format!("linear ({intersector})"), watertight, &linear_tally, structures);
             // The reference: the linear scan where it answered, else the first structure.
             let mut reference = linear_answers;
-            if checked < probes.len() {
-                if let Some((_, first)) = built.first() {
-                    reference.extend(Answer::all(first.as_ref(), &probes[checked..]));
-                }
+            if checked < probes.len()
+                && let Some((_, first)) = built.first()
+            {
+                reference.extend(Answer::all(first.as_ref(), &probes[checked..]));
             }
             let row = kinds
                 .entry(kind.to_string())

@@ -102,7 +102,7 @@ impl PixelSampler {
 /// above `√count` (found by trial division: at most √count steps).
 fn grid(count: u32) -> (u32, u32) {
     let mut columns = count.isqrt().max(1);
-    while count % columns != 0 {
+    while !count.is_multiple_of(columns) {
         columns -= 1;
     }
     (columns, count / columns)

@@ -141,10 +141,10 @@ impl Tally {
                     }
                 }
             }
-            if let Some(failure) = failure {
-                if tally.examples.len() < EXAMPLES {
-                    tally.examples.push(format!("{failure} for {:?}", probe.ray));
-                }
+            if let Some(failure) = failure
+                && tally.examples.len() < EXAMPLES
+            {
+                tally.examples.push(format!("{failure} for {:?}", probe.ray));
             }
         }
         tally
