@@ -18,6 +18,13 @@ pub(crate) fn boxes(args: &BvhBoxesArgs) -> Result<()> {
     let Some(method) = args.accel.accel.split_method() else {
         bail!("--accel {}: only BVH variants have boxes to export", args.accel.accel);
     };
+    if args.accel.accel.node_width() != Some(2) {
+        bail!(
+            "--accel {}: boxes are exported for binary BVHs; the wide ones are collapsed from --accel {}",
+            args.accel.accel,
+            method.name()
+        );
+    }
     let LoadedScene { scene, .. } = load_scene(args.scene.as_deref())?;
     let bvh = Bvh::new(&scene.triangle_positions(), method, &args.accel.build.params());
     let boxes = bvh.boxes_at_depths(&args.levels);

@@ -73,8 +73,16 @@ pub(crate) fn hit_triangle<T: TriangleTest>(
     t_max: f32,
 ) -> Option<TriangleHit> {
     let hit = T::intersect(&ray.triangles, ray.boxes.t_min, t_max, triangle)?;
+    box_rule(&ray.boxes, triangle, hit, t_max)
+}
+
+/// The second half of the hit rule: `hit`, found by the triangle test on
+/// `triangle`, counts only if the ray passes the robust slab test of the
+/// triangle's own box, and no earlier than it enters that box.
+#[inline(always)]
+pub(crate) fn box_rule(ray: &BoxRay, triangle: &[Vec3A; 3], hit: TriangleHit, t_max: f32) -> Option<TriangleHit> {
     let [a, b, c] = *triangle;
-    let enter = RobustSlabs::enter(&ray.boxes, a.min(b).min(c), a.max(b).max(c), t_max);
+    let enter = RobustSlabs::enter(ray, a.min(b).min(c), a.max(b).max(c), t_max);
     // `enter` is +∞ when the box is missed; otherwise it lies in [t_min, t_max].
     (enter != f32::INFINITY).then_some(TriangleHit { t: hit.t.max(enter), ..hit })
 }
@@ -93,11 +101,12 @@ pub(crate) fn test_triangles<Q: QueryKind, C: Counter, T: TriangleTest, F: HitFi
     filter: &F,
 ) -> bool {
     for (tested, (triangle, &id)) in triangles.iter().zip(ids).enumerate() {
-        if let Some(hit) = hit_triangle(ray, triangle, best.t_max) {
-            if best.offer(id, hit, filter) && Q::STOP_AT_FIRST_HIT {
-                counter.triangles_tested(tested as u32 + 1);
-                return true;
-            }
+        if let Some(hit) = hit_triangle(ray, triangle, best.t_max)
+            && best.offer(id, hit, filter)
+            && Q::STOP_AT_FIRST_HIT
+        {
+            counter.triangles_tested(tested as u32 + 1);
+            return true;
         }
     }
     counter.triangles_tested(triangles.len() as u32);
@@ -181,6 +190,15 @@ pub(crate) trait Structure: Send + Sync + std::fmt::Debug {
     /// The closest hit, or with [`AnyHit`] the first hit found.
     fn query<Q: QueryKind, C: Counter, F: HitFilter>(&self, ray: &Ray, counter: &mut C, filter: &F) -> Option<Hit>;
 
+    /// [`Structure::query`] for every ray of `rays`, handing each answer
+    /// to `answer(index, hit)`. Structures that trace coherent rays
+    /// together override it.
+    fn query_batch<Q: QueryKind>(&self, rays: &[Ray], answer: &mut dyn FnMut(usize, Option<Hit>)) {
+        for (index, ray) in rays.iter().enumerate() {
+            answer(index, self.query::<Q, _, _>(ray, &mut NoCounter, &AcceptAll));
+        }
+    }
+
     fn stats(&self) -> &BuildStats;
 }
 
@@ -213,6 +231,16 @@ impl<S: Structure> Accel for S {
 
     fn build_stats(&self) -> &BuildStats {
         self.stats()
+    }
+
+    fn intersect_batch(&self, rays: &[Ray], hits: &mut [Option<Hit>]) {
+        assert_eq!(rays.len(), hits.len(), "one hit slot per ray");
+        self.query_batch::<Closest>(rays, &mut |index, hit| hits[index] = hit);
+    }
+
+    fn occluded_batch(&self, rays: &[Ray], occluded: &mut [bool]) {
+        assert_eq!(rays.len(), occluded.len(), "one answer slot per ray");
+        self.query_batch::<AnyHit>(rays, &mut |index, hit| occluded[index] = hit.is_some());
     }
 }
 

@@ -1,6 +1,6 @@
 use rtgi_math::Vec3;
 
-use crate::{Accel, Bvh, Intersector, LinearScan, SplitMethod, Traversal};
+use crate::{Accel, Bvh, Bvh4, Bvh8, Intersector, LinearScan, SplitMethod, Traversal};
 
 /// The acceleration structures this crate offers, selectable by name.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -15,6 +15,10 @@ pub enum AccelKind {
     Sah,
     /// BVH split by the surface area heuristic over all centroid positions.
     SahSweep,
+    /// Binned SAH BVH collapsed to four children a node, traversed with SIMD.
+    Bvh4,
+    /// Binned SAH BVH collapsed to eight children a node, traversed with SIMD.
+    Bvh8,
 }
 
 /// Parameters of a build; structures ignore those that do not apply to them.
@@ -46,14 +50,34 @@ impl Default for BuildParams {
 
 impl AccelKind {
     /// Every variant, in the order tables list them.
-    pub const ALL: &'static [AccelKind] =
-        &[AccelKind::Linear, AccelKind::ObjectMedian, AccelKind::SpatialMedian, AccelKind::Sah, AccelKind::SahSweep];
+    pub const ALL: &'static [AccelKind] = &[
+        AccelKind::Linear,
+        AccelKind::ObjectMedian,
+        AccelKind::SpatialMedian,
+        AccelKind::Sah,
+        AccelKind::SahSweep,
+        AccelKind::Bvh4,
+        AccelKind::Bvh8,
+    ];
 
     /// The name used on command lines and in tables.
     pub fn name(self) -> &'static str {
-        match self.split_method() {
-            Some(method) => method.name(),
-            None => "linear",
+        match self {
+            AccelKind::Linear => "linear",
+            AccelKind::Bvh4 => "bvh4",
+            AccelKind::Bvh8 => "bvh8",
+            _ => self.split_method().map_or("linear", SplitMethod::name),
+        }
+    }
+
+    /// Children a node of this variant's tree has: 2 for the binary BVHs,
+    /// 4 or 8 for the wide ones, `None` for the linear scan.
+    pub fn node_width(self) -> Option<usize> {
+        match self {
+            AccelKind::Linear => None,
+            AccelKind::Bvh4 => Some(4),
+            AccelKind::Bvh8 => Some(8),
+            _ => Some(2),
         }
     }
 
@@ -65,14 +89,17 @@ impl AccelKind {
             AccelKind::SpatialMedian => Some(SplitMethod::SpatialMedian),
             AccelKind::Sah => Some(SplitMethod::BinnedSah),
             AccelKind::SahSweep => Some(SplitMethod::SweepSah),
+            AccelKind::Bvh4 | AccelKind::Bvh8 => Some(SplitMethod::BinnedSah),
         }
     }
 
     /// Builds this structure over `triangles`; hits name triangles by their index here.
     pub fn build(self, triangles: &[[Vec3; 3]], params: &BuildParams) -> Box<dyn Accel> {
-        match self.split_method() {
-            None => Box::new(LinearScan::new(triangles, params.intersector)),
-            Some(method) => Box::new(Bvh::new(triangles, method, params)),
+        match (self, self.split_method()) {
+            (AccelKind::Bvh4, Some(method)) => Box::new(Bvh4::new(triangles, method, params)),
+            (AccelKind::Bvh8, Some(method)) => Box::new(Bvh8::new(triangles, method, params)),
+            (_, Some(method)) => Box::new(Bvh::new(triangles, method, params)),
+            (_, None) => Box::new(LinearScan::new(triangles, params.intersector)),
         }
     }
 }

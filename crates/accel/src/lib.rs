@@ -54,9 +54,11 @@ mod contract;
 mod counters;
 mod kind;
 mod linear;
+pub mod simd;
 mod slab;
 mod triangle;
 pub mod verify;
+mod wide;
 
 pub use bvh::{Bvh, BvhNode, SplitMethod, Traversal};
 pub use contract::is_hittable;
@@ -64,6 +66,7 @@ pub use counters::{Counter, NoCounter, TraversalCounters};
 pub use kind::{AccelKind, BuildParams};
 pub use linear::LinearScan;
 pub use triangle::{Intersector, TriangleHit};
+pub use wide::{Bvh4, Bvh8, WideBvh};
 
 use rtgi_math::Ray;
 use serde::Serialize;

@@ -12,7 +12,7 @@ use rtgi_math::{BVec3A, Ray, Vec3A, gamma};
 /// `1 + 2γ(3)`: slab exit distances are enlarged by this factor so that
 /// rounding never drops a box the ray touches (Ize, "Robust BVH Ray
 /// Traversal", JCGT 2013; pbrt-v4 `Bounds3::IntersectP`).
-const ROBUST_FAR_SCALE: f32 = 1.0 + 2.0 * gamma(3);
+pub(crate) const ROBUST_FAR_SCALE: f32 = 1.0 + 2.0 * gamma(3);
 
 /// A ray prepared for box tests.
 #[derive(Clone, Copy, Debug)]

@@ -1,9 +1,10 @@
 //! Ray/triangle intersection tests.
 
-use rtgi_math::glam::{Mat3A, Vec3Swizzles};
 use rtgi_math::{Vec3, Vec3A};
 
 use crate::contract::{PreparedRay, hit_triangle};
+use crate::simd::arith;
+use crate::simd::triangles::{self, BlockHits, TriangleBlock};
 
 /// Where a ray hits a triangle: distance and barycentric coordinates of
 /// the second and third corners (the first corner's is `1 - beta - gamma`).
@@ -75,6 +76,12 @@ pub(crate) trait TriangleTest {
     type Ray;
     fn prepare(origin: Vec3A, direction: Vec3A) -> Self::Ray;
     fn intersect(ray: &Self::Ray, t_min: f32, t_max: f32, v: &[Vec3A; 3]) -> Option<TriangleHit>;
+
+    /// The same test on the four triangles of a block at once: lanes in
+    /// [`BlockHits::exact`] hold the bits `intersect` computes for their
+    /// triangle, and lanes in [`BlockHits::rescan`] must be decided by
+    /// `intersect` itself (the watertight test's double-precision cases).
+    fn intersect_block(ray: &Self::Ray, t_min: f32, t_max: f32, block: &TriangleBlock) -> BlockHits;
 }
 
 pub(crate) struct MollerTrumbore;
@@ -95,26 +102,17 @@ impl TriangleTest for MollerTrumbore {
     /// Solves `o + t d = v0 + beta (v1 - v0) + gamma (v2 - v0)` by Cramer's rule.
     #[inline(always)]
     fn intersect(ray: &Self::Ray, t_min: f32, t_max: f32, v: &[Vec3A; 3]) -> Option<TriangleHit> {
-        let edge1 = v[1] - v[0];
-        let edge2 = v[2] - v[0];
-        let p = ray.direction.cross(edge2);
-        let det = edge1.dot(p);
-        if det == 0.0 || !det.is_finite() {
+        let [det, beta, gamma, t] =
+            arith::moller_trumbore(ray.origin.to_array(), ray.direction.to_array(), v.map(|corner| corner.to_array()));
+        if det == 0.0 || !det.is_finite() || !(0.0..=1.0).contains(&beta) || gamma < 0.0 || beta + gamma > 1.0 {
             return None;
         }
-        let inv_det = 1.0 / det;
-        let s = ray.origin - v[0];
-        let beta = s.dot(p) * inv_det;
-        if !(0.0..=1.0).contains(&beta) {
-            return None;
-        }
-        let q = s.cross(edge1);
-        let gamma = ray.direction.dot(q) * inv_det;
-        if gamma < 0.0 || beta + gamma > 1.0 {
-            return None;
-        }
-        let t = edge2.dot(q) * inv_det;
         (t >= t_min && t <= t_max && t.is_finite()).then_some(TriangleHit { t, beta, gamma })
+    }
+
+    #[inline(always)]
+    fn intersect_block(ray: &Self::Ray, t_min: f32, t_max: f32, block: &TriangleBlock) -> BlockHits {
+        triangles::moller_trumbore_block(ray.origin.to_array(), ray.direction.to_array(), t_min, t_max, block)
     }
 }
 
@@ -123,10 +121,10 @@ pub(crate) struct Watertight;
 /// The ray in the watertight test's frame: the axis where the direction is
 /// largest becomes z, and a shear maps the direction onto +z.
 pub(crate) struct WatertightRay {
-    origin: Vec3A,
+    pub(crate) origin: Vec3A,
     /// Source axes of the permuted x, y and z.
-    axes: [usize; 3],
-    shear: [f32; 3],
+    pub(crate) axes: [usize; 3],
+    pub(crate) shear: [f32; 3],
 }
 
 impl TriangleTest for Watertight {
@@ -156,46 +154,51 @@ impl TriangleTest for Watertight {
     #[inline(always)]
     fn intersect(ray: &Self::Ray, t_min: f32, t_max: f32, v: &[Vec3A; 3]) -> Option<TriangleHit> {
         let [kx, ky, kz] = ray.axes;
-        let [sx, sy, sz] = ray.shear;
-        // The three vertices relative to the origin, transposed so that each
-        // vector holds one coordinate of all three: lanes are (A, B, C).
-        let by_axis = Mat3A::from_cols(v[0] - ray.origin, v[1] - ray.origin, v[2] - ray.origin).transpose();
-        let (x, y, z) = (by_axis.col(kx), by_axis.col(ky), by_axis.col(kz));
-        // Permuted and sheared. Every vertex goes through the same arithmetic
-        // whichever triangle it belongs to, so neighbours see the same
-        // transformed edge.
-        let xs = x - sx * z;
-        let ys = y - sy * z;
-        // Scaled barycentrics (U, V, W) = the 2D edge functions
-        // (Cx By - Cy Bx, Ax Cy - Ay Cx, Bx Ay - By Ax), one a lane. A shared
-        // edge gives exactly negated values in the two triangles (products
-        // commute and x - y = -(y - x) exactly); no fused multiply-add may
-        // change that.
-        let mut uvw = xs.zxy() * ys.yzx() - ys.zxy() * xs.yzx();
+        // The corners relative to the origin, permuted. Every corner goes
+        // through the same arithmetic whichever triangle it belongs to, so
+        // neighbours see the same transformed edge.
+        let relative = v.map(|corner| {
+            let r = (corner - ray.origin).to_array();
+            [r[kx], r[ky], r[kz]]
+        });
+        let [xs, ys, zs] = arith::watertight_shear(relative, ray.shear);
+        let mut uvw = arith::watertight_edges(xs, ys);
         // On an edge, single precision may have rounded a tiny value to zero:
         // decide in double precision, where the products are exact.
-        if uvw.cmpeq(Vec3A::ZERO).any() {
-            let (xs, ys) = (xs.to_array().map(f64::from), ys.to_array().map(f64::from));
-            let edge = |p: usize, q: usize| (xs[p] * ys[q] - ys[p] * xs[q]) as f32;
-            uvw = Vec3A::new(edge(2, 1), edge(0, 2), edge(1, 0));
+        if uvw.contains(&0.0) {
+            uvw = watertight_edges_f64(xs, ys);
         }
-        if uvw.cmplt(Vec3A::ZERO).any() && uvw.cmpgt(Vec3A::ZERO).any() {
+        if uvw.iter().any(|&e| e < 0.0) && uvw.iter().any(|&e| e > 0.0) {
             return None;
         }
-        let det = uvw.element_sum();
+        let (det, t_scaled) = arith::watertight_det_and_scaled_t(uvw, zs);
         if det == 0.0 || !det.is_finite() {
             return None;
         }
         // The distance is computed in full before it is compared with the
         // range (see `TriangleTest`): comparing the scaled distance with the
         // scaled range first would round differently for different `t_max`.
-        let t = uvw.dot(z * sz) / det;
+        let t = t_scaled / det;
         if !(t >= t_min && t <= t_max && t.is_finite()) {
             return None;
         }
-        let [_, beta, gamma] = (uvw / det).to_array();
-        Some(TriangleHit { t, beta, gamma })
+        Some(TriangleHit { t, beta: uvw[1] / det, gamma: uvw[2] / det })
     }
+
+    #[inline(always)]
+    fn intersect_block(ray: &Self::Ray, t_min: f32, t_max: f32, block: &TriangleBlock) -> BlockHits {
+        triangles::watertight_block(ray.origin.to_array(), ray.axes, ray.shear, t_min, t_max, block)
+    }
+}
+
+/// The edge functions of [`arith::watertight_edges`] in double precision,
+/// where the products of single-precision numbers are exact, rounded to
+/// single precision: used when single precision gave an exact zero.
+#[inline(never)]
+pub(crate) fn watertight_edges_f64(xs: [f32; 3], ys: [f32; 3]) -> [f32; 3] {
+    let (xs, ys) = (xs.map(f64::from), ys.map(f64::from));
+    let edge = |p: usize, q: usize| (xs[p] * ys[q] - ys[p] * xs[q]) as f32;
+    [edge(2, 1), edge(0, 2), edge(1, 0)]
 }
 
 #[cfg(test)]

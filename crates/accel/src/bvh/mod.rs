@@ -162,6 +162,11 @@ impl Bvh {
         &self.nodes
     }
 
+    /// Triangle corners in leaf order, and the input index of each.
+    pub(crate) fn leaf_order(&self) -> (&[[Vec3A; 3]], &[u32]) {
+        (&self.triangles, &self.triangle_ids)
+    }
+
     /// The input indices of the triangles of a leaf.
     pub fn leaf_triangles(&self, leaf: &BvhNode) -> &[u32] {
         &self.triangle_ids[leaf.first() as usize..(leaf.first() + leaf.count()) as usize]

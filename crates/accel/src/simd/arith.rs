@@ -1,0 +1,92 @@
+//! The arithmetic of the ray/triangle tests, written once for one lane
+//! (`f32`) and for four (`Vec4`): the scalar tests and the four-triangle
+//! block tests evaluate the same expressions in the same order, so every
+//! lane of a block test computes the bits the scalar test computes for
+//! that triangle. (Rust never fuses `a * b + c` into one rounding, and
+//! `Vec4`'s operators round each lane as `f32`'s do.)
+
+use std::ops::{Add, Div, Mul, Sub};
+
+use rtgi_math::Vec4;
+
+/// Numbers with IEEE single-precision arithmetic in every lane.
+pub(crate) trait Lanes:
+    Copy + Add<Output = Self> + Sub<Output = Self> + Mul<Output = Self> + Div<Output = Self>
+{
+    fn splat(value: f32) -> Self;
+}
+
+impl Lanes for f32 {
+    #[inline(always)]
+    fn splat(value: f32) -> Self {
+        value
+    }
+}
+
+impl Lanes for Vec4 {
+    #[inline(always)]
+    fn splat(value: f32) -> Self {
+        Vec4::splat(value)
+    }
+}
+
+/// `a × b`, each component a difference of two products.
+#[inline(always)]
+pub(crate) fn cross<L: Lanes>(a: [L; 3], b: [L; 3]) -> [L; 3] {
+    [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
+}
+
+/// `a · b`, summed left to right.
+#[inline(always)]
+pub(crate) fn dot<L: Lanes>(a: [L; 3], b: [L; 3]) -> L {
+    (a[0] * b[0] + a[1] * b[1]) + a[2] * b[2]
+}
+
+#[inline(always)]
+pub(crate) fn sub<L: Lanes>(a: [L; 3], b: [L; 3]) -> [L; 3] {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+
+/// The values of the Möller-Trumbore test: `(det, beta, gamma, t)`, where
+/// `beta`, `gamma` and `t` are already divided by `det`.
+#[inline(always)]
+pub(crate) fn moller_trumbore<L: Lanes>(origin: [L; 3], direction: [L; 3], v: [[L; 3]; 3]) -> [L; 4] {
+    let edge1 = sub(v[1], v[0]);
+    let edge2 = sub(v[2], v[0]);
+    let p = cross(direction, edge2);
+    let det = dot(edge1, p);
+    let inv_det = L::splat(1.0) / det;
+    let s = sub(origin, v[0]);
+    let beta = dot(s, p) * inv_det;
+    let q = cross(s, edge1);
+    let gamma = dot(direction, q) * inv_det;
+    let t = dot(edge2, q) * inv_det;
+    [det, beta, gamma, t]
+}
+
+/// The first step of the watertight test (Woop, Benthin and Wald 2013):
+/// the corners relative to the origin, permuted so that the direction's
+/// largest axis is z, sheared so that the ray runs along +z. Returns the
+/// sheared x, y and z of the three corners.
+///
+/// `relative[c][k]` is corner `c` minus the origin along the permuted axis `k`.
+#[inline(always)]
+pub(crate) fn watertight_shear<L: Lanes>(relative: [[L; 3]; 3], shear: [f32; 3]) -> [[L; 3]; 3] {
+    let (sx, sy, sz) = (L::splat(shear[0]), L::splat(shear[1]), L::splat(shear[2]));
+    [relative.map(|c| c[0] - sx * c[2]), relative.map(|c| c[1] - sy * c[2]), relative.map(|c| c[2] * sz)]
+}
+
+/// The scaled barycentrics `(U, V, W)`: the 2D edge functions of the
+/// sheared corners. A shared edge gives exactly negated values in the two
+/// triangles (products commute and `x - y = -(y - x)` exactly).
+#[inline(always)]
+pub(crate) fn watertight_edges<L: Lanes>(xs: [L; 3], ys: [L; 3]) -> [L; 3] {
+    [xs[2] * ys[1] - ys[2] * xs[1], xs[0] * ys[2] - ys[0] * xs[2], xs[1] * ys[0] - ys[1] * xs[0]]
+}
+
+/// The watertight test's determinant and its distance scaled by the
+/// determinant, from the scaled barycentrics and the sheared corner heights.
+#[inline(always)]
+pub(crate) fn watertight_det_and_scaled_t<L: Lanes>(uvw: [L; 3], zs: [L; 3]) -> (L, L) {
+    ((uvw[0] + uvw[1]) + uvw[2], dot(uvw, zs))
+}

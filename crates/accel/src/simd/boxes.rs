@@ -1,0 +1,151 @@
+//! One ray against the `W` child boxes of a wide node.
+//!
+//! The boxes are stored structure-of-arrays ([`WideBoxes`]), and each lane
+//! runs the arithmetic of the robust slab test ([`crate::slab::RobustSlabs`])
+//! on its box: the same subtractions, products and enlargement of the exit
+//! distance, and the same treatment of NaN (an origin on a slab plane along
+//! a zero direction component leaves that axis out). Only the order in
+//! which the three axes' distances are combined differs, and maxima and
+//! minima are exact, so each lane's entry distance is the bits the scalar
+//! test computes: culling stays exact (see the crate's exactness contract).
+
+use rtgi_math::Vec4;
+
+use crate::slab::{BoxRay, ROBUST_FAR_SCALE};
+
+/// The boxes of `W` children: `planes[k]` holds, for each child, the box's
+/// minimum (k = 0, 1, 2) or maximum (k = 3, 4, 5) along axis `k % 3`.
+/// Lanes without a child hold the empty box (minimum +∞, maximum -∞),
+/// which no ray enters.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[repr(C)]
+pub(crate) struct WideBoxes<const W: usize> {
+    pub(crate) planes: [[f32; W]; 6],
+}
+
+impl<const W: usize> WideBoxes<W> {
+    pub(crate) const EMPTY: Self = Self {
+        planes: [
+            [f32::INFINITY; W],
+            [f32::INFINITY; W],
+            [f32::INFINITY; W],
+            [f32::NEG_INFINITY; W],
+            [f32::NEG_INFINITY; W],
+            [f32::NEG_INFINITY; W],
+        ],
+    };
+
+    /// Sets lane `lane` to the box `[min, max]`.
+    pub(crate) fn set(&mut self, lane: usize, min: [f32; 3], max: [f32; 3]) {
+        for axis in 0..3 {
+            self.planes[axis][lane] = min[axis];
+            self.planes[3 + axis][lane] = max[axis];
+        }
+    }
+
+    /// The distance at which the ray enters each box within
+    /// `[t_min, t_max]`, or +∞ for boxes it misses, and a mask of the
+    /// boxes entered (bit `i` for lane `i`).
+    ///
+    /// Four lanes at a time, as `Vec4`s: SSE at the baseline, VEX- or
+    /// EVEX-encoded when compiled for a wider level.
+    #[inline(always)]
+    pub(crate) fn enter(&self, ray: &PlaneRay, t_max: f32) -> (u32, [f32; W]) {
+        const { assert!(W.is_multiple_of(4), "wide nodes have a multiple of four lanes") };
+        let mut distances = [f32::INFINITY; W];
+        let mut mask = 0;
+        for chunk in 0..W / 4 {
+            let lanes = chunk * 4..chunk * 4 + 4;
+            let mut enter = Vec4::splat(ray.t_min);
+            let mut exit = Vec4::splat(t_max);
+            for (axis, flip) in FAR_OF_NEAR.into_iter().enumerate() {
+                let near = Vec4::from_slice(&self.planes[ray.near[axis]][lanes.clone()]);
+                let far = Vec4::from_slice(&self.planes[ray.near[axis] ^ flip][lanes.clone()]);
+                let (origin, inv) = (Vec4::splat(ray.origin[axis]), Vec4::splat(ray.inv_direction[axis]));
+                let t_near = (near - origin) * inv;
+                let t_far = (far - origin) * inv * Vec4::splat(ROBUST_FAR_SCALE);
+                // A NaN compares false and leaves the bound as it was.
+                enter = Vec4::select(t_near.cmpgt(enter), t_near, enter);
+                exit = Vec4::select(t_far.cmplt(exit), t_far, exit);
+            }
+            let entered = enter.cmple(exit) & enter.cmplt(Vec4::INFINITY);
+            Vec4::select(entered, enter, Vec4::INFINITY).write_to_slice(&mut distances[lanes]);
+            mask |= entered.bitmask() << (chunk * 4);
+        }
+        (mask, distances)
+    }
+}
+
+/// `near ^ FAR_OF_NEAR[axis]` turns the index of an axis's min plane into
+/// its max plane's and back (`axis ^ (axis + 3)`).
+pub(crate) const FAR_OF_NEAR: [usize; 3] = [3, 1 ^ 4, 2 ^ 5];
+
+/// A ray prepared for [`WideBoxes::enter`]: per axis, which of the box's
+/// planes it meets first (the maximum where the direction's sign bit is
+/// set, so that -0 counts as negative, as in the scalar test).
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct PlaneRay {
+    pub(crate) origin: [f32; 3],
+    pub(crate) inv_direction: [f32; 3],
+    pub(crate) near: [usize; 3],
+    pub(crate) t_min: f32,
+}
+
+impl PlaneRay {
+    #[inline(always)]
+    pub(crate) fn new(ray: &BoxRay) -> Self {
+        let negative = [ray.negative.test(0), ray.negative.test(1), ray.negative.test(2)];
+        Self {
+            origin: ray.origin.to_array(),
+            inv_direction: ray.inv_direction.to_array(),
+            near: [0, 1, 2].map(|axis| if negative[axis] { axis + 3 } else { axis }),
+            t_min: ray.t_min,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::slab::{RobustSlabs, SlabTest};
+    use rtgi_math::{Ray, Rng, Vec3, Vec3A};
+
+    #[test]
+    fn lanes_enter_exactly_where_the_scalar_test_does() {
+        let mut rng = Rng::new(9, 2);
+        let coordinate = |rng: &mut Rng| match rng.next_u32() % 8 {
+            0 => 0.0,
+            1 => 1.0,
+            2 => -1.0,
+            _ => rng.next_f32() * 8.0 - 4.0,
+        };
+        for _ in 0..20_000 {
+            let mut boxes = WideBoxes::<8>::EMPTY;
+            let mut scalar = Vec::new();
+            for lane in 0..7 {
+                let a = [0; 3].map(|_| coordinate(&mut rng));
+                let b = [0; 3].map(|_| coordinate(&mut rng));
+                let (min, max) = (Vec3::from(a).min(Vec3::from(b)), Vec3::from(a).max(Vec3::from(b)));
+                boxes.set(lane, min.to_array(), max.to_array());
+                scalar.push((min, max));
+            }
+            let origin = Vec3::from([0; 3].map(|_| coordinate(&mut rng)));
+            let mut direction = Vec3::from([0; 3].map(|_| coordinate(&mut rng)));
+            if direction == Vec3::ZERO {
+                direction = Vec3::new(-0.0, 0.0, 1.0);
+            }
+            let ray = Ray::new(origin, direction);
+            let box_ray = BoxRay::new(&ray);
+            let t_max = if rng.next_u32().is_multiple_of(2) { f32::INFINITY } else { rng.next_f32() * 4.0 };
+            let (mask, lanes) = boxes.enter(&PlaneRay::new(&box_ray), t_max);
+            for (lane, (min, max)) in scalar.iter().enumerate() {
+                let expected = RobustSlabs::enter(&box_ray, Vec3A::from(*min), Vec3A::from(*max), t_max);
+                assert_eq!(lanes[lane].to_bits(), expected.to_bits(), "{ray:?} {min} {max} {t_max}");
+            }
+            assert_eq!(lanes[7], f32::INFINITY, "the empty lane is never entered");
+            for (lane, distance) in lanes.iter().enumerate() {
+                assert_eq!(mask >> lane & 1 == 1, *distance < f32::INFINITY);
+            }
+        }
+    }
+}

@@ -1,0 +1,403 @@
+//! Run-time choice of the instruction set: the one module of the crate
+//! that may use `unsafe`.
+//!
+//! The build targets x86-64-v2 (SSE4.2), so that the binary runs on any
+//! such CPU. The hot loops ([`Kernel`]s) are compiled three times: for that
+//! baseline, with AVX2 and FMA, and with AVX-512; [`dispatch`] runs the
+//! widest the CPU supports. Calling a `#[target_feature]` function is
+//! `unsafe` because running instructions the CPU lacks is undefined
+//! behaviour; each call below is made only after the CPU was seen to have
+//! every feature the function enables.
+//!
+//! The kernels are written as plain loops over fixed-size lanes that the
+//! compiler vectorises for whichever instruction set the function is
+//! compiled with; results are the same bits on every level (no fused
+//! multiply-add is ever formed: Rust does not contract `a * b + c`), which
+//! the tests of the wide BVHs check by running every level.
+#![allow(unsafe_code)]
+
+use std::sync::atomic::{AtomicU8, Ordering};
+
+use super::boxes::{FAR_OF_NEAR, PlaneRay, WideBoxes};
+use crate::slab::ROBUST_FAR_SCALE;
+use crate::wide::packet::{PACKET, PacketRays};
+
+/// The instruction sets the kernels are compiled for, narrowest first.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
+pub enum SimdLevel {
+    /// SSE up to 4.2: the x86-64-v2 baseline, and every other architecture's default.
+    Portable,
+    /// AVX2 with FMA, BMI and LZCNT (x86-64-v3).
+    Avx2,
+    /// AVX-512 F, VL, BW, DQ and CD on top of AVX2 (x86-64-v4).
+    Avx512,
+}
+
+impl SimdLevel {
+    pub const ALL: &'static [SimdLevel] = &[SimdLevel::Portable, SimdLevel::Avx2, SimdLevel::Avx512];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            SimdLevel::Portable => "portable",
+            SimdLevel::Avx2 => "avx2",
+            SimdLevel::Avx512 => "avx512",
+        }
+    }
+
+    /// The widest level this CPU supports.
+    pub fn detected() -> SimdLevel {
+        #[cfg(target_arch = "x86_64")]
+        {
+            let avx2 = std::arch::is_x86_feature_detected!("avx2")
+                && std::arch::is_x86_feature_detected!("fma")
+                && std::arch::is_x86_feature_detected!("bmi1")
+                && std::arch::is_x86_feature_detected!("bmi2")
+                && std::arch::is_x86_feature_detected!("lzcnt");
+            let avx512 = avx2
+                && std::arch::is_x86_feature_detected!("avx512f")
+                && std::arch::is_x86_feature_detected!("avx512vl")
+                && std::arch::is_x86_feature_detected!("avx512bw")
+                && std::arch::is_x86_feature_detected!("avx512dq")
+                && std::arch::is_x86_feature_detected!("avx512cd");
+            if avx512 {
+                return SimdLevel::Avx512;
+            }
+            if avx2 {
+                return SimdLevel::Avx2;
+            }
+        }
+        SimdLevel::Portable
+    }
+}
+
+rtgi_math::named_choices!(SimdLevel, "SIMD level");
+
+/// The level in use, as `SimdLevel as u8`; `UNSET` until first asked.
+static ACTIVE: AtomicU8 = AtomicU8::new(UNSET);
+const UNSET: u8 = u8::MAX;
+
+fn from_u8(value: u8) -> SimdLevel {
+    SimdLevel::ALL[value as usize]
+}
+
+/// The level the kernels run at: the detected one, or lower if
+/// [`limit_simd_level`] asked for it.
+pub fn active_simd_level() -> SimdLevel {
+    match ACTIVE.load(Ordering::Relaxed) {
+        UNSET => {
+            let detected = SimdLevel::detected();
+            ACTIVE.store(detected as u8, Ordering::Relaxed);
+            detected
+        }
+        value => from_u8(value),
+    }
+}
+
+/// Runs the kernels at most at `level` from now on, in every thread (to
+/// compare levels, or to rule one out); a level above what the CPU
+/// supports is lowered to that. Returns the level now in use.
+pub fn limit_simd_level(level: SimdLevel) -> SimdLevel {
+    let level = level.min(SimdLevel::detected());
+    ACTIVE.store(level as u8, Ordering::Relaxed);
+    level
+}
+
+/// A hot loop compiled once per [`SimdLevel`]. `run` must be
+/// `#[inline(always)]`, and so must everything it calls that should be
+/// vectorised for the level: a function compiled for the baseline and not
+/// inlined runs at the baseline. The kernels that need instructions of a
+/// level explicitly take them from `isa`.
+pub(crate) trait Kernel {
+    type Output;
+    fn run<I: Isa>(self, isa: I) -> Self::Output;
+}
+
+/// Runs `kernel` compiled for the active level.
+#[inline(always)]
+pub(crate) fn dispatch<K: Kernel>(kernel: K) -> K::Output {
+    #[cfg(target_arch = "x86_64")]
+    match active_simd_level() {
+        // SAFETY: `active_simd_level` is never above `SimdLevel::detected()`
+        // (`limit_simd_level` clamps to it), which checked at run time that
+        // the CPU has every feature `run_avx512` enables.
+        SimdLevel::Avx512 => unsafe { run_avx512(kernel) },
+        // SAFETY: as above, the CPU was seen to have every feature `run_avx2` enables.
+        SimdLevel::Avx2 => unsafe { run_avx2(kernel) },
+        SimdLevel::Portable => kernel.run(Portable),
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    kernel.run(Portable)
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2,fma,bmi1,bmi2,lzcnt,popcnt")]
+fn run_avx2<K: Kernel>(kernel: K) -> K::Output {
+    kernel.run(Avx2(()))
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx512f,avx512vl,avx512bw,avx512dq,avx512cd,avx2,fma,bmi1,bmi2,lzcnt,popcnt")]
+fn run_avx512<K: Kernel>(kernel: K) -> K::Output {
+    kernel.run(Avx512(()))
+}
+
+/// The kernels that are written for one instruction set; [`Portable`]
+/// holds the versions every CPU runs, which the others must match bit for
+/// bit.
+pub(crate) trait Isa: Copy {
+    /// [`WideBoxes::enter`]: where one ray enters each of `W` boxes.
+    fn enter_boxes<const W: usize>(self, boxes: &WideBoxes<W>, ray: &PlaneRay, t_max: f32) -> (u32, [f32; W]);
+
+    /// [`PacketRays::enter_box`]: which rays of a packet enter one box.
+    fn enter_box_packet(
+        self,
+        near: [f32; 3],
+        far: [f32; 3],
+        rays: &PacketRays,
+        t_max: &[f32; PACKET],
+        active: u32,
+    ) -> (u32, f32);
+}
+
+/// The kernels in plain Rust (SSE at the x86-64-v2 baseline).
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Portable;
+
+impl Isa for Portable {
+    #[inline(always)]
+    fn enter_boxes<const W: usize>(self, boxes: &WideBoxes<W>, ray: &PlaneRay, t_max: f32) -> (u32, [f32; W]) {
+        boxes.enter(ray, t_max)
+    }
+
+    #[inline(always)]
+    fn enter_box_packet(
+        self,
+        near: [f32; 3],
+        far: [f32; 3],
+        rays: &PacketRays,
+        t_max: &[f32; PACKET],
+        active: u32,
+    ) -> (u32, f32) {
+        rays.enter_box(near, far, t_max, active)
+    }
+}
+
+/// Proof that the CPU runs AVX2 and FMA: made only by `run_avx2`, which
+/// `dispatch` calls after detecting those features.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Avx2(());
+
+/// Proof that the CPU runs AVX-512 (F, VL, BW, DQ, CD) and AVX2: made only
+/// by `run_avx512`, which `dispatch` calls after detecting those features.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Avx512(());
+
+#[cfg(not(target_arch = "x86_64"))]
+impl Isa for Avx2 {
+    fn enter_boxes<const W: usize>(self, boxes: &WideBoxes<W>, ray: &PlaneRay, t_max: f32) -> (u32, [f32; W]) {
+        Portable.enter_boxes(boxes, ray, t_max)
+    }
+
+    fn enter_box_packet(
+        self,
+        near: [f32; 3],
+        far: [f32; 3],
+        rays: &PacketRays,
+        t_max: &[f32; PACKET],
+        active: u32,
+    ) -> (u32, f32) {
+        Portable.enter_box_packet(near, far, rays, t_max, active)
+    }
+}
+
+#[cfg(not(target_arch = "x86_64"))]
+impl Isa for Avx512 {
+    fn enter_boxes<const W: usize>(self, boxes: &WideBoxes<W>, ray: &PlaneRay, t_max: f32) -> (u32, [f32; W]) {
+        Portable.enter_boxes(boxes, ray, t_max)
+    }
+
+    fn enter_box_packet(
+        self,
+        near: [f32; 3],
+        far: [f32; 3],
+        rays: &PacketRays,
+        t_max: &[f32; PACKET],
+        active: u32,
+    ) -> (u32, f32) {
+        Portable.enter_box_packet(near, far, rays, t_max, active)
+    }
+}
+
+#[cfg(target_arch = "x86_64")]
+impl Isa for Avx2 {
+    #[inline(always)]
+    fn enter_boxes<const W: usize>(self, boxes: &WideBoxes<W>, ray: &PlaneRay, t_max: f32) -> (u32, [f32; W]) {
+        if !W.is_multiple_of(8) {
+            return boxes.enter(ray, t_max);
+        }
+        // SAFETY: an `Avx2` exists only where the CPU was seen to run AVX2
+        // (see the type), the one requirement of calling a function with
+        // `#[target_feature(enable = "avx2")]`.
+        unsafe { enter_boxes_avx2(boxes, ray, t_max) }
+    }
+
+    #[inline(always)]
+    fn enter_box_packet(
+        self,
+        near: [f32; 3],
+        far: [f32; 3],
+        rays: &PacketRays,
+        t_max: &[f32; PACKET],
+        active: u32,
+    ) -> (u32, f32) {
+        // SAFETY: as above, the CPU runs AVX2.
+        unsafe { enter_box_packet_avx2(near, far, rays, t_max, active) }
+    }
+}
+
+#[cfg(target_arch = "x86_64")]
+impl Isa for Avx512 {
+    #[inline(always)]
+    fn enter_boxes<const W: usize>(self, boxes: &WideBoxes<W>, ray: &PlaneRay, t_max: f32) -> (u32, [f32; W]) {
+        if !W.is_multiple_of(8) {
+            return boxes.enter(ray, t_max);
+        }
+        // SAFETY: an `Avx512` exists only where the CPU was seen to run
+        // AVX-512 and AVX2 (see the type); the kernel needs AVX2.
+        unsafe { enter_boxes_avx2(boxes, ray, t_max) }
+    }
+
+    #[inline(always)]
+    fn enter_box_packet(
+        self,
+        near: [f32; 3],
+        far: [f32; 3],
+        rays: &PacketRays,
+        t_max: &[f32; PACKET],
+        active: u32,
+    ) -> (u32, f32) {
+        // SAFETY: an `Avx512` exists only where the CPU was seen to run AVX-512 F.
+        unsafe { enter_box_packet_avx512(near, far, rays, t_max, active) }
+    }
+}
+
+/// [`WideBoxes::enter`] eight lanes at a time, in 256-bit registers; the
+/// same operations in the same order, lane by lane.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+#[inline]
+fn enter_boxes_avx2<const W: usize>(boxes: &WideBoxes<W>, ray: &PlaneRay, t_max: f32) -> (u32, [f32; W]) {
+    use std::arch::x86_64::*;
+    let load = |plane: usize, chunk: usize| {
+        let lanes: &[f32; 8] = boxes.planes[plane][chunk * 8..chunk * 8 + 8].try_into().expect("eight lanes");
+        // SAFETY: `lanes` is a reference to eight `f32`s, valid for an
+        // unaligned 32-byte load.
+        unsafe { _mm256_loadu_ps(lanes.as_ptr()) }
+    };
+    let mut distances = [f32::INFINITY; W];
+    let mut mask = 0;
+    for chunk in 0..W / 8 {
+        let mut enter = _mm256_set1_ps(ray.t_min);
+        let mut exit = _mm256_set1_ps(t_max);
+        for (axis, flip) in FAR_OF_NEAR.into_iter().enumerate() {
+            let near = load(ray.near[axis], chunk);
+            let far = load(ray.near[axis] ^ flip, chunk);
+            let origin = _mm256_set1_ps(ray.origin[axis]);
+            let inv = _mm256_set1_ps(ray.inv_direction[axis]);
+            let t_near = _mm256_mul_ps(_mm256_sub_ps(near, origin), inv);
+            let t_far = _mm256_mul_ps(_mm256_mul_ps(_mm256_sub_ps(far, origin), inv), _mm256_set1_ps(ROBUST_FAR_SCALE));
+            // `max(a, b)` is `a > b ? a : b`: a NaN in `a` leaves the bound.
+            enter = _mm256_max_ps(t_near, enter);
+            exit = _mm256_min_ps(t_far, exit);
+        }
+        let infinity = _mm256_set1_ps(f32::INFINITY);
+        let entered =
+            _mm256_and_ps(_mm256_cmp_ps::<_CMP_LE_OQ>(enter, exit), _mm256_cmp_ps::<_CMP_LT_OQ>(enter, infinity));
+        let out: &mut [f32; 8] = (&mut distances[chunk * 8..chunk * 8 + 8]).try_into().expect("eight lanes");
+        // SAFETY: `out` is a mutable reference to eight `f32`s, valid for an
+        // unaligned 32-byte store.
+        unsafe { _mm256_storeu_ps(out.as_mut_ptr(), _mm256_blendv_ps(infinity, enter, entered)) };
+        mask |= (_mm256_movemask_ps(entered) as u32) << (chunk * 8);
+    }
+    (mask, distances)
+}
+
+/// [`PacketRays::enter_box`] eight rays at a time, in 256-bit registers.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+#[inline]
+fn enter_box_packet_avx2(
+    near: [f32; 3],
+    far: [f32; 3],
+    rays: &PacketRays,
+    t_max: &[f32; PACKET],
+    active: u32,
+) -> (u32, f32) {
+    use std::arch::x86_64::*;
+    let load = |values: &[f32; PACKET], chunk: usize| {
+        let lanes: &[f32; 8] = values[chunk * 8..chunk * 8 + 8].try_into().expect("eight lanes");
+        // SAFETY: `lanes` is a reference to eight `f32`s, valid for an
+        // unaligned 32-byte load.
+        unsafe { _mm256_loadu_ps(lanes.as_ptr()) }
+    };
+    let infinity = _mm256_set1_ps(f32::INFINITY);
+    let mut earliest = infinity;
+    let mut mask = 0;
+    for chunk in 0..PACKET / 8 {
+        let mut enter = load(&rays.t_min, chunk);
+        let mut exit = load(t_max, chunk);
+        for axis in 0..3 {
+            let origin = load(&rays.origin[axis], chunk);
+            let inv = load(&rays.inv_direction[axis], chunk);
+            let t_near = _mm256_mul_ps(_mm256_sub_ps(_mm256_set1_ps(near[axis]), origin), inv);
+            let t_far = _mm256_mul_ps(
+                _mm256_mul_ps(_mm256_sub_ps(_mm256_set1_ps(far[axis]), origin), inv),
+                _mm256_set1_ps(ROBUST_FAR_SCALE),
+            );
+            enter = _mm256_max_ps(t_near, enter);
+            exit = _mm256_min_ps(t_far, exit);
+        }
+        let entered =
+            _mm256_and_ps(_mm256_cmp_ps::<_CMP_LE_OQ>(enter, exit), _mm256_cmp_ps::<_CMP_LT_OQ>(enter, infinity));
+        earliest = _mm256_min_ps(earliest, _mm256_blendv_ps(infinity, enter, entered));
+        mask |= (_mm256_movemask_ps(entered) as u32) << (chunk * 8);
+    }
+    let mut lanes = [0.0f32; 8];
+    // SAFETY: `lanes` is eight `f32`s, valid for an unaligned 32-byte store.
+    unsafe { _mm256_storeu_ps(lanes.as_mut_ptr(), earliest) };
+    (mask & active, lanes.iter().fold(f32::INFINITY, |a, &b| a.min(b)))
+}
+
+/// [`PacketRays::enter_box`] on all sixteen rays in one 512-bit register.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx512f")]
+#[inline]
+fn enter_box_packet_avx512(
+    near: [f32; 3],
+    far: [f32; 3],
+    rays: &PacketRays,
+    t_max: &[f32; PACKET],
+    active: u32,
+) -> (u32, f32) {
+    use std::arch::x86_64::*;
+    // SAFETY: each argument is a reference to sixteen `f32`s, valid for an
+    // unaligned 64-byte load.
+    let load = |values: &[f32; PACKET]| unsafe { _mm512_loadu_ps(values.as_ptr()) };
+    let mut enter = load(&rays.t_min);
+    let mut exit = load(t_max);
+    for axis in 0..3 {
+        let origin = load(&rays.origin[axis]);
+        let inv = load(&rays.inv_direction[axis]);
+        let t_near = _mm512_mul_ps(_mm512_sub_ps(_mm512_set1_ps(near[axis]), origin), inv);
+        let t_far = _mm512_mul_ps(
+            _mm512_mul_ps(_mm512_sub_ps(_mm512_set1_ps(far[axis]), origin), inv),
+            _mm512_set1_ps(ROBUST_FAR_SCALE),
+        );
+        enter = _mm512_max_ps(t_near, enter);
+        exit = _mm512_min_ps(t_far, exit);
+    }
+    let entered = _mm512_cmp_ps_mask::<_CMP_LE_OQ>(enter, exit)
+        & _mm512_cmp_ps_mask::<_CMP_LT_OQ>(enter, _mm512_set1_ps(f32::INFINITY));
+    let earliest = _mm512_mask_reduce_min_ps(entered, enter);
+    (entered as u32 & active, earliest)
+}

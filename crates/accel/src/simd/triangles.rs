@@ -1,0 +1,119 @@
+//! One ray against four triangles at once.
+//!
+//! A [`TriangleBlock`] stores four triangles structure-of-arrays, so that
+//! each step of a triangle test runs on all four in one SIMD instruction.
+//! The tests evaluate the expressions of [`arith`](super::arith), which the
+//! scalar tests evaluate too: every lane computes the bits the scalar test
+//! computes for its triangle. Lanes the scalar test would decide in double
+//! precision (the watertight test's exact zeros) are handed back to it.
+
+use rtgi_math::glam::BVec4A;
+use rtgi_math::{Vec3A, Vec4};
+
+use super::arith;
+
+/// Four triangles, structure-of-arrays: `corners[c][axis]` holds the
+/// coordinate along `axis` of corner `c` of the four triangles. Lanes
+/// without a triangle hold NaN corners, which every test rejects, and the
+/// id [`TriangleBlock::NO_TRIANGLE`].
+#[derive(Clone, Copy, Debug)]
+#[repr(C, align(16))]
+pub(crate) struct TriangleBlock {
+    pub(crate) corners: [[Vec4; 3]; 3],
+    /// Input index of each lane's triangle.
+    pub(crate) ids: [u32; 4],
+}
+
+impl TriangleBlock {
+    pub(crate) const LANES: usize = 4;
+    pub(crate) const NO_TRIANGLE: u32 = u32::MAX;
+
+    /// A block of up to four triangles and their input indices.
+    pub(crate) fn new(triangles: &[[Vec3A; 3]], ids: &[u32]) -> Self {
+        assert!(triangles.len() <= Self::LANES && triangles.len() == ids.len());
+        let mut corners = [[Vec4::NAN; 3]; 3];
+        let mut lane_ids = [Self::NO_TRIANGLE; 4];
+        for (lane, (triangle, &id)) in triangles.iter().zip(ids).enumerate() {
+            for (c, corner) in triangle.iter().enumerate() {
+                for axis in 0..3 {
+                    corners[c][axis][lane] = corner[axis];
+                }
+            }
+            lane_ids[lane] = id;
+        }
+        Self { corners, ids: lane_ids }
+    }
+
+    /// The corners of the triangle in `lane`.
+    #[inline(always)]
+    pub(crate) fn triangle(&self, lane: usize) -> [Vec3A; 3] {
+        let c = &self.corners;
+        [0, 1, 2].map(|k| Vec3A::new(c[k][0][lane], c[k][1][lane], c[k][2][lane]))
+    }
+
+    /// Lanes that hold a triangle.
+    pub(crate) fn len(&self) -> u32 {
+        self.ids.iter().filter(|&&id| id != Self::NO_TRIANGLE).count() as u32
+    }
+}
+
+/// What a block test found: bit `i` of `exact` says that lane `i` was hit,
+/// at `t[i]` with barycentrics `beta[i]`, `gamma[i]`; bit `i` of `rescan`
+/// that the scalar test must decide lane `i`.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct BlockHits {
+    pub(crate) exact: u32,
+    pub(crate) rescan: u32,
+    pub(crate) t: Vec4,
+    pub(crate) beta: Vec4,
+    pub(crate) gamma: Vec4,
+}
+
+#[inline(always)]
+fn in_range(t: Vec4, t_min: f32, t_max: f32) -> BVec4A {
+    t.cmpge(Vec4::splat(t_min)) & t.cmple(Vec4::splat(t_max)) & t.is_finite_mask()
+}
+
+/// [`crate::triangle::Watertight`] on four triangles.
+#[inline(always)]
+pub(crate) fn watertight_block(
+    origin: [f32; 3],
+    axes: [usize; 3],
+    shear: [f32; 3],
+    t_min: f32,
+    t_max: f32,
+    block: &TriangleBlock,
+) -> BlockHits {
+    let relative = block.corners.map(|corner| axes.map(|axis| corner[axis] - Vec4::splat(origin[axis])));
+    let [xs, ys, zs] = arith::watertight_shear(relative, shear);
+    let uvw = arith::watertight_edges(xs, ys);
+    let zero = Vec4::ZERO;
+    let rescan = uvw[0].cmpeq(zero) | uvw[1].cmpeq(zero) | uvw[2].cmpeq(zero);
+    let negative = uvw[0].cmplt(zero) | uvw[1].cmplt(zero) | uvw[2].cmplt(zero);
+    let positive = uvw[0].cmpgt(zero) | uvw[1].cmpgt(zero) | uvw[2].cmpgt(zero);
+    let (det, t_scaled) = arith::watertight_det_and_scaled_t(uvw, zs);
+    let t = t_scaled / det;
+    let hit = !(negative & positive) & det.cmpne(zero) & det.is_finite_mask() & in_range(t, t_min, t_max);
+    BlockHits { exact: (hit & !rescan).bitmask(), rescan: rescan.bitmask(), t, beta: uvw[1] / det, gamma: uvw[2] / det }
+}
+
+/// [`crate::triangle::MollerTrumbore`] on four triangles.
+#[inline(always)]
+pub(crate) fn moller_trumbore_block(
+    origin: [f32; 3],
+    direction: [f32; 3],
+    t_min: f32,
+    t_max: f32,
+    block: &TriangleBlock,
+) -> BlockHits {
+    let [det, beta, gamma, t] =
+        arith::moller_trumbore(origin.map(Vec4::splat), direction.map(Vec4::splat), block.corners);
+    let (zero, one) = (Vec4::ZERO, Vec4::ONE);
+    let inside = det.cmpne(zero)
+        & det.is_finite_mask()
+        & beta.cmpge(zero)
+        & beta.cmple(one)
+        & !gamma.cmplt(zero)
+        & !(beta + gamma).cmpgt(one);
+    BlockHits { exact: (inside & in_range(t, t_min, t_max)).bitmask(), rescan: 0, t, beta, gamma }
+}

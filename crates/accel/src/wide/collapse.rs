@@ -1,0 +1,124 @@
+//! Collapsing a binary BVH into a `W`-wide one, as Embree, tinybvh and
+//! obvhs do: each wide node takes the two children of a binary node and
+//! keeps opening the child with the largest surface area until it has `W`
+//! children or only leaves are left. Binary leaves become wide leaves whose
+//! triangles are copied, in order, into blocks of four.
+
+use rtgi_math::Vec3A;
+
+use super::node::{ChildRef, WideNode};
+use crate::boxa::BoxA;
+use crate::bvh::{Bvh, BvhNode};
+use crate::simd::triangles::TriangleBlock;
+
+/// The wide tree: nodes (the root first), triangle blocks in leaf order,
+/// and what was measured on the way.
+pub(crate) struct WideTree<const W: usize> {
+    pub(crate) nodes: Vec<WideNode<W>>,
+    pub(crate) blocks: Vec<TriangleBlock>,
+    pub(crate) leaves: usize,
+    /// Edges on the longest path from the root to a leaf.
+    pub(crate) depth: usize,
+    /// SAH cost in units of one triangle test, each wide node costing
+    /// `traversal_cost`, relative to the root's area.
+    pub(crate) sah_cost: f32,
+}
+
+pub(crate) fn collapse<const W: usize>(binary: &Bvh, traversal_cost: f32) -> WideTree<W> {
+    const { assert!(W >= 2 && W <= 32) };
+    let (triangles, ids) = binary.leaf_order();
+    let mut tree = WideTree { nodes: Vec::new(), blocks: Vec::new(), leaves: 0, depth: 0, sah_cost: 0.0 };
+    let Some(root) = binary.nodes().first() else {
+        return tree;
+    };
+    let collapser =
+        Collapser { binary: binary.nodes(), triangles, ids, root_area: corners(root).half_area(), traversal_cost };
+    let mut cost = 0.0f64;
+    if root.is_leaf() {
+        // A wide root over the one leaf, so that traversal always starts at a node.
+        let mut node = WideNode::EMPTY;
+        node.children[0] = collapser.leaf(root, &mut tree, &mut cost);
+        node.boxes.set(0, root.min().to_array(), root.max().to_array());
+        tree.nodes.push(node);
+        cost += collapser.relative_area(root) * traversal_cost as f64;
+        tree.depth = 1;
+    } else {
+        collapser.node(root, 0, &mut tree, &mut cost);
+    }
+    tree.sah_cost = cost as f32;
+    tree
+}
+
+fn corners(node: &BvhNode) -> BoxA {
+    BoxA { min: node.min().into(), max: node.max().into() }
+}
+
+struct Collapser<'a> {
+    binary: &'a [BvhNode],
+    triangles: &'a [[Vec3A; 3]],
+    ids: &'a [u32],
+    root_area: f32,
+    traversal_cost: f32,
+}
+
+impl Collapser<'_> {
+    fn relative_area(&self, node: &BvhNode) -> f64 {
+        if self.root_area > 0.0 { (corners(node).half_area() / self.root_area) as f64 } else { 1.0 }
+    }
+
+    fn children(&self, node: &BvhNode) -> [&BvhNode; 2] {
+        let first = node.first() as usize;
+        [&self.binary[first], &self.binary[first + 1]]
+    }
+
+    /// Emits the wide node for the binary interior node `node` and,
+    /// depth first, its subtrees; returns its reference.
+    fn node<const W: usize>(&self, node: &BvhNode, depth: usize, tree: &mut WideTree<W>, cost: &mut f64) -> ChildRef {
+        debug_assert!(!node.is_leaf());
+        let index = tree.nodes.len();
+        tree.nodes.push(WideNode::EMPTY);
+        tree.depth = tree.depth.max(depth + 1);
+        *cost += self.relative_area(node) * self.traversal_cost as f64;
+        let [left, right] = self.children(node);
+        let mut children = [left; W];
+        children[1] = right;
+        let mut len = 2;
+        while len < W {
+            let largest = children[..len]
+                .iter()
+                .enumerate()
+                .filter(|(_, child)| !child.is_leaf())
+                .max_by(|(_, a), (_, b)| corners(a).half_area().total_cmp(&corners(b).half_area()))
+                .map(|(i, _)| i);
+            let Some(largest) = largest else { break };
+            let [left, right] = self.children(children[largest]);
+            children.copy_within(largest + 1..len, largest + 2);
+            children[largest] = left;
+            children[largest + 1] = right;
+            len += 1;
+        }
+        let mut wide = WideNode::EMPTY;
+        for (lane, child) in children[..len].iter().enumerate() {
+            wide.boxes.set(lane, child.min().to_array(), child.max().to_array());
+            wide.children[lane] =
+                if child.is_leaf() { self.leaf(child, tree, cost) } else { self.node(child, depth + 1, tree, cost) };
+        }
+        tree.nodes[index] = wide;
+        ChildRef::node(index)
+    }
+
+    /// Copies the triangles of the binary leaf `leaf` into blocks.
+    fn leaf<const W: usize>(&self, leaf: &BvhNode, tree: &mut WideTree<W>, cost: &mut f64) -> ChildRef {
+        let range = leaf.first() as usize..(leaf.first() + leaf.count()) as usize;
+        let first_block = tree.blocks.len();
+        for (triangles, ids) in self.triangles[range.clone()]
+            .chunks(TriangleBlock::LANES)
+            .zip(self.ids[range.clone()].chunks(TriangleBlock::LANES))
+        {
+            tree.blocks.push(TriangleBlock::new(triangles, ids));
+        }
+        tree.leaves += 1;
+        *cost += self.relative_area(leaf) * range.len() as f64;
+        ChildRef::leaf(first_block, tree.blocks.len() - first_block)
+    }
+}

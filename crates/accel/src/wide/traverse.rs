@@ -1,0 +1,211 @@
+//! Single-ray traversal of a wide BVH: all children of a node are tested
+//! at once, those the ray enters are visited nearest first, and the others
+//! wait on a stack with their entry distance, so that they are dropped
+//! without a second test once a hit lies in front of them.
+
+use std::marker::PhantomData;
+
+use rtgi_math::Ray;
+
+use super::WideBvh;
+use super::node::ChildRef;
+use crate::contract::{Best, HitFilter, PreparedRay, QueryKind, box_rule, hit_triangle};
+use crate::simd::boxes::PlaneRay;
+use crate::simd::{Isa, Kernel, dispatch};
+use crate::triangle::{MollerTrumbore, TriangleHit, TriangleTest, Watertight};
+use crate::{Counter, Hit, Intersector};
+
+/// Children waiting to be visited, with the distance at which the ray
+/// enters each, packed into 64 bits (so that a new stack is cleared with
+/// a plain memset). `INLINE` entries live in an array on the call stack; a
+/// deeper stack (only degenerate trees need one) continues on the heap.
+pub(crate) struct TraversalStack<const INLINE: usize> {
+    entries: [u64; INLINE],
+    len: usize,
+    spill: Vec<u64>,
+}
+
+impl<const INLINE: usize> TraversalStack<INLINE> {
+    #[inline(always)]
+    pub(crate) fn new() -> Self {
+        Self { entries: [0; INLINE], len: 0, spill: Vec::new() }
+    }
+
+    #[inline(always)]
+    pub(crate) fn clear(&mut self) {
+        self.len = 0;
+        self.spill.clear();
+    }
+
+    #[inline(always)]
+    pub(crate) fn push(&mut self, (child, enter): (ChildRef, f32)) {
+        let entry = (enter.to_bits() as u64) << 32 | child.to_bits() as u64;
+        if self.len < INLINE {
+            self.entries[self.len] = entry;
+            self.len += 1;
+        } else {
+            self.spill.push(entry);
+        }
+    }
+
+    #[inline(always)]
+    pub(crate) fn pop(&mut self) -> Option<(ChildRef, f32)> {
+        let entry = if let Some(entry) = self.spill.pop() {
+            entry
+        } else if self.len > 0 {
+            self.len -= 1;
+            self.entries[self.len]
+        } else {
+            return None;
+        };
+        Some((ChildRef::from_bits(entry as u32), f32::from_bits((entry >> 32) as u32)))
+    }
+}
+
+/// Entries kept on the call stack: enough for every tree but degenerate ones.
+const INLINE_STACK: usize = 32;
+
+impl<const W: usize> WideBvh<W> {
+    /// The query compiled for the intersector and run at the active SIMD level.
+    pub(super) fn query_dispatched<Q: QueryKind, C: Counter, F: HitFilter>(
+        &self,
+        ray: &Ray,
+        counter: &mut C,
+        filter: &F,
+    ) -> Option<Hit> {
+        match self.intersector {
+            Intersector::Watertight => {
+                dispatch(SingleRay::<W, Q, C, Watertight, F> { bvh: self, ray, counter, filter, test: PhantomData })
+            }
+            Intersector::MollerTrumbore => {
+                dispatch(SingleRay::<W, Q, C, MollerTrumbore, F> { bvh: self, ray, counter, filter, test: PhantomData })
+            }
+        }
+    }
+
+    /// Closest hit, or with [`crate::contract::AnyHit`] the first hit found.
+    #[inline(always)]
+    pub(super) fn traverse<Q: QueryKind, C: Counter, T: TriangleTest, F: HitFilter, I: Isa, const S: usize>(
+        &self,
+        isa: I,
+        ray: &Ray,
+        stack: &mut TraversalStack<S>,
+        counter: &mut C,
+        filter: &F,
+    ) -> Option<Hit> {
+        if !ray.is_valid() || self.nodes.is_empty() {
+            return None;
+        }
+        let prepared = PreparedRay::<T>::new(ray);
+        let plane_ray = PlaneRay::new(&prepared.boxes);
+        let mut best = Best::new(ray);
+        stack.clear();
+        let mut current = ChildRef::node(0);
+        loop {
+            if current.is_leaf() {
+                if self.visit_leaf::<Q, C, T, F>(current, &prepared, &mut best, counter, filter) {
+                    return best.hit;
+                }
+            } else {
+                let node = &self.nodes[current.node_index()];
+                counter.node_visited();
+                let (entered, enter) = isa.enter_boxes(&node.boxes, &plane_ray, best.t_max);
+                if entered != 0 {
+                    let first = entered.trailing_zeros() as usize;
+                    if entered & (entered - 1) == 0 {
+                        current = node.children[first];
+                        continue;
+                    }
+                    // Children entered, sorted far to near: the nearest is
+                    // visited now, the others are pushed, nearest last.
+                    let mut sorted = [(ChildRef::NONE, 0.0f32); W];
+                    let mut count = 0;
+                    let mut lanes = entered;
+                    while lanes != 0 {
+                        let lane = lanes.trailing_zeros() as usize;
+                        lanes &= lanes - 1;
+                        let entry = (node.children[lane], enter[lane]);
+                        let mut at = count;
+                        while at > 0 && sorted[at - 1].1 < entry.1 {
+                            sorted[at] = sorted[at - 1];
+                            at -= 1;
+                        }
+                        sorted[at] = entry;
+                        count += 1;
+                    }
+                    for &entry in &sorted[..count - 1] {
+                        stack.push(entry);
+                    }
+                    current = sorted[count - 1].0;
+                    continue;
+                }
+            }
+            // Next from the stack; a child entered beyond the best hit is
+            // dropped (one entered at exactly its distance may hold a tie).
+            loop {
+                let Some((child, enter)) = stack.pop() else {
+                    return best.hit;
+                };
+                if enter <= best.t_max {
+                    current = child;
+                    break;
+                }
+            }
+        }
+    }
+
+    /// Tests the triangles of a leaf, offering hits to `best`; returns
+    /// whether the query is answered (an any-hit query found a hit).
+    #[inline(always)]
+    pub(super) fn visit_leaf<Q: QueryKind, C: Counter, T: TriangleTest, F: HitFilter>(
+        &self,
+        leaf: ChildRef,
+        ray: &PreparedRay<T>,
+        best: &mut Best,
+        counter: &mut C,
+        filter: &F,
+    ) -> bool {
+        for block in &self.blocks[leaf.blocks()] {
+            counter.triangles_tested(block.len());
+            let hits = T::intersect_block(&ray.triangles, ray.boxes.t_min, best.t_max, block);
+            let mut lanes = hits.exact | hits.rescan;
+            while lanes != 0 {
+                let lane = lanes.trailing_zeros() as usize;
+                lanes &= lanes - 1;
+                let triangle = block.triangle(lane);
+                let hit = if hits.rescan & (1 << lane) != 0 {
+                    hit_triangle(ray, &triangle, best.t_max)
+                } else {
+                    let hit = TriangleHit { t: hits.t[lane], beta: hits.beta[lane], gamma: hits.gamma[lane] };
+                    box_rule(&ray.boxes, &triangle, hit, best.t_max)
+                };
+                if let Some(hit) = hit
+                    && best.offer(block.ids[lane], hit, filter)
+                    && Q::STOP_AT_FIRST_HIT
+                {
+                    return true;
+                }
+            }
+        }
+        false
+    }
+}
+
+/// One query as a [`Kernel`], so that it runs compiled for the active SIMD level.
+struct SingleRay<'a, const W: usize, Q, C, T, F> {
+    bvh: &'a WideBvh<W>,
+    ray: &'a Ray,
+    counter: &'a mut C,
+    filter: &'a F,
+    test: PhantomData<(Q, T)>,
+}
+
+impl<const W: usize, Q: QueryKind, C: Counter, T: TriangleTest, F: HitFilter> Kernel for SingleRay<'_, W, Q, C, T, F> {
+    type Output = Option<Hit>;
+
+    #[inline(always)]
+    fn run<I: Isa>(self, isa: I) -> Option<Hit> {
+        let mut stack = TraversalStack::<INLINE_STACK>::new();
+        self.bvh.traverse::<Q, C, T, F, I, INLINE_STACK>(isa, self.ray, &mut stack, self.counter, self.filter)
+    }
+}
