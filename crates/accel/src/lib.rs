@@ -52,6 +52,8 @@ mod boxa;
 mod bvh;
 mod contract;
 mod counters;
+#[cfg(feature = "embree")]
+mod embree;
 mod kind;
 mod linear;
 mod slab;
@@ -61,7 +63,9 @@ pub mod verify;
 pub use bvh::{Bvh, BvhNode, SplitMethod, Traversal};
 pub use contract::is_hittable;
 pub use counters::{Counter, NoCounter, TraversalCounters};
-pub use kind::{AccelKind, BuildParams};
+#[cfg(feature = "embree")]
+pub use embree::{EmbreeBackend, EmbreeError};
+pub use kind::{AccelKind, BuildError, BuildParams};
 pub use linear::LinearScan;
 pub use triangle::{Intersector, TriangleHit};
 
