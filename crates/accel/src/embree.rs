@@ -30,6 +30,19 @@ use crate::{Accel, BuildStats, Hit, TraversalCounters, is_hittable};
 /// Embree's "no geometry hit" marker (`RTC_INVALID_GEOMETRY_ID`).
 const INVALID_ID: u32 = u32::MAX;
 
+/// The largest coordinate Embree accepts in a ray's origin and direction
+/// (`FLT_LARGE` in its `kernels/common/ray.h`); builds with assertions
+/// abort on rays beyond it.
+const EMBREE_LARGEST: f32 = 1.844e18;
+
+/// Whether Embree can trace `ray`: a valid ray ([`Ray::is_valid`]) whose
+/// origin and direction lie within Embree's range.
+fn traceable(ray: &Ray) -> bool {
+    ray.is_valid()
+        && ray.origin.abs().max_element() <= EMBREE_LARGEST
+        && ray.direction.abs().max_element() <= EMBREE_LARGEST
+}
+
 /// Rays per packet of the batch queries (`rtcIntersect16`, `rtcOccluded16`).
 const PACKET: usize = 16;
 
@@ -63,7 +76,9 @@ impl std::error::Error for EmbreeError {}
 ///   index table maps its primitive IDs back; the others are counted in
 ///   [`BuildStats::excluded_triangles`]. `beta` and `gamma` are Embree's
 ///   `u` and `v`, the barycentrics of the second and third corners.
-/// - Invalid rays ([`Ray::is_valid`]) hit nothing, as with our structures.
+/// - Invalid rays ([`Ray::is_valid`]) hit nothing, as with our structures,
+///   and so do rays with a coordinate of origin or direction beyond
+///   1.844e18, which Embree does not accept (it asserts on them).
 /// - The counted queries count the ray only: Embree does not report the
 ///   nodes it visits or the triangles it tests, so those counters stay 0.
 /// - The filtered queries pass the filter to Embree's intersection-context
@@ -288,7 +303,7 @@ impl EmbreeBackend {
 
     /// The closest hit, with `filter` (or none) in the intersection context.
     fn closest(&self, ray: &Ray, filter: Option<&dyn Fn(u32, f32, f32) -> bool>) -> Option<Hit> {
-        if !ray.is_valid() {
+        if !traceable(ray) {
             return None;
         }
         let mut context = FilterContext::new(sys::RTCIntersectContextFlags::INCOHERENT, filter, &self.ids);
@@ -307,7 +322,7 @@ impl EmbreeBackend {
 
     /// Whether anything is hit, with `filter` (or none) in the context.
     fn any(&self, ray: &Ray, filter: Option<&dyn Fn(u32, f32, f32) -> bool>) -> bool {
-        if !ray.is_valid() {
+        if !traceable(ray) {
             return false;
         }
         let mut context = FilterContext::new(sys::RTCIntersectContextFlags::INCOHERENT, filter, &self.ids);
@@ -436,7 +451,7 @@ impl ValidMask {
     fn of(rays: &[Ray]) -> Self {
         let mut mask = [0; PACKET];
         for (lane, ray) in mask.iter_mut().zip(rays) {
-            *lane = if ray.is_valid() { -1 } else { 0 };
+            *lane = if traceable(ray) { -1 } else { 0 };
         }
         Self(mask)
     }
@@ -463,7 +478,7 @@ fn packet_rays(rays: &[Ray]) -> sys::RTCRay16 {
         id: [0; PACKET],
         flags: [0; PACKET],
     };
-    for (lane, ray) in rays.iter().enumerate().filter(|(_, r)| r.is_valid()) {
+    for (lane, ray) in rays.iter().enumerate().filter(|(_, r)| traceable(r)) {
         packet.org_x[lane] = ray.origin.x;
         packet.org_y[lane] = ray.origin.y;
         packet.org_z[lane] = ray.origin.z;
