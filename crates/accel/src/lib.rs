@@ -47,6 +47,16 @@
 //! scene, and `rtgi verify` runs it from the command line; the fast
 //! traversal ([`Traversal::Fast`]) drops boxes that rays graze and is
 //! outside the contract.
+//!
+//! # Peers
+//!
+//! With the `embree` feature (and the system's Embree 3,
+//! `apt install libembree-dev`), `EmbreeBackend` puts Intel Embree behind
+//! [`Accel`] as `AccelKind::Embree`, to compare against. It is a peer
+//! ([`AccelKind::PEERS`]), outside the contract: it breaks ties in its own
+//! order and rounds differently on grazing rays, so it is not in
+//! [`AccelKind::ALL`]. Its module is the one place of the workspace where
+//! `unsafe` code is allowed.
 
 mod boxa;
 mod bvh;
