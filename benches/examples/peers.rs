@@ -1,11 +1,14 @@
-//! Our SAH BVH against obvhs' BVH2 on the same rays, in one run:
+//! Our SAH BVH against peers on the same rays, in one run:
 //! `cargo run --release -p rtgi-benches --example peers [-- SCENE.obj]`.
+//! The peers are obvhs' BVH2 and, built with `--features embree`, Intel
+//! Embree 3 through `rtcIntersect1` (one ray at a time, [`Accel::intersect`])
+//! and `rtcIntersect16` (packets of 16, [`Accel::intersect_batch`]).
 //!
 //! Follows the method of `../shared/notes/peers.md`: 1024×1024 primary rays
 //! framing the bounding sphere with a 40° field of view, and 1,000,000
 //! incoherent rays from uniform points in the bounding box in uniform
-//! directions; closest hit. Timings on a shared machine drift, so the two
-//! libraries' runs alternate and each figure is the median of 15 runs
+//! directions; closest hit. Timings on a shared machine drift, so the
+//! contenders' runs alternate and each figure is the median of 15 runs
 //! (builds: 15 builds).
 
 use std::time::{Duration, Instant};
@@ -13,7 +16,9 @@ use std::time::{Duration, Instant};
 use obvhs::BvhBuildParams;
 use obvhs::bvh2::builder::build_bvh2_from_tris;
 use rayon::prelude::*;
-use rtgi_accel::{AccelKind, BuildParams};
+#[cfg(feature = "embree")]
+use rtgi_accel::Hit;
+use rtgi_accel::{Accel, AccelKind, BuildParams};
 use rtgi_benches::workspace_root;
 use rtgi_math::Ray;
 use rtgi_math::glam::Vec3A;
@@ -22,21 +27,38 @@ use rtgi_scene::Scene;
 
 const RUNS: usize = 15;
 
+/// Rays per parallel work item; a multiple of 16, so that packets stay full.
+const CHUNK: usize = 1024;
+
 fn median(mut values: Vec<f64>) -> f64 {
     values.sort_by(f64::total_cmp);
     values[values.len() / 2]
 }
 
-/// Seconds of each of `RUNS` alternating runs of `a` and `b`, as medians.
-fn alternate(a: &mut dyn FnMut() -> f64, b: &mut dyn FnMut() -> f64) -> (f64, f64) {
-    a();
-    b();
-    let (mut times_a, mut times_b) = (Vec::new(), Vec::new());
-    for _ in 0..RUNS {
-        times_a.push(a());
-        times_b.push(b());
+/// Medians of `RUNS` rounds in which each of `runs` runs once, in turn
+/// (after one warm-up round), so that drift hits every contender alike.
+fn alternate(runs: &mut [&mut dyn FnMut() -> f64]) -> Vec<f64> {
+    for run in runs.iter_mut() {
+        run();
     }
-    (median(times_a), median(times_b))
+    let mut times = vec![Vec::new(); runs.len()];
+    for _ in 0..RUNS {
+        for (run, times) in runs.iter_mut().zip(&mut times) {
+            times.push(run());
+        }
+    }
+    times.into_iter().map(median).collect()
+}
+
+/// Traces a chunk of rays and counts the hits.
+type Trace<'a> = Box<dyn Fn(&[Ray]) -> usize + Sync + 'a>;
+
+/// One structure under test: how to build it (and drop it, for build
+/// timings), and how to trace a chunk of rays, counting the hits.
+struct Contender<'a> {
+    name: &'static str,
+    build: Box<dyn Fn() + Sync + 'a>,
+    trace: Trace<'a>,
 }
 
 fn main() {
@@ -48,83 +70,122 @@ fn main() {
     let triangles = scene.triangle_positions();
     let primary = primary_rays(&bounding_sphere_camera(&scene), 1024, 1024);
     let incoherent = box_rays(&scene, 1_000_000, 1);
+    println!("{}: {} triangles; medians of {RUNS} alternating runs", path.display(), triangles.len());
+
+    let params = BuildParams::default();
+    let ours = AccelKind::Sah.build(&triangles, &params);
     let peer_triangles: Vec<obvhs::triangle::Triangle> = triangles
         .iter()
         .map(|t| obvhs::triangle::Triangle { v0: Vec3A::from(t[0]), v1: Vec3A::from(t[1]), v2: Vec3A::from(t[2]) })
         .collect();
-    println!("{}: {} triangles; medians of {RUNS} alternating runs", path.display(), triangles.len());
-
-    let pools: Vec<rayon::ThreadPool> =
-        [1, 2].iter().map(|&n| rayon::ThreadPoolBuilder::new().num_threads(n).build().unwrap()).collect();
-    let ours = AccelKind::Sah.build(&triangles, &BuildParams::default());
-    let peer = build_bvh2_from_tris(&peer_triangles, BvhBuildParams::medium_build(), &mut Duration::default());
+    let build_obvhs =
+        || build_bvh2_from_tris(&peer_triangles, BvhBuildParams::medium_build(), &mut Duration::default());
+    let obvhs = build_obvhs();
     // Triangles in the peer's leaf order, as its documentation advises.
-    let peer_leaf_order: Vec<_> = peer.primitive_indices.iter().map(|&i| peer_triangles[i as usize]).collect();
-    let our_trace = |ray: &Ray| ours.intersect(ray).is_some();
-    let peer_trace = |ray: &Ray| {
-        let ray = obvhs::ray::Ray::new(ray.origin.into(), ray.direction.into(), ray.t_min, ray.t_max);
-        let mut hit = obvhs::ray::RayHit::none();
-        peer.ray_traverse(ray, &mut hit, |r, id| peer_leaf_order[id].intersect(r))
-    };
+    let obvhs_leaf_order: Vec<_> = obvhs.primitive_indices.iter().map(|&i| peer_triangles[i as usize]).collect();
+    let one_at_a_time = |accel: &dyn Accel, rays: &[Ray]| rays.iter().filter(|r| accel.intersect(r).is_some()).count();
+
+    #[cfg(feature = "embree")]
+    let embree = AccelKind::Embree.try_build(&triangles, &params).unwrap_or_else(|e| panic!("{e}"));
+    #[cfg_attr(not(feature = "embree"), allow(unused_mut))]
+    let mut contenders = vec![
+        Contender {
+            name: "rtgi sah",
+            build: Box::new(|| drop(AccelKind::Sah.build(&triangles, &params))),
+            trace: Box::new(|rays| one_at_a_time(ours.as_ref(), rays)),
+        },
+        Contender {
+            name: "obvhs bvh2",
+            build: Box::new(|| drop(build_obvhs())),
+            trace: Box::new(|rays| {
+                rays.iter()
+                    .filter(|ray| {
+                        let ray = obvhs::ray::Ray::new(ray.origin.into(), ray.direction.into(), ray.t_min, ray.t_max);
+                        let mut hit = obvhs::ray::RayHit::none();
+                        obvhs.ray_traverse(ray, &mut hit, |r, id| obvhs_leaf_order[id].intersect(r))
+                    })
+                    .count()
+            }),
+        },
+    ];
+    #[cfg(feature = "embree")]
+    {
+        let build_embree = || drop(AccelKind::Embree.try_build(&triangles, &params).unwrap_or_else(|e| panic!("{e}")));
+        contenders.push(Contender {
+            name: "embree 1",
+            build: Box::new(build_embree),
+            trace: Box::new(|rays| one_at_a_time(embree.as_ref(), rays)),
+        });
+        contenders.push(Contender {
+            name: "embree 16",
+            build: Box::new(build_embree),
+            trace: Box::new(|rays| {
+                let mut hits: Vec<Option<Hit>> = vec![None; rays.len()];
+                embree.intersect_batch(rays, &mut hits);
+                hits.iter().filter(|h| h.is_some()).count()
+            }),
+        });
+    }
+    let names: Vec<&str> = contenders.iter().map(|c| c.name).collect();
+    if names.iter().any(|n| n.starts_with("embree")) {
+        println!(
+            "embree 1: rtcIntersect1 (Accel::intersect); embree 16: rtcIntersect16 packets (Accel::intersect_batch)"
+        );
+    }
+
     let timed = |pool: &rayon::ThreadPool, work: &(dyn Fn() + Sync)| {
         let start = Instant::now();
         pool.install(work);
         start.elapsed().as_secs_f64()
     };
-
-    println!(
-        "{:<10} {:>14} {:>14} {:>14} {:>14} {:>14} {:>14}",
-        "", "build ms", "", "primary", "Mrays/s", "incoherent", "Mrays/s"
-    );
-    println!(
-        "{:<10} {:>14} {:>14} {:>14} {:>14} {:>14} {:>14}",
-        "threads", "rtgi sah", "obvhs bvh2", "rtgi sah", "obvhs bvh2", "rtgi sah", "obvhs bvh2"
-    );
+    let pools: Vec<rayon::ThreadPool> =
+        [1, 2].iter().map(|&n| rayon::ThreadPoolBuilder::new().num_threads(n).build().unwrap()).collect();
+    let header = |what: &str| {
+        println!();
+        println!("{what}");
+        print!("{:<8}", "threads");
+        names.iter().for_each(|n| print!(" {n:>12}"));
+        println!();
+    };
+    let row = |threads: usize, values: &[f64], decimals: usize| {
+        print!("{threads:<8}");
+        values.iter().for_each(|v| print!(" {v:>12.decimals$}"));
+        println!();
+    };
+    let measure_builds = |pool: &rayon::ThreadPool| {
+        let mut runs: Vec<Box<dyn FnMut() -> f64 + '_>> =
+            contenders.iter().map(|c| Box::new(|| timed(pool, &*c.build)) as Box<dyn FnMut() -> f64>).collect();
+        let mut runs: Vec<&mut dyn FnMut() -> f64> = runs.iter_mut().map(|r| &mut **r as _).collect();
+        alternate(&mut runs).into_iter().map(|s| s * 1e3).collect::<Vec<_>>()
+    };
+    let measure_rays = |pool: &rayon::ThreadPool, rays: &[Ray]| {
+        let mut runs: Vec<Box<dyn FnMut() -> f64 + '_>> = contenders
+            .iter()
+            .map(|c| {
+                Box::new(|| {
+                    timed(pool, &|| {
+                        std::hint::black_box(rays.par_chunks(CHUNK).map(|chunk| (c.trace)(chunk)).sum::<usize>());
+                    })
+                }) as Box<dyn FnMut() -> f64>
+            })
+            .collect();
+        let mut runs: Vec<&mut dyn FnMut() -> f64> = runs.iter_mut().map(|r| &mut **r as _).collect();
+        alternate(&mut runs).into_iter().map(|s| rays.len() as f64 / s * 1e-6).collect::<Vec<_>>()
+    };
+    header("build ms");
     for pool in &pools {
-        let (build_ours, build_peer) = alternate(
-            &mut || timed(pool, &|| drop(AccelKind::Sah.build(&triangles, &BuildParams::default()))),
-            &mut || {
-                timed(pool, &|| {
-                    drop(build_bvh2_from_tris(
-                        &peer_triangles,
-                        BvhBuildParams::medium_build(),
-                        &mut Duration::default(),
-                    ))
-                })
-            },
-        );
-        let throughput = |rays: &[Ray]| {
-            let count = |trace: &(dyn Fn(&Ray) -> bool + Sync)| {
-                rays.par_chunks(1024).map(|c| c.iter().filter(|r| trace(r)).count()).sum::<usize>()
-            };
-            let (a, b) = alternate(
-                &mut || {
-                    timed(pool, &|| {
-                        std::hint::black_box(count(&our_trace));
-                    })
-                },
-                &mut || {
-                    timed(pool, &|| {
-                        std::hint::black_box(count(&peer_trace));
-                    })
-                },
-            );
-            (rays.len() as f64 / a * 1e-6, rays.len() as f64 / b * 1e-6)
-        };
-        let (primary_ours, primary_peer) = throughput(&primary);
-        let (incoherent_ours, incoherent_peer) = throughput(&incoherent);
-        println!(
-            "{:<10} {:>14.1} {:>14.1} {:>14.2} {:>14.2} {:>14.2} {:>14.2}",
-            pool.current_num_threads(),
-            build_ours * 1e3,
-            build_peer * 1e3,
-            primary_ours,
-            primary_peer,
-            incoherent_ours,
-            incoherent_peer
-        );
+        row(pool.current_num_threads(), &measure_builds(pool), 1);
     }
-    let hits_ours = primary.iter().filter(|r| our_trace(r)).count();
-    let hits_peer = primary.iter().filter(|r| peer_trace(r)).count();
-    println!("primary hits: rtgi {hits_ours}, obvhs {hits_peer} of {}", primary.len());
+    for (what, rays) in [("primary Mrays/s", &primary), ("incoherent Mrays/s", &incoherent)] {
+        header(what);
+        for pool in &pools {
+            row(pool.current_num_threads(), &measure_rays(pool, rays), 2);
+        }
+    }
+    println!();
+    print!("primary hits of {}:", primary.len());
+    for contender in &contenders {
+        print!(" {} {},", contender.name, primary.chunks(CHUNK).map(|c| (contender.trace)(c)).sum::<usize>());
+    }
+    println!();
 }

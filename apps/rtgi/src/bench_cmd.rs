@@ -3,7 +3,7 @@
 
 use std::time::Instant;
 
-use anyhow::Result;
+use anyhow::{Result, bail};
 use rayon::prelude::*;
 use rtgi_accel::{Accel, AccelKind, BuildParams, BuildStats, Intersector, Traversal, TraversalCounters};
 use rtgi_math::Ray;
@@ -56,6 +56,9 @@ struct ParamsReport {
 #[derive(Debug, Serialize)]
 struct VariantReport {
     variant: String,
+    /// A peer's backend (Embree): it reports no nodes or triangle tests,
+    /// and is not held to the exactness contract.
+    peer: bool,
     /// Median build time on one thread and on all threads.
     build_ms_1_thread: f64,
     build_ms_all_threads: f64,
@@ -88,6 +91,9 @@ pub(crate) fn run(args: &BenchArgs) -> Result<()> {
     let single = thread_pool(Some(1))?;
     let params = args.build.params();
     let repeats = args.repeats as usize;
+    if args.accuracy_accel.is_peer() {
+        bail!("--accuracy-accel {}: a peer's backend has no intersector or traversal to choose", args.accuracy_accel);
+    }
 
     // The camera rtgi render would use, over the default image aspect of the batch.
     let framing = AccelKind::Sah.build(&triangles, &params);
@@ -109,7 +115,7 @@ pub(crate) fn run(args: &BenchArgs) -> Result<()> {
     let mut linear: Option<(f64, f64)> = None;
     for &kind in &args.accel.0 {
         eprintln!("measuring {kind} ...");
-        let report = measure_variant(kind, &triangles, &params, &primary, &incoherent, args, &pool, &single, linear);
+        let report = measure_variant(kind, &triangles, &params, &primary, &incoherent, args, &pool, &single, linear)?;
         if kind == AccelKind::Linear {
             linear = Some((report.primary.mrays_all_threads, report.incoherent.mrays_all_threads));
         }
@@ -161,24 +167,24 @@ fn measure_variant(
     pool: &rayon::ThreadPool,
     single: &rayon::ThreadPool,
     linear: Option<(f64, f64)>,
-) -> VariantReport {
+) -> Result<VariantReport> {
     let repeats = args.repeats as usize;
-    let build_ms = |pool: &rayon::ThreadPool| {
+    let build_ms = |pool: &rayon::ThreadPool| -> Result<f64> {
         let mut times: Vec<f64> = (0..repeats)
             .map(|_| {
                 let start = Instant::now();
-                let accel = pool.install(|| kind.build(triangles, params));
+                let accel = pool.install(|| kind.try_build(triangles, params))?;
                 let ms = start.elapsed().as_secs_f64() * 1e3;
                 drop(accel);
-                ms
+                Ok(ms)
             })
-            .collect();
+            .collect::<Result<_>>()?;
         times.sort_by(f64::total_cmp);
-        times[times.len() / 2]
+        Ok(times[times.len() / 2])
     };
-    let build_ms_1_thread = build_ms(single);
-    let build_ms_all_threads = build_ms(pool);
-    let accel = pool.install(|| kind.build(triangles, params));
+    let build_ms_1_thread = build_ms(single)?;
+    let build_ms_all_threads = build_ms(pool)?;
+    let accel = pool.install(|| kind.try_build(triangles, params))?;
 
     // The linear scan is timed on an evenly spaced subset of each batch.
     let subset = |rays: &[Ray]| -> Vec<Ray> {
@@ -208,14 +214,15 @@ fn measure_variant(
     };
     let primary = batch(primary, linear.map(|l| l.0));
     let incoherent = batch(incoherent, linear.map(|l| l.1));
-    VariantReport {
+    Ok(VariantReport {
         variant: kind.name().to_owned(),
+        peer: kind.is_peer(),
         build_ms_1_thread,
         build_ms_all_threads,
         stats: accel.build_stats().clone(),
         primary,
         incoherent,
-    }
+    })
 }
 
 /// Traversal work and hits of a batch.
@@ -279,7 +286,11 @@ fn print_table(report: &BenchReport, linear_rays: u32) {
         let batch = |b: &BatchReport| {
             (
                 format!("{} / {}", significant(b.mrays_1_thread), significant(b.mrays_all_threads)),
-                format!("{:.1}, {:.1}", b.nodes_visited_per_ray, b.triangles_tested_per_ray),
+                if v.peer {
+                    "-".to_owned()
+                } else {
+                    format!("{:.1}, {:.1}", b.nodes_visited_per_ray, b.triangles_tested_per_ray)
+                },
                 speedup(b.speedup_vs_linear),
             )
         };
@@ -304,6 +315,12 @@ fn print_table(report: &BenchReport, linear_rays: u32) {
     }
     if report.variants.iter().any(|v| v.variant == "linear") {
         println!("linear: timed on an evenly spaced subset of at most {linear_rays} rays of each batch");
+    }
+    if report.variants.iter().any(|v| v.peer) {
+        println!(
+            "embree: Intel Embree 3, a peer (its own BVH, build quality medium; not held to the exactness contract); \
+             it reports no nodes or triangle tests, and its SAH cost, nodes and depth are not ours to measure"
+        );
     }
 }
 

@@ -2,7 +2,7 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 use clap::{Args, Parser, Subcommand};
-use rtgi_accel::{AccelKind, BuildParams, Intersector, Traversal};
+use rtgi_accel::{AccelKind, BuildError, BuildParams, Intersector, Traversal};
 use rtgi_image::ToneOperator;
 use rtgi_math::Vec3;
 use rtgi_render::{DirectStrategy, EffectOverrides, Integrator, PixelSampler};
@@ -380,9 +380,10 @@ pub(crate) struct BenchArgs {
 #[derive(Clone, Debug)]
 pub(crate) struct AccelList(pub(crate) Vec<AccelKind>);
 
+/// `all` is our structures and the peers built in (Embree with the `embree` feature).
 fn parse_accel_list(text: &str) -> Result<AccelList, String> {
     if text == "all" {
-        return Ok(AccelList(AccelKind::ALL.to_vec()));
+        return Ok(AccelList(AccelKind::ALL.iter().chain(AccelKind::PEERS).copied().collect()));
     }
     text.split(',')
         .map(|name| name.trim().parse::<AccelKind>().map_err(|e| e.to_string()))
@@ -497,7 +498,8 @@ impl ImageSize {
 /// The acceleration structure and its build parameters.
 #[derive(Debug, Args)]
 pub(crate) struct AccelArgs {
-    /// Acceleration structure: linear, object-median, spatial-median, sah, sah-sweep
+    /// Acceleration structure: linear, object-median, spatial-median, sah, sah-sweep, or embree
+    /// (Intel Embree 3, in builds with the embree feature)
     #[arg(long, default_value = "sah")]
     pub(crate) accel: AccelKind,
 
@@ -543,8 +545,8 @@ impl BuildArgs {
 
 impl AccelArgs {
     /// Builds the chosen structure over the scene's triangles.
-    pub(crate) fn build(&self, scene: &rtgi_scene::Scene) -> Box<dyn rtgi_accel::Accel> {
-        self.accel.build(&scene.triangle_positions(), &self.build.params())
+    pub(crate) fn build(&self, scene: &rtgi_scene::Scene) -> Result<Box<dyn rtgi_accel::Accel>, BuildError> {
+        self.accel.try_build(&scene.triangle_positions(), &self.build.params())
     }
 }
 

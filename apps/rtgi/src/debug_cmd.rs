@@ -61,9 +61,15 @@ pub(crate) fn heatmap(args: &HeatmapArgs) -> Result<()> {
     if args.scale.is_some_and(|s| !(s > 0.0 && s.is_finite())) {
         bail!("--scale must be a positive number");
     }
+    if args.accel.accel.is_peer() {
+        bail!(
+            "--accel {}: a peer's backend does not report the nodes it visits or the triangles it tests",
+            args.accel.accel
+        );
+    }
     let LoadedScene { scene, name, .. } = load_scene(args.scene.as_deref())?;
     let pool = thread_pool(args.threads)?;
-    let accel = pool.install(|| args.accel.build(&scene));
+    let accel = pool.install(|| args.accel.build(&scene))?;
     let camera = choose_camera(&scene, accel.as_ref(), &args.camera, args.size.aspect())?;
     let (counts, total) =
         pool.install(|| render_traversal_cost(accel.as_ref(), &camera, args.size.width, args.size.height, &|_| {}));

@@ -57,7 +57,7 @@ pub(crate) fn run(args: &BenchEffectsArgs) -> Result<()> {
     print!("{plan}");
 
     let pool = thread_pool(args.threads)?;
-    let accel = pool.install(|| args.accel.build(&scene));
+    let accel = pool.install(|| args.accel.build(&scene))?;
     let camera = choose_camera(&scene, accel.as_ref(), &args.camera, args.size.aspect())?;
     let measure = |settings: &RenderSettings| -> (f64, HdrImage) {
         let mut times = Vec::new();

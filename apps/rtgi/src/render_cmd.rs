@@ -37,7 +37,7 @@ pub(crate) fn run(args: &RenderArgs) -> Result<()> {
 
     let pool = thread_pool(args.threads)?;
 
-    let accel = pool.install(|| args.accel.build(&scene));
+    let accel = pool.install(|| args.accel.build(&scene))?;
     let camera = choose_camera(&scene, accel.as_ref(), &args.camera, args.size.aspect())?;
     let (image, stats) = pool.install(|| {
         let bar = progress_bar(args.size.width as u64 * args.size.height as u64);

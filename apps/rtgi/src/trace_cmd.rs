@@ -22,7 +22,7 @@ pub(crate) fn run(args: &TraceArgs) -> Result<()> {
 
     let pool = thread_pool(args.threads)?;
     let build_start = Instant::now();
-    let accel = pool.install(|| args.accel.build(&scene));
+    let accel = pool.install(|| args.accel.build(&scene))?;
     let build_ms = build_start.elapsed().as_secs_f64() * 1e3;
 
     let trace_start = Instant::now();

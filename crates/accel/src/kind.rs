@@ -19,6 +19,10 @@ pub enum AccelKind {
     Bvh4,
     /// Binned SAH BVH collapsed to eight children a node, traversed with SIMD.
     Bvh8,
+    /// Intel Embree 3 ([`crate::EmbreeBackend`], feature `embree`): a peer
+    /// to compare against, not held to the exactness contract.
+    #[cfg(feature = "embree")]
+    Embree,
 }
 
 /// Parameters of a build; structures ignore those that do not apply to them.
@@ -60,23 +64,43 @@ impl AccelKind {
         AccelKind::Bvh8,
     ];
 
+    /// Backends written by others, measured beside ours but not held to
+    /// the exactness contract: they differ from the linear scan at ties and
+    /// on grazing rays. Not in [`AccelKind::ALL`] nor in
+    /// [`AccelKind::all_configurations`]; empty without the `embree` feature.
+    #[cfg(feature = "embree")]
+    pub const PEERS: &'static [AccelKind] = &[AccelKind::Embree];
+    /// Backends written by others, measured beside ours but not held to
+    /// the exactness contract; empty without the `embree` feature.
+    #[cfg(not(feature = "embree"))]
+    pub const PEERS: &'static [AccelKind] = &[];
+
+    /// Whether this is a peer's backend ([`AccelKind::PEERS`]).
+    pub fn is_peer(self) -> bool {
+        Self::PEERS.contains(&self)
+    }
+
     /// The name used on command lines and in tables.
     pub fn name(self) -> &'static str {
         match self {
             AccelKind::Linear => "linear",
             AccelKind::Bvh4 => "bvh4",
             AccelKind::Bvh8 => "bvh8",
+            #[cfg(feature = "embree")]
+            AccelKind::Embree => "embree",
             _ => self.split_method().map_or("linear", SplitMethod::name),
         }
     }
 
     /// Children a node of this variant's tree has: 2 for the binary BVHs,
-    /// 4 or 8 for the wide ones, `None` for the linear scan.
+    /// 4 or 8 for the wide ones, `None` for the linear scan and peers.
     pub fn node_width(self) -> Option<usize> {
         match self {
             AccelKind::Linear => None,
             AccelKind::Bvh4 => Some(4),
             AccelKind::Bvh8 => Some(8),
+            #[cfg(feature = "embree")]
+            AccelKind::Embree => None,
             _ => Some(2),
         }
     }
@@ -90,21 +114,86 @@ impl AccelKind {
             AccelKind::Sah => Some(SplitMethod::BinnedSah),
             AccelKind::SahSweep => Some(SplitMethod::SweepSah),
             AccelKind::Bvh4 | AccelKind::Bvh8 => Some(SplitMethod::BinnedSah),
+            #[cfg(feature = "embree")]
+            AccelKind::Embree => None,
         }
     }
 
     /// Builds this structure over `triangles`; hits name triangles by their index here.
+    ///
+    /// # Panics
+    /// If a peer's build fails (Embree out of memory); [`AccelKind::try_build`]
+    /// returns that error instead. Our structures' builds cannot fail.
     pub fn build(self, triangles: &[[Vec3; 3]], params: &BuildParams) -> Box<dyn Accel> {
-        match (self, self.split_method()) {
+        self.try_build(triangles, params).unwrap_or_else(|error| panic!("{error}"))
+    }
+
+    /// [`AccelKind::build`], with the error of a peer's failed build.
+    ///
+    /// # Errors
+    /// If Embree cannot create its device or build its scene.
+    pub fn try_build(self, triangles: &[[Vec3; 3]], params: &BuildParams) -> Result<Box<dyn Accel>, BuildError> {
+        #[cfg(feature = "embree")]
+        if self == AccelKind::Embree {
+            return match crate::EmbreeBackend::new(triangles) {
+                Ok(backend) => Ok(Box::new(backend)),
+                Err(error) => Err(BuildError { variant: self.name(), reason: error.to_string() }),
+            };
+        }
+        Ok(match (self, self.split_method()) {
             (AccelKind::Bvh4, Some(method)) => Box::new(Bvh4::new(triangles, method, params)),
             (AccelKind::Bvh8, Some(method)) => Box::new(Bvh8::new(triangles, method, params)),
             (_, Some(method)) => Box::new(Bvh::new(triangles, method, params)),
             (_, None) => Box::new(LinearScan::new(triangles, params.intersector)),
-        }
+        })
     }
 }
 
-rtgi_math::named_choices!(AccelKind, "acceleration structure");
+/// Why a structure could not be built; only peers' builds can fail.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct BuildError {
+    /// The variant's name.
+    pub variant: &'static str,
+    /// What went wrong.
+    pub reason: String,
+}
+
+impl std::fmt::Display for BuildError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "cannot build {}: {}", self.variant, self.reason)
+    }
+}
+
+impl std::error::Error for BuildError {}
+
+/// What naming `embree` says in a build without the feature.
+const EMBREE_NOT_BUILT: &str = "the embree backend is not built in: install Embree 3 (apt install libembree-dev) \
+     and build with the embree feature (cargo build --release --features embree)";
+
+impl std::fmt::Display for AccelKind {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+/// Parses the names of [`AccelKind::ALL`] and [`AccelKind::PEERS`] (as
+/// `rtgi_math::named_choices!` does, with the peers); `embree` in a build
+/// without the feature is an error that says how to get it.
+impl std::str::FromStr for AccelKind {
+    type Err = String;
+
+    fn from_str(text: &str) -> Result<Self, Self::Err> {
+        let choices = || Self::ALL.iter().chain(Self::PEERS).copied();
+        if let Some(kind) = choices().find(|kind| kind.name() == text) {
+            return Ok(kind);
+        }
+        if text == "embree" {
+            return Err(EMBREE_NOT_BUILT.to_owned());
+        }
+        let names: Vec<&str> = choices().map(AccelKind::name).collect();
+        Err(format!("unknown acceleration structure '{text}' (expected one of: {})", names.join(", ")))
+    }
+}
 
 impl AccelKind {
     /// Every variant with a spread of build parameters (leaf sizes 1, 2, 4,

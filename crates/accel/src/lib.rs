@@ -47,11 +47,23 @@
 //! scene, and `rtgi verify` runs it from the command line; the fast
 //! traversal ([`Traversal::Fast`]) drops boxes that rays graze and is
 //! outside the contract.
+//!
+//! # Peers
+//!
+//! With the `embree` feature (and the system's Embree 3,
+//! `apt install libembree-dev`), `EmbreeBackend` puts Intel Embree behind
+//! [`Accel`] as `AccelKind::Embree`, to compare against. It is a peer
+//! ([`AccelKind::PEERS`]), outside the contract: it breaks ties in its own
+//! order and rounds differently on grazing rays, so it is not in
+//! [`AccelKind::ALL`]. Its module is the one place of the workspace where
+//! `unsafe` code is allowed.
 
 mod boxa;
 mod bvh;
 mod contract;
 mod counters;
+#[cfg(feature = "embree")]
+mod embree;
 mod kind;
 mod linear;
 pub mod simd;
@@ -63,7 +75,9 @@ mod wide;
 pub use bvh::{Bvh, BvhNode, SplitMethod, Traversal};
 pub use contract::is_hittable;
 pub use counters::{Counter, NoCounter, TraversalCounters};
-pub use kind::{AccelKind, BuildParams};
+#[cfg(feature = "embree")]
+pub use embree::{EmbreeBackend, EmbreeError};
+pub use kind::{AccelKind, BuildError, BuildParams};
 pub use linear::LinearScan;
 pub use triangle::{Intersector, TriangleHit};
 pub use wide::{Bvh4, Bvh8, WideBvh};
