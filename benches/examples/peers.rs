@@ -1,4 +1,6 @@
-//! Our SAH BVH against peers on the same rays, in one run:
+//! Our binary SAH BVH and our wide BVHs (one ray at a time, and through
+//! the batch API, which traces coherent rays as packets of 16) against
+//! peers on the same rays, in one run:
 //! `cargo run --release -p rtgi-benches --example peers [-- SCENE.obj]`.
 //! The peers are obvhs' BVH2 and, built with `--features embree`, Intel
 //! Embree 3 through `rtcIntersect1` (one ray at a time, [`Accel::intersect`])
@@ -16,9 +18,7 @@ use std::time::{Duration, Instant};
 use obvhs::BvhBuildParams;
 use obvhs::bvh2::builder::build_bvh2_from_tris;
 use rayon::prelude::*;
-#[cfg(feature = "embree")]
-use rtgi_accel::Hit;
-use rtgi_accel::{Accel, AccelKind, BuildParams};
+use rtgi_accel::{Accel, AccelKind, BuildParams, Hit};
 use rtgi_benches::workspace_root;
 use rtgi_math::Ray;
 use rtgi_math::glam::Vec3A;
@@ -73,7 +73,8 @@ fn main() {
     println!("{}: {} triangles; medians of {RUNS} alternating runs", path.display(), triangles.len());
 
     let params = BuildParams::default();
-    let ours = AccelKind::Sah.build(&triangles, &params);
+    let ours: Vec<(AccelKind, Box<dyn Accel>)> =
+        [AccelKind::Sah, AccelKind::Bvh4, AccelKind::Bvh8].map(|kind| (kind, kind.build(&triangles, &params))).into();
     let peer_triangles: Vec<obvhs::triangle::Triangle> = triangles
         .iter()
         .map(|t| obvhs::triangle::Triangle { v0: Vec3A::from(t[0]), v1: Vec3A::from(t[1]), v2: Vec3A::from(t[2]) })
@@ -88,26 +89,46 @@ fn main() {
     #[cfg(feature = "embree")]
     let embree = AccelKind::Embree.try_build(&triangles, &params).unwrap_or_else(|e| panic!("{e}"));
     #[cfg_attr(not(feature = "embree"), allow(unused_mut))]
-    let mut contenders = vec![
-        Contender {
-            name: "rtgi sah",
-            build: Box::new(|| drop(AccelKind::Sah.build(&triangles, &params))),
-            trace: Box::new(|rays| one_at_a_time(ours.as_ref(), rays)),
-        },
-        Contender {
-            name: "obvhs bvh2",
-            build: Box::new(|| drop(build_obvhs())),
-            trace: Box::new(|rays| {
-                rays.iter()
-                    .filter(|ray| {
-                        let ray = obvhs::ray::Ray::new(ray.origin.into(), ray.direction.into(), ray.t_min, ray.t_max);
-                        let mut hit = obvhs::ray::RayHit::none();
-                        obvhs.ray_traverse(ray, &mut hit, |r, id| obvhs_leaf_order[id].intersect(r))
-                    })
-                    .count()
-            }),
-        },
-    ];
+    let batched = |accel: &dyn Accel, rays: &[Ray]| {
+        let mut hits: Vec<Option<Hit>> = vec![None; rays.len()];
+        accel.intersect_batch(rays, &mut hits);
+        hits.iter().filter(|h| h.is_some()).count()
+    };
+    let mut contenders = Vec::new();
+    let (triangles_ref, params_ref) = (&triangles, &params);
+    for (kind, accel) in &ours {
+        let (kind, accel) = (*kind, accel.as_ref());
+        let names: [&'static str; 2] = match kind {
+            AccelKind::Bvh4 => ["rtgi bvh4", "rtgi bvh4 16"],
+            AccelKind::Bvh8 => ["rtgi bvh8", "rtgi bvh8 16"],
+            _ => ["rtgi sah", ""],
+        };
+        contenders.push(Contender {
+            name: names[0],
+            build: Box::new(move || drop(kind.build(triangles_ref, params_ref))),
+            trace: Box::new(move |rays| one_at_a_time(accel, rays)),
+        });
+        if !names[1].is_empty() {
+            contenders.push(Contender {
+                name: names[1],
+                build: Box::new(move || drop(kind.build(triangles_ref, params_ref))),
+                trace: Box::new(move |rays| batched(accel, rays)),
+            });
+        }
+    }
+    contenders.extend([Contender {
+        name: "obvhs bvh2",
+        build: Box::new(|| drop(build_obvhs())),
+        trace: Box::new(|rays| {
+            rays.iter()
+                .filter(|ray| {
+                    let ray = obvhs::ray::Ray::new(ray.origin.into(), ray.direction.into(), ray.t_min, ray.t_max);
+                    let mut hit = obvhs::ray::RayHit::none();
+                    obvhs.ray_traverse(ray, &mut hit, |r, id| obvhs_leaf_order[id].intersect(r))
+                })
+                .count()
+        }),
+    }]);
     #[cfg(feature = "embree")]
     {
         let build_embree = || drop(AccelKind::Embree.try_build(&triangles, &params).unwrap_or_else(|e| panic!("{e}")));
@@ -119,18 +140,13 @@ fn main() {
         contenders.push(Contender {
             name: "embree 16",
             build: Box::new(build_embree),
-            trace: Box::new(|rays| {
-                let mut hits: Vec<Option<Hit>> = vec![None; rays.len()];
-                embree.intersect_batch(rays, &mut hits);
-                hits.iter().filter(|h| h.is_some()).count()
-            }),
+            trace: Box::new(|rays| batched(embree.as_ref(), rays)),
         });
     }
     let names: Vec<&str> = contenders.iter().map(|c| c.name).collect();
+    println!("'16': the batch API (Accel::intersect_batch) on consecutive rays, 4×4 tiles of the primary rays");
     if names.iter().any(|n| n.starts_with("embree")) {
-        println!(
-            "embree 1: rtcIntersect1 (Accel::intersect); embree 16: rtcIntersect16 packets (Accel::intersect_batch)"
-        );
+        println!("embree 1: rtcIntersect1 (Accel::intersect); embree 16: rtcIntersect16 packets");
     }
 
     let timed = |pool: &rayon::ThreadPool, work: &(dyn Fn() + Sync)| {

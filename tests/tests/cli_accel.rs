@@ -148,7 +148,7 @@ fn bench_measures_every_variant_and_writes_json() {
 fn bvh_boxes_are_written_as_obj_groups() {
     let dir = scratch_dir("boxes");
     let out = dir.join("boxes.obj");
-    let run = rtgi(&["bvh-boxes", "-o", s(&out), "--levels", "0,1"]);
+    let run = rtgi(&["bvh-boxes", "-o", s(&out), "--levels", "0,1", "--accel", "sah"]);
     assert!(run.success, "{run:?}");
     let obj = std::fs::read_to_string(&out).unwrap();
     assert!(obj.contains("g level_0") && obj.contains("g level_1"));
@@ -158,6 +158,14 @@ fn bvh_boxes_are_written_as_obj_groups() {
     // The file is a valid OBJ that the scene loader reads back: 12 triangles a box.
     let boxes = Scene::load(&out).unwrap();
     assert_eq!(boxes.triangles.len(), 36);
+    // A wide BVH: one root box and, below it, up to eight children.
+    let wide = dir.join("wide.obj");
+    let run = rtgi(&["bvh-boxes", "-o", s(&wide), "--levels", "0,1", "--accel", "bvh8"]);
+    assert!(run.success, "{run:?}");
+    let obj = std::fs::read_to_string(&wide).unwrap();
+    let level_1 = obj.split("g level_1").nth(1).expect("a level-1 group");
+    let children = level_1.lines().filter(|l| l.starts_with("v ")).count() / 8;
+    assert!((2..=8).contains(&children), "{children} children");
     let linear = rtgi(&["bvh-boxes", "-o", s(&dir.join("l.obj")), "--accel", "linear"]);
     assert!(!linear.success && linear.stderr.contains("linear"), "{linear:?}");
 }
@@ -201,19 +209,27 @@ fn verify_checks_the_built_in_adversarial_scenes_and_writes_json() {
     let json = dir.join("verify.json");
     let run = rtgi(&["verify", "--rays", "20000", "--json", s(&json)]);
     assert!(run.success, "{}", run.stderr);
-    for kind in ["random", "vertex", "edge", "axis-parallel", "secondary", "silhouette", "inside", "through-edge"] {
+    for kind in
+        ["random", "vertex", "edge", "axis-parallel", "secondary", "silhouette", "camera", "inside", "through-edge"]
+    {
         assert!(run.stdout.lines().any(|l| l.starts_with(kind)), "no row for {kind}:\n{}", run.stdout);
     }
-    for structure in ["linear", "object-median", "spatial-median", "sah", "sah-sweep"] {
+    for structure in ["linear", "object-median", "spatial-median", "sah", "sah-sweep", "bvh4", "bvh8"] {
         assert!(run.stdout.lines().any(|l| l.starts_with(structure)), "no row for {structure}:\n{}", run.stdout);
     }
     let report: serde_json::Value = serde_json::from_slice(&std::fs::read(&json).unwrap()).unwrap();
     let structures = report["structures"].as_array().unwrap();
-    // Ours and the peers built in (Embree, with the embree feature), whose
-    // differences are reported but are not failures.
-    assert_eq!(structures.len(), 5 + rtgi_accel::AccelKind::PEERS.len());
+    // Ours (the wide BVHs twice: one ray at a time and in batches) and the
+    // peers built in (Embree, with the embree feature), whose differences
+    // are reported but are not failures.
+    assert_eq!(structures.len(), 9 + rtgi_accel::AccelKind::PEERS.len());
+    assert!(
+        structures
+            .iter()
+            .any(|s| s["structure"].as_str().is_some_and(|n| n.starts_with("bvh8") && n.ends_with("batch")))
+    );
     let mut ours = structures.iter().filter(|s| s["peer"] == false);
-    assert_eq!(ours.clone().count(), 5);
+    assert_eq!(ours.clone().count(), 9);
     assert!(ours.all(|s| s["tally"]["closest_disagreements"] == 0 && s["tally"]["leaks"] == 0));
 }
 

@@ -25,7 +25,6 @@ struct BenchReport {
     primary_rays: usize,
     incoherent_rays: usize,
     incoherent_seed: u64,
-    params: ParamsReport,
     variants: Vec<VariantReport>,
     /// Every intersector and traversal on one structure: speed beside failure rates.
     accuracy: Vec<AccuracyReport>,
@@ -56,6 +55,8 @@ struct ParamsReport {
 #[derive(Debug, Serialize)]
 struct VariantReport {
     variant: String,
+    /// The build parameters: the variant's defaults with the options given.
+    params: ParamsReport,
     /// A peer's backend (Embree): it reports no nodes or triangle tests,
     /// and is not held to the exactness contract.
     peer: bool,
@@ -75,6 +76,11 @@ struct BatchReport {
     mrays_1_thread: f64,
     mrays_all_threads: f64,
     hit_fraction: f64,
+    /// Throughput through the batch API (`Accel::intersect_batch`, chunks
+    /// of 1024 consecutive rays), which traces coherent rays as packets
+    /// where the structure can; one ray at a time otherwise.
+    batch_mrays_1_thread: f64,
+    batch_mrays_all_threads: f64,
     nodes_visited_per_ray: f64,
     triangles_tested_per_ray: f64,
     /// Time per ray of the linear scan over time per ray of this variant, all threads.
@@ -89,14 +95,13 @@ pub(crate) fn run(args: &BenchArgs) -> Result<()> {
     let triangles = scene.triangle_positions();
     let pool = thread_pool(args.threads)?;
     let single = thread_pool(Some(1))?;
-    let params = args.build.params();
     let repeats = args.repeats as usize;
     if args.accuracy_accel.is_peer() {
         bail!("--accuracy-accel {}: a peer's backend has no intersector or traversal to choose", args.accuracy_accel);
     }
 
     // The camera rtgi render would use, over the default image aspect of the batch.
-    let framing = AccelKind::Sah.build(&triangles, &params);
+    let framing = AccelKind::Bvh8.build(&triangles, &AccelKind::Bvh8.default_params());
     let camera = choose_camera(&scene, framing.as_ref(), &Default::default(), args.width as f32 / args.height as f32)?;
     drop(framing);
     let primary = primary_rays(&camera, args.width, args.height);
@@ -115,6 +120,7 @@ pub(crate) fn run(args: &BenchArgs) -> Result<()> {
     let mut linear: Option<(f64, f64)> = None;
     for &kind in &args.accel.0 {
         eprintln!("measuring {kind} ...");
+        let params = args.build.params_for(kind);
         let report = measure_variant(kind, &triangles, &params, &primary, &incoherent, args, &pool, &single, linear)?;
         if kind == AccelKind::Linear {
             linear = Some((report.primary.mrays_all_threads, report.incoherent.mrays_all_threads));
@@ -129,7 +135,8 @@ pub(crate) fn run(args: &BenchArgs) -> Result<()> {
         }
     }
 
-    let accuracy = measure_accuracy(args, &triangles, &params, &primary, &incoherent, &pool);
+    let accuracy =
+        measure_accuracy(args, &triangles, &args.build.params_for(args.accuracy_accel), &primary, &incoherent, &pool);
 
     let report = BenchReport {
         scene: name,
@@ -139,11 +146,6 @@ pub(crate) fn run(args: &BenchArgs) -> Result<()> {
         primary_rays: primary.len(),
         incoherent_rays: incoherent.len(),
         incoherent_seed: args.seed,
-        params: ParamsReport {
-            max_leaf_size: params.max_leaf_size,
-            sah_bins: params.sah_bins,
-            traversal_cost: params.traversal_cost,
-        },
         variants,
         accuracy,
     };
@@ -200,6 +202,13 @@ fn measure_variant(
         let trace = |r: &Ray| accel.intersect(r).is_some();
         let mrays_1_thread = throughput(&rays, single, timed_repeats, trace);
         let mrays_all_threads = throughput(&rays, pool, timed_repeats, trace);
+        let batch_trace = |chunk: &[Ray]| {
+            let mut hits = vec![None; chunk.len()];
+            accel.intersect_batch(chunk, &mut hits);
+            hits.iter().filter(|h| h.is_some()).count()
+        };
+        let batch_mrays_1_thread = batch_throughput(&rays, single, timed_repeats, &batch_trace);
+        let batch_mrays_all_threads = batch_throughput(&rays, pool, timed_repeats, &batch_trace);
         let (counters, hits) = count(accel.as_ref(), &rays, pool);
         let per_ray = |n: u64| n as f64 / rays.len().max(1) as f64;
         BatchReport {
@@ -207,6 +216,8 @@ fn measure_variant(
             mrays_1_thread,
             mrays_all_threads,
             hit_fraction: hits as f64 / rays.len().max(1) as f64,
+            batch_mrays_1_thread,
+            batch_mrays_all_threads,
             nodes_visited_per_ray: per_ray(counters.nodes_visited),
             triangles_tested_per_ray: per_ray(counters.triangles_tested),
             speedup_vs_linear: linear_mrays.map(|l| mrays_all_threads / l),
@@ -216,6 +227,11 @@ fn measure_variant(
     let incoherent = batch(incoherent, linear.map(|l| l.1));
     Ok(VariantReport {
         variant: kind.name().to_owned(),
+        params: ParamsReport {
+            max_leaf_size: params.max_leaf_size,
+            sah_bins: params.sah_bins,
+            traversal_cost: params.traversal_cost,
+        },
         peer: kind.is_peer(),
         build_ms_1_thread,
         build_ms_all_threads,
@@ -223,6 +239,26 @@ fn measure_variant(
         primary,
         incoherent,
     })
+}
+
+/// Million rays a second through `trace`, which answers a chunk of rays
+/// and returns its hits: the median of `repeats` runs after a warm-up.
+fn batch_throughput(
+    rays: &[Ray],
+    pool: &rayon::ThreadPool,
+    repeats: usize,
+    trace: &(dyn Fn(&[Ray]) -> usize + Sync),
+) -> f64 {
+    let run = || {
+        let start = Instant::now();
+        let hits: usize = pool.install(|| rays.par_chunks(1024).map(trace).sum());
+        std::hint::black_box(hits);
+        start.elapsed().as_secs_f64()
+    };
+    run();
+    let mut seconds: Vec<f64> = (0..repeats.max(1)).map(|_| run()).collect();
+    seconds.sort_by(f64::total_cmp);
+    rays.len() as f64 / seconds[seconds.len() / 2].max(1e-12) * 1e-6
 }
 
 /// Traversal work and hits of a batch.
@@ -250,7 +286,7 @@ fn print_table(report: &BenchReport, linear_rays: u32) {
         report.scene, report.triangles, report.threads, report.primary_rays, report.incoherent_rays, report.repeats
     );
     println!(
-        "{:<15} {:>8} {:>8} {:>7} {:>8} {:>5} {:>8} | {:>15} {:>13} {:>11} | {:>15} {:>13} {:>11}",
+        "{:<15} {:>8} {:>8} {:>7} {:>8} {:>5} {:>8} | {:>15} {:>15} {:>13} {:>11} | {:>15} {:>13} {:>11}",
         "",
         "build ms",
         "build ms",
@@ -259,6 +295,7 @@ fn print_table(report: &BenchReport, linear_rays: u32) {
         "depth",
         "memory",
         "primary Mrays/s",
+        "batch Mrays/s",
         "nodes, tris",
         "x linear",
         "incoh. Mrays/s",
@@ -266,7 +303,7 @@ fn print_table(report: &BenchReport, linear_rays: u32) {
         "x linear"
     );
     println!(
-        "{:<15} {:>8} {:>8} {:>7} {:>8} {:>5} {:>8} | {:>15} {:>13} {:>11} | {:>15} {:>13} {:>11}",
+        "{:<15} {:>8} {:>8} {:>7} {:>8} {:>5} {:>8} | {:>15} {:>15} {:>13} {:>11} | {:>15} {:>13} {:>11}",
         "variant",
         "1 thr",
         format!("{} thr", report.threads),
@@ -274,6 +311,7 @@ fn print_table(report: &BenchReport, linear_rays: u32) {
         "",
         "",
         "MiB",
+        format!("1 / {} thr", report.threads),
         format!("1 / {} thr", report.threads),
         "per ray",
         "(all thr)",
@@ -295,9 +333,14 @@ fn print_table(report: &BenchReport, linear_rays: u32) {
             )
         };
         let (p, pn, ps) = batch(&v.primary);
+        let pb = format!(
+            "{} / {}",
+            significant(v.primary.batch_mrays_1_thread),
+            significant(v.primary.batch_mrays_all_threads)
+        );
         let (i, inn, is) = batch(&v.incoherent);
         println!(
-            "{:<15} {:>8.1} {:>8.1} {:>7.1} {:>8} {:>5} {:>8.2} | {:>15} {:>13} {:>11} | {:>15} {:>13} {:>11}",
+            "{:<15} {:>8.1} {:>8.1} {:>7.1} {:>8} {:>5} {:>8.2} | {:>15} {:>15} {:>13} {:>11} | {:>15} {:>13} {:>11}",
             v.variant,
             v.build_ms_1_thread,
             v.build_ms_all_threads,
@@ -306,6 +349,7 @@ fn print_table(report: &BenchReport, linear_rays: u32) {
             v.stats.depth,
             v.stats.memory_bytes as f64 / (1024.0 * 1024.0),
             p,
+            pb,
             pn,
             ps,
             i,
@@ -313,6 +357,10 @@ fn print_table(report: &BenchReport, linear_rays: u32) {
             is
         );
     }
+    println!(
+        "batch: the batch API on chunks of 1024 consecutive rays (primary rays come in 4x4 pixel tiles); \
+         the wide BVHs trace coherent rays as packets of 16, the others one ray at a time"
+    );
     if report.variants.iter().any(|v| v.variant == "linear") {
         println!("linear: timed on an evenly spaced subset of at most {linear_rays} rays of each batch");
     }

@@ -498,9 +498,9 @@ impl ImageSize {
 /// The acceleration structure and its build parameters.
 #[derive(Debug, Args)]
 pub(crate) struct AccelArgs {
-    /// Acceleration structure: linear, object-median, spatial-median, sah, sah-sweep, or embree
-    /// (Intel Embree 3, in builds with the embree feature)
-    #[arg(long, default_value = "sah")]
+    /// Acceleration structure: linear, object-median, spatial-median, sah, sah-sweep, bvh4, bvh8,
+    /// or embree (Intel Embree 3, in builds with the embree feature)
+    #[arg(long, default_value = "bvh8")]
     pub(crate) accel: AccelKind,
 
     #[command(flatten)]
@@ -510,17 +510,17 @@ pub(crate) struct AccelArgs {
 /// Build parameters of the BVH variants.
 #[derive(Debug, Args)]
 pub(crate) struct BuildArgs {
-    /// Most triangles in a BVH leaf
-    #[arg(long, default_value_t = BuildParams::default().max_leaf_size as u32, value_parser = clap::value_parser!(u32).range(1..=255))]
-    pub(crate) leaf_size: u32,
+    /// Most triangles in a BVH leaf [default: 4; 8 for the wide BVHs]
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=255))]
+    pub(crate) leaf_size: Option<u32>,
 
     /// Bins per axis of the binned SAH build
     #[arg(long, default_value_t = BuildParams::default().sah_bins as u32, value_parser = clap::value_parser!(u32).range(2..=256))]
     pub(crate) sah_bins: u32,
 
-    /// Cost of a BVH traversal step relative to a ray/triangle test, for the SAH
-    #[arg(long, default_value_t = BuildParams::default().traversal_cost)]
-    pub(crate) traversal_cost: f32,
+    /// Cost of a BVH traversal step relative to a ray/triangle test, for the SAH [default: 1; 4 for the wide BVHs]
+    #[arg(long)]
+    pub(crate) traversal_cost: Option<f32>,
 
     /// Ray/triangle test: watertight, moller-trumbore
     #[arg(long, default_value_t = Intersector::default())]
@@ -532,11 +532,15 @@ pub(crate) struct BuildArgs {
 }
 
 impl BuildArgs {
-    pub(crate) fn params(&self) -> BuildParams {
+    /// The parameters for `kind`: its own defaults
+    /// ([`AccelKind::default_params`]), with the options given on the
+    /// command line in their place.
+    pub(crate) fn params_for(&self, kind: AccelKind) -> BuildParams {
+        let defaults = kind.default_params();
         BuildParams {
-            max_leaf_size: self.leaf_size as usize,
+            max_leaf_size: self.leaf_size.map_or(defaults.max_leaf_size, |size| size as usize),
             sah_bins: self.sah_bins as usize,
-            traversal_cost: self.traversal_cost,
+            traversal_cost: self.traversal_cost.unwrap_or(defaults.traversal_cost),
             intersector: self.intersector,
             traversal: self.traversal,
         }
@@ -546,7 +550,7 @@ impl BuildArgs {
 impl AccelArgs {
     /// Builds the chosen structure over the scene's triangles.
     pub(crate) fn build(&self, scene: &rtgi_scene::Scene) -> Result<Box<dyn rtgi_accel::Accel>, BuildError> {
-        self.accel.try_build(&scene.triangle_positions(), &self.build.params())
+        self.accel.try_build(&scene.triangle_positions(), &self.build.params_for(self.accel))
     }
 }
 

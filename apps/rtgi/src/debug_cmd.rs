@@ -3,7 +3,7 @@
 use std::fmt::Write as _;
 
 use anyhow::{Result, bail};
-use rtgi_accel::{Accel, Bvh};
+use rtgi_accel::{Accel, Bvh, Bvh4, Bvh8};
 use rtgi_image::{HdrImage, OutputFormat, ToneMap, check_writable, heat_colour};
 use rtgi_render::render_traversal_cost;
 
@@ -18,22 +18,30 @@ pub(crate) fn boxes(args: &BvhBoxesArgs) -> Result<()> {
     let Some(method) = args.accel.accel.split_method() else {
         bail!("--accel {}: only BVH variants have boxes to export", args.accel.accel);
     };
-    if args.accel.accel.node_width() != Some(2) {
-        bail!(
-            "--accel {}: boxes are exported for binary BVHs; the wide ones are collapsed from --accel {}",
-            args.accel.accel,
-            method.name()
-        );
-    }
     let LoadedScene { scene, .. } = load_scene(args.scene.as_deref())?;
-    let bvh = Bvh::new(&scene.triangle_positions(), method, &args.accel.build.params());
-    let boxes = bvh.boxes_at_depths(&args.levels);
+    let kind = args.accel.accel;
+    let (triangles, params) = (scene.triangle_positions(), args.accel.build.params_for(kind));
+    let (boxes, stats) = match kind.node_width() {
+        Some(4) => {
+            let bvh = Bvh4::new(&triangles, method, &params);
+            (bvh.boxes_at_depths(&args.levels), bvh.build_stats().clone())
+        }
+        Some(8) => {
+            let bvh = Bvh8::new(&triangles, method, &params);
+            (bvh.boxes_at_depths(&args.levels), bvh.build_stats().clone())
+        }
+        _ => {
+            let bvh = Bvh::new(&triangles, method, &params);
+            (bvh.boxes_at_depths(&args.levels), bvh.build_stats().clone())
+        }
+    };
     let mut obj = format!(
-        "# BVH boxes of levels {:?}, {} build ({} nodes, depth {}), written by rtgi\n",
+        "# BVH boxes of levels {:?}, {} ({} build, {} nodes, depth {}), written by rtgi\n",
         args.levels,
+        kind,
         method.name(),
-        bvh.build_stats().nodes,
-        bvh.build_stats().depth
+        stats.nodes,
+        stats.depth
     );
     let mut current_level = None;
     for (index, (level, aabb)) in boxes.iter().enumerate() {

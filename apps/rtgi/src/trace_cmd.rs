@@ -26,18 +26,27 @@ pub(crate) fn run(args: &TraceArgs) -> Result<()> {
     let build_ms = build_start.elapsed().as_secs_f64() * 1e3;
 
     let trace_start = Instant::now();
+    // Through the batch queries, in chunks of consecutive rays: the wide
+    // BVHs trace coherent runs of the file (camera rays in tiles) as packets.
     let hits: Vec<[u8; HIT_BYTES]> = pool.install(|| {
-        rays.par_iter()
-            .map(|ray| {
-                if args.any_hit {
-                    let triangle = if accel.occluded(ray) { 0 } else { MISS };
-                    encode_hit(0.0, triangle, 0.0, 0.0)
+        rays.par_chunks(1024)
+            .flat_map_iter(|chunk| {
+                let encoded: Vec<[u8; HIT_BYTES]> = if args.any_hit {
+                    let mut occluded = vec![false; chunk.len()];
+                    accel.occluded_batch(chunk, &mut occluded);
+                    occluded.iter().map(|&o| encode_hit(0.0, if o { 0 } else { MISS }, 0.0, 0.0)).collect()
                 } else {
-                    match accel.intersect(ray) {
-                        Some(h) => encode_hit(h.t, h.triangle, h.beta, h.gamma),
-                        None => encode_hit(f32::INFINITY, MISS, 0.0, 0.0),
-                    }
-                }
+                    let mut closest = vec![None; chunk.len()];
+                    accel.intersect_batch(chunk, &mut closest);
+                    closest
+                        .iter()
+                        .map(|hit| match hit {
+                            Some(h) => encode_hit(h.t, h.triangle, h.beta, h.gamma),
+                            None => encode_hit(f32::INFINITY, MISS, 0.0, 0.0),
+                        })
+                        .collect()
+                };
+                encoded
             })
             .collect()
     });

@@ -131,9 +131,10 @@ fn configurations(args: &VerifyArgs) -> Vec<(AccelKind, BuildParams)> {
     let mut configurations: Vec<(AccelKind, BuildParams)> = if args.exhaustive {
         AccelKind::all_configurations().into_iter().filter(|(kind, _)| chosen(kind)).collect()
     } else {
-        AccelKind::ALL.iter().filter(|k| chosen(k)).map(|&kind| (kind, args.build.params())).collect()
+        AccelKind::ALL.iter().filter(|k| chosen(k)).map(|&kind| (kind, args.build.params_for(kind))).collect()
     };
-    configurations.extend(AccelKind::PEERS.iter().filter(|k| chosen(k)).map(|&kind| (kind, args.build.params())));
+    configurations
+        .extend(AccelKind::PEERS.iter().filter(|k| chosen(k)).map(|&kind| (kind, args.build.params_for(kind))));
     configurations
 }
 
@@ -202,8 +203,14 @@ fn check_case(
                 add(name.clone(), watertight, kind.is_peer(), &tally, structures);
                 if kind.is_peer() {
                     row.peers.get_or_insert_with(Tally::default).add(&Tally { rays: 0, compared: 0, ..tally });
-                } else {
-                    row.add_failures(&tally, watertight);
+                    continue;
+                }
+                row.add_failures(&tally, watertight);
+                // The wide BVHs trace batches as packets: those answers too.
+                if kind.node_width().is_some_and(|width| width > 2) {
+                    let batched = Tally::of(probes, &Answer::all_batched(accel.as_ref(), probes), Some(&reference));
+                    add(format!("{name} batch"), watertight, false, &batched, structures);
+                    row.add_failures(&batched, watertight);
                 }
             }
         }

@@ -203,7 +203,13 @@ impl<'a, A: Accel + ?Sized> Transport<'a, A> {
 
     /// The radiance arriving along `ray` (a camera ray); adds the rays it
     /// traces to `rays`.
-    pub(crate) fn radiance<const S: u32>(&self, mut ray: Ray, rng: &mut Rng, rays: &mut u64) -> Vec3 {
+    pub(crate) fn radiance<const S: u32>(
+        &self,
+        mut ray: Ray,
+        mut first_hit: Option<Option<Hit>>,
+        rng: &mut Rng,
+        rays: &mut u64,
+    ) -> Vec3 {
         let scene = self.scene;
         let mut radiance = Vec3::ZERO;
         let mut throughput = Vec3::ONE;
@@ -216,7 +222,13 @@ impl<'a, A: Accel + ?Sized> Transport<'a, A> {
         loop {
             let u: [f32; dim::COUNT] = std::array::from_fn(|_| rng.next_f32());
             *rays += 1;
-            let Some(hit) = self.closest::<S>(&ray, u[dim::ALPHA]) else {
+            // The camera ray's hit may have been found already, with others
+            // of its block (never where alpha masks filter hits).
+            let hit = match first_hit.take() {
+                Some(hit) => hit,
+                None => self.closest::<S>(&ray, u[dim::ALPHA]),
+            };
+            let Some(hit) = hit else {
                 match self.environment {
                     Some(environment) if S & bits::EMITTED != 0 => {
                         let direction = ray.direction.normalize();

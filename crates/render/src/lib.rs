@@ -44,7 +44,7 @@ pub use shade::{albedo, alpha_accepts, has_alpha, shade_primary, shading_normal}
 use std::time::Instant;
 
 use rayon::prelude::*;
-use rtgi_accel::{Accel, TraversalCounters};
+use rtgi_accel::{Accel, Hit, TraversalCounters};
 use rtgi_image::HdrImage;
 use rtgi_math::{Ray, Rng, Vec2, Vec3};
 use rtgi_scene::{Camera, Scene};
@@ -146,16 +146,26 @@ pub fn render<A: Accel + ?Sized>(
     // The views of the closest hit follow the plan for alpha and textures too.
     let plan = EffectPlan::new(scene, settings);
     let (alpha, textures) = (plan.has(Effect::Alpha), plan.has(Effect::Textures));
+    // Camera rays are traced together, a 4×4 block of pixels at a time,
+    // unless alpha masks need the filtered query.
+    let batch = |rays: &[Ray], hits: &mut [Option<Hit>]| accel.intersect_batch(rays, hits);
+    let first_hits: Option<&FirstHits> = if alpha { None } else { Some(&batch) };
     let (image, rays) = match settings.integrator {
-        Integrator::Primary => render_samples(camera, settings, progress, |ray, rng, rays| {
+        Integrator::Primary => render_samples(camera, settings, progress, first_hits, |ray, first, rng, rays| {
             *rays += 1;
-            match shade::closest_hit(scene, accel, &ray, alpha.then(|| rng.next_f32())) {
+            let hit = match first {
+                Some(hit) => hit,
+                None => shade::closest_hit(scene, accel, &ray, alpha.then(|| rng.next_f32())),
+            };
+            match hit {
                 Some(hit) => shade_primary(scene, &ray, &hit, textures),
                 None => settings.background,
             }
         }),
-        Integrator::Direct | Integrator::Path => render_transport(scene, accel, camera, settings, &plan, progress),
-        aov => render_samples(camera, settings, progress, |ray, rng, rays| {
+        Integrator::Direct | Integrator::Path => {
+            render_transport(scene, accel, camera, settings, &plan, first_hits, progress)
+        }
+        aov => render_samples(camera, settings, progress, None, |ray, _, rng, rays| {
             *rays += 1;
             shade::aov(aov, scene, accel, (alpha, textures), &ray, rng)
         }),
@@ -178,6 +188,7 @@ fn render_transport<A: Accel + ?Sized>(
     camera: &Camera,
     settings: &RenderSettings,
     plan: &EffectPlan,
+    first_hits: Option<&FirstHits>,
     progress: &(dyn Fn(u64) + Sync),
 ) -> (HdrImage, u64) {
     let white_sky = Environment::Uniform(Vec3::ONE);
@@ -195,14 +206,17 @@ fn render_transport<A: Accel + ?Sized>(
         transport: &Transport<'_, A>,
         camera: &Camera,
         settings: &RenderSettings,
+        first_hits: Option<&FirstHits>,
         progress: &(dyn Fn(u64) + Sync),
     ) -> (HdrImage, u64) {
-        render_samples(camera, settings, progress, |ray, rng, rays| transport.radiance::<S>(ray, rng, rays))
+        render_samples(camera, settings, progress, first_hits, |ray, first, rng, rays| {
+            transport.radiance::<S>(ray, first, rng, rays)
+        })
     }
     macro_rules! specialised {
         ($($bits:literal)*) => {
             match plan.specialisation() {
-                $($bits => run::<$bits, A>(&transport, camera, settings, progress),)*
+                $($bits => run::<$bits, A>(&transport, camera, settings, first_hits, progress),)*
                 other => unreachable!("specialisation {other} out of range"),
             }
         };
@@ -211,36 +225,67 @@ fn render_transport<A: Accel + ?Sized>(
     specialised!(0 1 2 3 4 5 6 7 8 9 10 11 12 13 14 15 16 17 18 19 20 21 22 23 24 25 26 27 28 29 30 31)
 }
 
+/// Closest hits of a batch of camera rays ([`Accel::intersect_batch`]).
+type FirstHits<'a> = dyn Fn(&[Ray], &mut [Option<Hit>]) + Sync + 'a;
+
 /// Renders each pixel as the mean of `settings.samples_per_pixel` values
-/// of `sample(camera ray, generator, ray counter)`. Each sample has its own
-/// generator, seeded by (seed, pixel, sample); samples that come out
-/// infinite or NaN count as black rather than spoiling the pixel.
+/// of `sample(camera ray, its closest hit, generator, ray counter)`. Each
+/// sample has its own generator, seeded by (seed, pixel, sample); samples
+/// that come out infinite or NaN count as black rather than spoiling the
+/// pixel.
+///
+/// With `first_hits`, the camera rays of each sample of a 4×4 block of
+/// pixels are traced together through it and `sample` is handed the hit
+/// (`Some`); without, `sample` traces its camera ray itself (`None`). The
+/// hits are the same bits either way, and so is the image.
 fn render_samples(
     camera: &Camera,
     settings: &RenderSettings,
     progress: &(dyn Fn(u64) + Sync),
-    sample: impl Fn(Ray, &mut Rng, &mut u64) -> Vec3 + Sync,
+    first_hits: Option<&FirstHits>,
+    sample: impl Fn(Ray, Option<Option<Hit>>, &mut Rng, &mut u64) -> Vec3 + Sync,
 ) -> (HdrImage, u64) {
     let (width, height) = (settings.width, settings.height);
-    let rays = CameraRays::new(camera, width, height);
+    let camera_rays = CameraRays::new(camera, width, height);
     let spp = settings.samples_per_pixel.max(1);
-    render_pixels(width, height, progress, |x, y| {
-        let pixel_index = y as u64 * width as u64 + x as u64;
+    render_blocks(width, height, progress, |pixels, values| {
+        let pixel_index = |(x, y): (u32, u32)| y as u64 * width as u64 + x as u64;
         // One more generator per pixel, past every sample's: its shift of the pixel's pattern.
-        let mut shift = Rng::for_sample(settings.seed, pixel_index, u64::MAX);
-        let pixel_shift = Vec2::new(shift.next_f32(), shift.next_f32());
-        let mut sum = Vec3::ZERO;
+        let shifts: Vec<Vec2> = pixels
+            .iter()
+            .map(|&pixel| {
+                let mut shift = Rng::for_sample(settings.seed, pixel_index(pixel), u64::MAX);
+                Vec2::new(shift.next_f32(), shift.next_f32())
+            })
+            .collect();
+        let mut sums = vec![Vec3::ZERO; pixels.len()];
         let mut traced = 0;
+        let mut generators = Vec::with_capacity(pixels.len());
+        let mut rays = Vec::with_capacity(pixels.len());
+        let mut hits = vec![None; pixels.len()];
         for index in 0..spp {
-            let mut rng = Rng::for_sample(settings.seed, pixel_index, index as u64);
-            let position = PixelSample { index, count: spp, pixel_shift };
-            let ray = rays.ray(x, y, settings.sampler.offset(&position, &mut rng));
-            let value = sample(ray, &mut rng, &mut traced);
-            if value.is_finite() {
-                sum += value;
+            generators.clear();
+            rays.clear();
+            for (&(x, y), &pixel_shift) in pixels.iter().zip(&shifts) {
+                let mut rng = Rng::for_sample(settings.seed, pixel_index((x, y)), index as u64);
+                let position = PixelSample { index, count: spp, pixel_shift };
+                rays.push(camera_rays.ray(x, y, settings.sampler.offset(&position, &mut rng)));
+                generators.push(rng);
+            }
+            if let Some(first_hits) = first_hits {
+                first_hits(&rays, &mut hits);
+            }
+            for (i, (ray, rng)) in rays.iter().zip(&mut generators).enumerate() {
+                let value = sample(*ray, first_hits.map(|_| hits[i]), rng, &mut traced);
+                if value.is_finite() {
+                    sums[i] += value;
+                }
             }
         }
-        (sum / spp as f32, traced)
+        for (value, sum) in values.iter_mut().zip(sums) {
+            *value = sum / spp as f32;
+        }
+        traced
     })
 }
 
@@ -305,6 +350,51 @@ fn render_pixels(
         rays += traced;
         for (i, value) in pixels.into_iter().enumerate() {
             image.set(x0 + (i % tile_width) as u32, y0 + (i / tile_width) as u32, value);
+        }
+    }
+    (image, rays)
+}
+
+/// [`render_pixels`] a block of pixels at a time: each tile is cut into
+/// blocks of up to [`rays::TILE`]×[`rays::TILE`] pixels, and `block(pixels,
+/// values)` fills in the values of its pixels and returns the rays traced.
+fn render_blocks(
+    width: u32,
+    height: u32,
+    progress: &(dyn Fn(u64) + Sync),
+    block: impl Fn(&[(u32, u32)], &mut [Vec3]) -> u64 + Sync,
+) -> (HdrImage, u64) {
+    // Per tile: its pixels, their values, and the rays traced.
+    type Tile = (Vec<(u32, u32)>, Vec<Vec3>, u64);
+    let tile_pixels: Vec<Tile> = tiles(width, height)
+        .into_par_iter()
+        .map(|(x0, y0, x1, y1)| {
+            let pixels: Vec<(u32, u32)> = rays::tile_order(x1 - x0, y1 - y0).map(|(x, y)| (x0 + x, y0 + y)).collect();
+            let mut values = vec![Vec3::ZERO; pixels.len()];
+            let block_size = (rays::TILE * rays::TILE) as usize;
+            let mut traced = 0;
+            // `tile_order` lists whole blocks first-to-last; cut at block borders.
+            let mut start = 0;
+            while start < pixels.len() {
+                let (bx, by) = ((pixels[start].0 - x0) / rays::TILE, (pixels[start].1 - y0) / rays::TILE);
+                let len = pixels[start..]
+                    .iter()
+                    .take(block_size)
+                    .take_while(|&&(x, y)| (x - x0) / rays::TILE == bx && (y - y0) / rays::TILE == by)
+                    .count();
+                traced += block(&pixels[start..start + len], &mut values[start..start + len]);
+                start += len;
+            }
+            progress(pixels.len() as u64);
+            (pixels, values, traced)
+        })
+        .collect();
+    let mut image = HdrImage::new(width, height);
+    let mut rays = 0;
+    for (pixels, values, traced) in tile_pixels {
+        rays += traced;
+        for ((x, y), value) in pixels.into_iter().zip(values) {
+            image.set(x, y, value);
         }
     }
     (image, rays)

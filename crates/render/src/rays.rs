@@ -5,10 +5,30 @@ use rtgi_scene::{Camera, Scene};
 
 use crate::CameraRays;
 
-/// One ray through the centre of every pixel, row by row from the top.
+/// One ray through the centre of every pixel.
+///
+/// The rays come in 4×4 tiles of pixels (tiles row by row, pixels row by
+/// row within a tile), as a renderer traces them: sixteen consecutive
+/// rays are neighbours, which packet traversal
+/// ([`rtgi_accel::Accel::intersect_batch`]) exploits.
 pub fn primary_rays(camera: &Camera, width: u32, height: u32) -> Vec<Ray> {
     let rays = CameraRays::new(camera, width, height);
-    (0..height).flat_map(|y| (0..width).map(move |x| (x, y))).map(|(x, y)| rays.ray(x, y, Vec2::splat(0.5))).collect()
+    tile_order(width, height).map(|(x, y)| rays.ray(x, y, Vec2::splat(0.5))).collect()
+}
+
+/// Side of the square tiles in which camera rays are traced.
+pub const TILE: u32 = 4;
+
+/// Every pixel of a `width × height` image once, in [`TILE`]×[`TILE`]
+/// tiles: tiles row by row, pixels row by row within a tile (tiles at the
+/// right and bottom edges are cut to the image).
+pub fn tile_order(width: u32, height: u32) -> impl Iterator<Item = (u32, u32)> {
+    (0..height.div_ceil(TILE)).flat_map(move |ty| {
+        (0..width.div_ceil(TILE)).flat_map(move |tx| {
+            (ty * TILE..((ty + 1) * TILE).min(height))
+                .flat_map(move |y| (tx * TILE..((tx + 1) * TILE).min(width)).map(move |x| (x, y)))
+        })
+    })
 }
 
 /// Incoherent rays: origins uniformly distributed over the scene's surfaces
@@ -88,4 +108,24 @@ pub fn throughput(rays: &[Ray], pool: &rayon::ThreadPool, repeats: usize, trace:
     let mut seconds: Vec<f64> = (0..repeats.max(1)).map(|_| run()).collect();
     seconds.sort_by(f64::total_cmp);
     rays.len() as f64 / seconds[seconds.len() / 2].max(1e-12) * 1e-6
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn tile_order_visits_every_pixel_once_in_tiles() {
+        for (width, height) in [(8, 8), (5, 7), (1, 1), (4, 9)] {
+            let pixels: Vec<(u32, u32)> = tile_order(width, height).collect();
+            let mut sorted = pixels.clone();
+            sorted.sort_unstable();
+            sorted.dedup();
+            assert_eq!(sorted.len(), (width * height) as usize, "{width}×{height}");
+            assert_eq!(pixels.len(), sorted.len());
+        }
+        // The first sixteen pixels of a large image form the top-left tile.
+        let first: Vec<(u32, u32)> = tile_order(64, 64).take(16).collect();
+        assert!(first.iter().all(|&(x, y)| x < TILE && y < TILE));
+    }
 }

@@ -18,7 +18,7 @@ use crate::slab::{BoxRay, ROBUST_FAR_SCALE};
 /// Lanes without a child hold the empty box (minimum +∞, maximum -∞),
 /// which no ray enters.
 #[derive(Clone, Copy, Debug, PartialEq)]
-#[repr(C)]
+#[repr(C, align(32))]
 pub(crate) struct WideBoxes<const W: usize> {
     pub(crate) planes: [[f32; W]; 6],
 }

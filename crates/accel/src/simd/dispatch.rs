@@ -20,7 +20,7 @@ use std::sync::atomic::{AtomicU8, Ordering};
 
 use super::boxes::{FAR_OF_NEAR, PlaneRay, WideBoxes};
 use crate::slab::ROBUST_FAR_SCALE;
-use crate::wide::packet::{PACKET, PacketRays};
+use crate::wide::packet::{Lanes, PACKET, PacketRays};
 
 /// The instruction sets the kernels are compiled for, narrowest first.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
@@ -154,9 +154,29 @@ pub(crate) trait Isa: Copy {
         near: [f32; 3],
         far: [f32; 3],
         rays: &PacketRays,
-        t_max: &[f32; PACKET],
+        t_max: &Lanes,
         active: u32,
     ) -> (u32, f32);
+}
+
+/// Asks the CPU to start loading the `bytes` bytes at `data` into its
+/// caches, for memory that traversal is about to visit (the children it
+/// has just pushed); a hint that never changes what the program computes.
+#[inline(always)]
+pub(crate) fn prefetch<T>(data: &T, bytes: usize) {
+    #[cfg(target_arch = "x86_64")]
+    {
+        use std::arch::x86_64::{_MM_HINT_T0, _mm_prefetch};
+        let start = (data as *const T).cast::<i8>();
+        for offset in (0..bytes).step_by(64) {
+            // SAFETY: a prefetch never faults, whatever the address, and
+            // neither reads nor writes anything the program can observe;
+            // `wrapping_add` keeps the address computation defined.
+            unsafe { _mm_prefetch::<_MM_HINT_T0>(start.wrapping_add(offset)) };
+        }
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    let _ = (data, bytes);
 }
 
 /// The kernels in plain Rust (SSE at the x86-64-v2 baseline).
@@ -175,7 +195,7 @@ impl Isa for Portable {
         near: [f32; 3],
         far: [f32; 3],
         rays: &PacketRays,
-        t_max: &[f32; PACKET],
+        t_max: &Lanes,
         active: u32,
     ) -> (u32, f32) {
         rays.enter_box(near, far, t_max, active)
@@ -203,7 +223,7 @@ impl Isa for Avx2 {
         near: [f32; 3],
         far: [f32; 3],
         rays: &PacketRays,
-        t_max: &[f32; PACKET],
+        t_max: &Lanes,
         active: u32,
     ) -> (u32, f32) {
         Portable.enter_box_packet(near, far, rays, t_max, active)
@@ -221,7 +241,7 @@ impl Isa for Avx512 {
         near: [f32; 3],
         far: [f32; 3],
         rays: &PacketRays,
-        t_max: &[f32; PACKET],
+        t_max: &Lanes,
         active: u32,
     ) -> (u32, f32) {
         Portable.enter_box_packet(near, far, rays, t_max, active)
@@ -247,7 +267,7 @@ impl Isa for Avx2 {
         near: [f32; 3],
         far: [f32; 3],
         rays: &PacketRays,
-        t_max: &[f32; PACKET],
+        t_max: &Lanes,
         active: u32,
     ) -> (u32, f32) {
         // SAFETY: as above, the CPU runs AVX2.
@@ -273,7 +293,7 @@ impl Isa for Avx512 {
         near: [f32; 3],
         far: [f32; 3],
         rays: &PacketRays,
-        t_max: &[f32; PACKET],
+        t_max: &Lanes,
         active: u32,
     ) -> (u32, f32) {
         // SAFETY: an `Avx512` exists only where the CPU was seen to run AVX-512 F.
@@ -290,9 +310,12 @@ fn enter_boxes_avx2<const W: usize>(boxes: &WideBoxes<W>, ray: &PlaneRay, t_max:
     use std::arch::x86_64::*;
     let load = |plane: usize, chunk: usize| {
         let lanes: &[f32; 8] = boxes.planes[plane][chunk * 8..chunk * 8 + 8].try_into().expect("eight lanes");
-        // SAFETY: `lanes` is a reference to eight `f32`s, valid for an
-        // unaligned 32-byte load.
-        unsafe { _mm256_loadu_ps(lanes.as_ptr()) }
+        // SAFETY: `lanes` is a reference to eight `f32`s, valid for a
+        // 32-byte load, and 32-byte aligned: `WideBoxes` is, and each of
+        // its rows is a multiple of eight lanes (32 bytes) long. (An
+        // unaligned load would do, but LLVM's generic tuning splits those
+        // in two unless it sees the alignment.)
+        unsafe { _mm256_load_ps(lanes.as_ptr()) }
     };
     let mut distances = [f32::INFINITY; W];
     let mut mask = 0;
@@ -326,19 +349,14 @@ fn enter_boxes_avx2<const W: usize>(boxes: &WideBoxes<W>, ray: &PlaneRay, t_max:
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
 #[inline]
-fn enter_box_packet_avx2(
-    near: [f32; 3],
-    far: [f32; 3],
-    rays: &PacketRays,
-    t_max: &[f32; PACKET],
-    active: u32,
-) -> (u32, f32) {
+fn enter_box_packet_avx2(near: [f32; 3], far: [f32; 3], rays: &PacketRays, t_max: &Lanes, active: u32) -> (u32, f32) {
     use std::arch::x86_64::*;
-    let load = |values: &[f32; PACKET], chunk: usize| {
-        let lanes: &[f32; 8] = values[chunk * 8..chunk * 8 + 8].try_into().expect("eight lanes");
-        // SAFETY: `lanes` is a reference to eight `f32`s, valid for an
-        // unaligned 32-byte load.
-        unsafe { _mm256_loadu_ps(lanes.as_ptr()) }
+    let load = |values: &Lanes, chunk: usize| {
+        let lanes: &[f32; 8] = values.0[chunk * 8..chunk * 8 + 8].try_into().expect("eight lanes");
+        // SAFETY: `lanes` is a reference to eight `f32`s, valid for a
+        // 32-byte load, and 32-byte aligned: `Lanes` is 64-byte aligned and
+        // `chunk * 8` lanes are a multiple of 32 bytes.
+        unsafe { _mm256_load_ps(lanes.as_ptr()) }
     };
     let infinity = _mm256_set1_ps(f32::INFINITY);
     let mut earliest = infinity;
@@ -372,17 +390,11 @@ fn enter_box_packet_avx2(
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx512f")]
 #[inline]
-fn enter_box_packet_avx512(
-    near: [f32; 3],
-    far: [f32; 3],
-    rays: &PacketRays,
-    t_max: &[f32; PACKET],
-    active: u32,
-) -> (u32, f32) {
+fn enter_box_packet_avx512(near: [f32; 3], far: [f32; 3], rays: &PacketRays, t_max: &Lanes, active: u32) -> (u32, f32) {
     use std::arch::x86_64::*;
-    // SAFETY: each argument is a reference to sixteen `f32`s, valid for an
-    // unaligned 64-byte load.
-    let load = |values: &[f32; PACKET]| unsafe { _mm512_loadu_ps(values.as_ptr()) };
+    // SAFETY: each argument is a reference to sixteen `f32`s, valid for a
+    // 64-byte load, and `Lanes` is 64-byte aligned.
+    let load = |values: &Lanes| unsafe { _mm512_load_ps(values.0.as_ptr()) };
     let mut enter = load(&rays.t_min);
     let mut exit = load(t_max);
     for axis in 0..3 {

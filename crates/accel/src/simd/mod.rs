@@ -15,5 +15,5 @@ pub(crate) mod boxes;
 mod dispatch;
 pub(crate) mod triangles;
 
-pub(crate) use dispatch::{Isa, Kernel, dispatch};
+pub(crate) use dispatch::{Isa, Kernel, dispatch, prefetch};
 pub use dispatch::{SimdLevel, active_simd_level, limit_simd_level};

@@ -63,6 +63,23 @@ impl Answer {
             .map(|probe| Answer { closest: accel.intersect(&probe.ray), any: accel.occluded(&probe.ray) })
             .collect()
     }
+
+    /// The answers of `accel` through its batch queries
+    /// ([`Accel::intersect_batch`], [`Accel::occluded_batch`]) on chunks
+    /// of consecutive rays, where packet traversal runs; they must be
+    /// those of [`Answer::all`], bit for bit.
+    pub fn all_batched(accel: &dyn Accel, rays: &[ProbeRay]) -> Vec<Answer> {
+        rays.par_chunks(256)
+            .flat_map_iter(|chunk| {
+                let rays: Vec<Ray> = chunk.iter().map(|probe| probe.ray).collect();
+                let mut closest = vec![None; rays.len()];
+                let mut any = vec![false; rays.len()];
+                accel.intersect_batch(&rays, &mut closest);
+                accel.occluded_batch(&rays, &mut any);
+                closest.into_iter().zip(any).map(|(closest, any)| Answer { closest, any })
+            })
+            .collect()
+    }
 }
 
 /// Whether two closest hits are the same to the bit: triangle, `t`, `beta`, `gamma`.

@@ -31,6 +31,11 @@ pub enum RayKind {
     /// surrounded by triangles, all facing the ray. Each must hit
     /// something no later than the point aimed at; a miss is a leak.
     Silhouette,
+    /// Coherent, as a camera's: 4×4 tiles of rays from one origin through
+    /// a small grid around a point on a triangle, one of them exactly at
+    /// the triangle's first corner. Sixteen consecutive rays form a tile,
+    /// so that batch queries trace them as packets.
+    Camera,
 }
 
 impl RayKind {
@@ -41,6 +46,7 @@ impl RayKind {
         RayKind::AxisParallel,
         RayKind::Secondary,
         RayKind::Silhouette,
+        RayKind::Camera,
     ];
 
     pub fn name(self) -> &'static str {
@@ -51,6 +57,7 @@ impl RayKind {
             RayKind::AxisParallel => "axis-parallel",
             RayKind::Secondary => "secondary",
             RayKind::Silhouette => "silhouette",
+            RayKind::Camera => "camera",
         }
     }
 
@@ -64,6 +71,7 @@ impl RayKind {
         let mut rng = Rng::new(seed, 0x7e51f1 + self as u64);
         match self {
             RayKind::Silhouette => scene.silhouette_rays(count, &mut rng),
+            RayKind::Camera => scene.camera_rays(count, &mut rng),
             _ => (0..count).filter_map(|_| scene.ray(self, &mut rng)).collect(),
         }
     }
@@ -95,6 +103,33 @@ impl<'a> SceneFeatures<'a> {
             self.bounds.extent().max(Vec3::splat(self.bounds.max.abs().max_element() * 1e-3)).max(Vec3::ONE * 1e-30);
         let u = Vec3::new(rng.next_f32(), rng.next_f32(), rng.next_f32()) * 2.0 - 0.5;
         self.bounds.min + u * extent
+    }
+
+    /// Tiles of sixteen rays; see [`RayKind::Camera`].
+    fn camera_rays(&self, count: usize, rng: &mut Rng) -> Vec<ProbeRay> {
+        let mut rays = Vec::with_capacity(count);
+        while rays.len() < count {
+            let origin = self.origin(rng);
+            let (_, t) = self.random_triangle(rng);
+            let (u, v) = (rng.next_f32(), rng.next_f32());
+            let (u, v) = if u + v > 1.0 { (1.0 - u, 1.0 - v) } else { (u, v) };
+            let centre = t[0] + u * (t[1] - t[0]) + v * (t[2] - t[0]);
+            let axis = centre - origin;
+            if axis.length_squared().partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
+                continue;
+            }
+            let frame = rtgi_math::Frame::from_z(axis.normalize());
+            let spacing = 0.004 * self.bounds.extent().max_element();
+            for j in 0..4 {
+                for i in 0..4 {
+                    let offset = (i as f32 - 1.5) * spacing * frame.x + (j as f32 - 1.5) * spacing * frame.y;
+                    let target = if (i, j) == (1, 1) { t[0] } else { centre + offset };
+                    rays.push(ProbeRay { ray: Ray::new(origin, target - origin), expect: Expect::Nothing });
+                }
+            }
+        }
+        rays.truncate(count);
+        rays
     }
 
     fn ray(&self, kind: RayKind, rng: &mut Rng) -> Option<ProbeRay> {
@@ -158,7 +193,7 @@ impl<'a> SceneFeatures<'a> {
                 };
                 Some(ProbeRay { ray, expect })
             }
-            RayKind::Silhouette => unreachable!("made by silhouette_rays"),
+            RayKind::Silhouette | RayKind::Camera => unreachable!("made by silhouette_rays and camera_rays"),
         }
     }
 

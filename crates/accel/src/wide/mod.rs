@@ -16,7 +16,7 @@ mod traverse;
 
 use std::time::Instant;
 
-use rtgi_math::Vec3;
+use rtgi_math::{Aabb, Vec3};
 
 use crate::contract::{HitFilter, QueryKind, Structure};
 use crate::simd::triangles::TriangleBlock;
@@ -68,6 +68,45 @@ impl<const W: usize> WideBvh<W> {
             memory_bytes: std::mem::size_of_val(tree.nodes.as_slice()) + std::mem::size_of_val(tree.blocks.as_slice()),
         };
         Self { nodes: tree.nodes, blocks: tree.blocks, stats, intersector: params.intersector }
+    }
+}
+
+impl<const W: usize> WideBvh<W> {
+    /// The boxes of all nodes and leaves at the given depths (the root, the
+    /// union of its children's boxes, is depth 0); a leaf shallower than a
+    /// requested depth is not repeated below itself.
+    pub fn boxes_at_depths(&self, depths: &[usize]) -> Vec<(usize, Aabb)> {
+        let mut boxes = Vec::new();
+        let Some(root) = self.nodes.first() else {
+            return boxes;
+        };
+        let children = |node: &WideNode<W>| -> Vec<(ChildRef, Aabb)> {
+            (0..W)
+                .filter(|&lane| node.children[lane] != ChildRef::NONE)
+                .map(|lane| {
+                    let p = &node.boxes.planes;
+                    let min = Vec3::new(p[0][lane], p[1][lane], p[2][lane]);
+                    let max = Vec3::new(p[3][lane], p[4][lane], p[5][lane]);
+                    (node.children[lane], Aabb::new(min, max))
+                })
+                .collect()
+        };
+        if depths.contains(&0) {
+            let union = children(root).iter().fold(Aabb::EMPTY, |acc, (_, b)| acc.union(b));
+            boxes.push((0, union));
+        }
+        let mut stack: Vec<(ChildRef, Aabb, usize)> =
+            children(root).into_iter().map(|(child, bounds)| (child, bounds, 1)).collect();
+        while let Some((child, bounds, depth)) = stack.pop() {
+            if depths.contains(&depth) {
+                boxes.push((depth, bounds));
+            }
+            if !child.is_leaf() {
+                stack.extend(children(&self.nodes[child.node_index()]).into_iter().map(|(c, b)| (c, b, depth + 1)));
+            }
+        }
+        boxes.sort_by_key(|(depth, _)| *depth);
+        boxes
     }
 }
 

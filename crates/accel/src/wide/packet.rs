@@ -35,12 +35,17 @@ pub(crate) const PACKET: usize = 16;
 #[derive(Clone, Copy, Debug)]
 #[repr(C, align(64))]
 pub(crate) struct PacketRays {
-    pub(crate) origin: [[f32; PACKET]; 3],
-    pub(crate) inv_direction: [[f32; PACKET]; 3],
-    pub(crate) t_min: [f32; PACKET],
+    pub(crate) origin: [Lanes; 3],
+    pub(crate) inv_direction: [Lanes; 3],
+    pub(crate) t_min: Lanes,
     /// Index of each axis's near plane in a node's planes (see `WideBoxes`).
     pub(crate) near: [usize; 3],
 }
+
+/// One number for each ray of a packet, aligned for 512-bit loads.
+#[derive(Clone, Copy, Debug)]
+#[repr(C, align(64))]
+pub(crate) struct Lanes(pub(crate) [f32; PACKET]);
 
 /// Smallest cosine between the first ray's direction and any other's for
 /// a batch of rays to be traced as a packet: about 8°. Beyond that the
@@ -66,19 +71,19 @@ impl PacketRays {
         }
         // Lanes past the end repeat the first ray; their answers are dropped.
         let mut packet = PacketRays {
-            origin: [[0.0; PACKET]; 3],
-            inv_direction: [[0.0; PACKET]; 3],
-            t_min: [first.t_min; PACKET],
+            origin: [Lanes([0.0; PACKET]); 3],
+            inv_direction: [Lanes([0.0; PACKET]); 3],
+            t_min: Lanes([first.t_min; PACKET]),
             near: [0, 1, 2].map(|axis| if signs(first)[axis] { axis + 3 } else { axis }),
         };
         for lane in 0..PACKET {
             let ray = rays.get(lane).unwrap_or(first);
             for axis in 0..3 {
-                packet.origin[axis][lane] = ray.origin[axis];
+                packet.origin[axis].0[lane] = ray.origin[axis];
                 // As `BoxRay` computes it, so that the box tests agree with the scalar one.
-                packet.inv_direction[axis][lane] = 1.0 / ray.direction[axis];
+                packet.inv_direction[axis].0[lane] = 1.0 / ray.direction[axis];
             }
-            packet.t_min[lane] = ray.t_min;
+            packet.t_min.0[lane] = ray.t_min;
         }
         Some(packet)
     }
@@ -90,16 +95,16 @@ impl PacketRays {
     /// later than their `t_max`; and a distance no later than the earliest
     /// entry among them. The robust slab test's arithmetic, ray by ray.
     #[inline(always)]
-    pub(crate) fn enter_box(&self, near: [f32; 3], far: [f32; 3], t_max: &[f32; PACKET], active: u32) -> (u32, f32) {
+    pub(crate) fn enter_box(&self, near: [f32; 3], far: [f32; 3], t_max: &Lanes, active: u32) -> (u32, f32) {
         let mut mask = 0;
         let mut earliest = Vec4::INFINITY;
         for chunk in 0..PACKET / 4 {
             let lanes = chunk * 4..chunk * 4 + 4;
-            let mut enter = Vec4::from_slice(&self.t_min[lanes.clone()]);
-            let mut exit = Vec4::from_slice(&t_max[lanes.clone()]);
+            let mut enter = Vec4::from_slice(&self.t_min.0[lanes.clone()]);
+            let mut exit = Vec4::from_slice(&t_max.0[lanes.clone()]);
             for axis in 0..3 {
-                let origin = Vec4::from_slice(&self.origin[axis][lanes.clone()]);
-                let inv = Vec4::from_slice(&self.inv_direction[axis][lanes.clone()]);
+                let origin = Vec4::from_slice(&self.origin[axis].0[lanes.clone()]);
+                let inv = Vec4::from_slice(&self.inv_direction[axis].0[lanes.clone()]);
                 let t_near = (Vec4::splat(near[axis]) - origin) * inv;
                 let t_far = (Vec4::splat(far[axis]) - origin) * inv * Vec4::splat(ROBUST_FAR_SCALE);
                 // A NaN compares false and leaves the bound as it was.
@@ -152,7 +157,7 @@ impl<const W: usize> WideBvh<W> {
         answer: &mut dyn FnMut(usize, Option<Hit>),
     ) {
         let mut best: [Best; PACKET] = std::array::from_fn(|lane| Best::new(rays.get(lane).unwrap_or(&rays[0])));
-        let mut t_max: [f32; PACKET] = std::array::from_fn(|lane| best[lane].t_max);
+        let mut t_max = Lanes(std::array::from_fn(|lane| best[lane].t_max));
         // Prepared for the triangle tests when the ray reaches its first leaf.
         let mut prepared: [Option<PreparedRay<T>>; PACKET] = std::array::from_fn(|_| None);
         let all = if rays.len() == PACKET { u32::MAX >> (32 - PACKET) } else { (1 << rays.len()) - 1 };
@@ -173,7 +178,7 @@ impl<const W: usize> WideBvh<W> {
                         &mut NoCounter,
                         &AcceptAll,
                     );
-                    t_max[lane] = best[lane].t_max;
+                    t_max.0[lane] = best[lane].t_max;
                     if answered {
                         done |= 1 << lane;
                     }
@@ -224,7 +229,7 @@ impl<const W: usize> WideBvh<W> {
                 while lanes != 0 {
                     let lane = lanes.trailing_zeros() as usize;
                     lanes &= lanes - 1;
-                    farthest = farthest.max(t_max[lane]);
+                    farthest = farthest.max(t_max.0[lane]);
                 }
                 if entry.enter <= farthest {
                     current = entry;

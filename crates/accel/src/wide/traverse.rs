@@ -8,10 +8,11 @@ use std::marker::PhantomData;
 use rtgi_math::Ray;
 
 use super::WideBvh;
-use super::node::ChildRef;
+use super::node::{ChildRef, WideNode};
 use crate::contract::{Best, HitFilter, PreparedRay, QueryKind, box_rule, hit_triangle};
 use crate::simd::boxes::PlaneRay;
-use crate::simd::{Isa, Kernel, dispatch};
+use crate::simd::triangles::TriangleBlock;
+use crate::simd::{Isa, Kernel, dispatch, prefetch};
 use crate::triangle::{MollerTrumbore, TriangleHit, TriangleTest, Watertight};
 use crate::{Counter, Hit, Intersector};
 
@@ -134,6 +135,7 @@ impl<const W: usize> WideBvh<W> {
                         count += 1;
                     }
                     for &entry in &sorted[..count - 1] {
+                        self.prefetch(entry.0);
                         stack.push(entry);
                     }
                     current = sorted[count - 1].0;
@@ -151,6 +153,19 @@ impl<const W: usize> WideBvh<W> {
                     break;
                 }
             }
+        }
+    }
+
+    /// Starts loading the memory of a child that will be visited soon.
+    #[inline(always)]
+    fn prefetch(&self, child: ChildRef) {
+        if child.is_leaf() {
+            let blocks = child.blocks();
+            if let Some(first) = self.blocks.get(blocks.start) {
+                prefetch(first, blocks.len() * std::mem::size_of::<TriangleBlock>());
+            }
+        } else if let Some(node) = self.nodes.get(child.node_index()) {
+            prefetch(node, std::mem::size_of::<WideNode<W>>());
         }
     }
 
