@@ -58,7 +58,13 @@ pub(crate) struct PreparedRay<T: TriangleTest> {
 impl<T: TriangleTest> PreparedRay<T> {
     #[inline(always)]
     pub(crate) fn new(ray: &Ray) -> Self {
-        Self { triangles: T::prepare(ray.origin.into(), ray.direction.into()), boxes: BoxRay::new(ray) }
+        Self::with_boxes(ray, BoxRay::new(ray))
+    }
+
+    /// The ray prepared for triangles, with its box preparation done already.
+    #[inline(always)]
+    pub(crate) fn with_boxes(ray: &Ray, boxes: BoxRay) -> Self {
+        Self { triangles: T::prepare(ray.origin.into(), ray.direction.into()), boxes }
     }
 }
 

@@ -31,17 +31,18 @@ impl TriangleBlock {
     /// A block of up to four triangles and their input indices.
     pub(crate) fn new(triangles: &[[Vec3A; 3]], ids: &[u32]) -> Self {
         assert!(triangles.len() <= Self::LANES && triangles.len() == ids.len());
-        let mut corners = [[Vec4::NAN; 3]; 3];
+        let mut corners = [[[f32::NAN; 4]; 3]; 3];
         let mut lane_ids = [Self::NO_TRIANGLE; 4];
         for (lane, (triangle, &id)) in triangles.iter().zip(ids).enumerate() {
             for (c, corner) in triangle.iter().enumerate() {
+                let corner = corner.to_array();
                 for axis in 0..3 {
                     corners[c][axis][lane] = corner[axis];
                 }
             }
             lane_ids[lane] = id;
         }
-        Self { corners, ids: lane_ids }
+        Self { corners: corners.map(|corner| corner.map(Vec4::from_array)), ids: lane_ids }
     }
 
     /// The corners of the triangle in `lane`.

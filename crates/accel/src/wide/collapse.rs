@@ -27,7 +27,14 @@ pub(crate) struct WideTree<const W: usize> {
 pub(crate) fn collapse<const W: usize>(binary: &Bvh, traversal_cost: f32) -> WideTree<W> {
     const { assert!(W >= 2 && W <= 32) };
     let (triangles, ids) = binary.leaf_order();
-    let mut tree = WideTree { nodes: Vec::new(), blocks: Vec::new(), leaves: 0, depth: 0, sah_cost: 0.0 };
+    // Each wide node replaces at least one binary node; each block holds at least one triangle.
+    let mut tree = WideTree {
+        nodes: Vec::with_capacity(binary.nodes().len().div_ceil(2)),
+        blocks: Vec::with_capacity(triangles.len()),
+        leaves: 0,
+        depth: 0,
+        sah_cost: 0.0,
+    };
     let Some(root) = binary.nodes().first() else {
         return tree;
     };
@@ -79,26 +86,30 @@ impl Collapser<'_> {
         tree.nodes.push(WideNode::EMPTY);
         tree.depth = tree.depth.max(depth + 1);
         *cost += self.relative_area(node) * self.traversal_cost as f64;
+        // Children with the area that ranks them for opening (-1 for leaves).
+        let openable = |child: &BvhNode| if child.is_leaf() { -1.0 } else { corners(child).half_area() };
         let [left, right] = self.children(node);
-        let mut children = [left; W];
-        children[1] = right;
+        let mut children = [(left, openable(left)); W];
+        children[1] = (right, openable(right));
         let mut len = 2;
         while len < W {
-            let largest = children[..len]
-                .iter()
-                .enumerate()
-                .filter(|(_, child)| !child.is_leaf())
-                .max_by(|(_, a), (_, b)| corners(a).half_area().total_cmp(&corners(b).half_area()))
-                .map(|(i, _)| i);
-            let Some(largest) = largest else { break };
-            let [left, right] = self.children(children[largest]);
+            let mut largest = 0;
+            for i in 1..len {
+                if children[i].1 > children[largest].1 {
+                    largest = i;
+                }
+            }
+            if children[largest].1 < 0.0 {
+                break;
+            }
+            let [left, right] = self.children(children[largest].0);
             children.copy_within(largest + 1..len, largest + 2);
-            children[largest] = left;
-            children[largest + 1] = right;
+            children[largest] = (left, openable(left));
+            children[largest + 1] = (right, openable(right));
             len += 1;
         }
         let mut wide = WideNode::EMPTY;
-        for (lane, child) in children[..len].iter().enumerate() {
+        for (lane, &(child, _)) in children[..len].iter().enumerate() {
             wide.boxes.set(lane, child.min().to_array(), child.max().to_array());
             wide.children[lane] =
                 if child.is_leaf() { self.leaf(child, tree, cost) } else { self.node(child, depth + 1, tree, cost) };

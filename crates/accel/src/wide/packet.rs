@@ -59,12 +59,16 @@ impl PacketRays {
     fn new(rays: &[Ray]) -> Option<Self> {
         debug_assert!(rays.len() <= PACKET);
         let first = rays.first()?;
-        let signs = |ray: &Ray| ray.direction.to_array().map(f32::is_sign_negative);
-        let axis = first.direction.normalize();
+        let sign_bits = |ray: &Ray| ray.direction.is_negative_bitmask();
+        let (axis, first_signs) = (first.direction, sign_bits(first));
+        let axis_length2 = axis.length_squared();
+        // cos(d, axis) ≥ c, squared: (d · axis)² ≥ c² |d|² |axis|², with d · axis ≥ 0.
         let coherent = rays.iter().all(|ray| {
+            let along = ray.direction.dot(axis);
             ray.is_valid()
-                && signs(ray) == signs(first)
-                && ray.direction.dot(axis) >= COHERENT_COSINE * ray.direction.length()
+                && sign_bits(ray) == first_signs
+                && along >= 0.0
+                && along * along >= COHERENT_COSINE * COHERENT_COSINE * ray.direction.length_squared() * axis_length2
         });
         if !coherent {
             return None;
@@ -74,14 +78,15 @@ impl PacketRays {
             origin: [Lanes([0.0; PACKET]); 3],
             inv_direction: [Lanes([0.0; PACKET]); 3],
             t_min: Lanes([first.t_min; PACKET]),
-            near: [0, 1, 2].map(|axis| if signs(first)[axis] { axis + 3 } else { axis }),
+            near: [0, 1, 2].map(|axis| if first_signs >> axis & 1 == 1 { axis + 3 } else { axis }),
         };
         for lane in 0..PACKET {
             let ray = rays.get(lane).unwrap_or(first);
+            // As `BoxRay` computes it, so that the box tests agree with the scalar one.
+            let (origin, inv) = (ray.origin.to_array(), (1.0 / rtgi_math::Vec3A::from(ray.direction)).to_array());
             for axis in 0..3 {
-                packet.origin[axis].0[lane] = ray.origin[axis];
-                // As `BoxRay` computes it, so that the box tests agree with the scalar one.
-                packet.inv_direction[axis].0[lane] = 1.0 / ray.direction[axis];
+                packet.origin[axis].0[lane] = origin[axis];
+                packet.inv_direction[axis].0[lane] = inv[axis];
             }
             packet.t_min.0[lane] = ray.t_min;
         }

@@ -13,6 +13,7 @@ use crate::contract::{Best, HitFilter, PreparedRay, QueryKind, box_rule, hit_tri
 use crate::simd::boxes::PlaneRay;
 use crate::simd::triangles::TriangleBlock;
 use crate::simd::{Isa, Kernel, dispatch, prefetch};
+use crate::slab::BoxRay;
 use crate::triangle::{MollerTrumbore, TriangleHit, TriangleTest, Watertight};
 use crate::{Counter, Hit, Intersector};
 
@@ -97,14 +98,18 @@ impl<const W: usize> WideBvh<W> {
         if !ray.is_valid() || self.nodes.is_empty() {
             return None;
         }
-        let prepared = PreparedRay::<T>::new(ray);
-        let plane_ray = PlaneRay::new(&prepared.boxes);
+        let box_ray = BoxRay::new(ray);
+        let plane_ray = PlaneRay::new(&box_ray);
+        // The triangle test's preparation waits for the first leaf: most
+        // camera rays of a framed object never reach one.
+        let mut prepared: Option<PreparedRay<T>> = None;
         let mut best = Best::new(ray);
         stack.clear();
         let mut current = ChildRef::node(0);
         loop {
             if current.is_leaf() {
-                if self.visit_leaf::<Q, C, T, F>(current, &prepared, &mut best, counter, filter) {
+                let prepared = prepared.get_or_insert_with(|| PreparedRay::with_boxes(ray, box_ray));
+                if self.visit_leaf::<Q, C, T, F>(current, prepared, &mut best, counter, filter) {
                     return best.hit;
                 }
             } else {
@@ -115,6 +120,15 @@ impl<const W: usize> WideBvh<W> {
                     let first = entered.trailing_zeros() as usize;
                     if entered & (entered - 1) == 0 {
                         current = node.children[first];
+                        continue;
+                    }
+                    let second = (entered & (entered - 1)).trailing_zeros() as usize;
+                    if entered.count_ones() == 2 {
+                        let (near, far) = if enter[second] < enter[first] { (second, first) } else { (first, second) };
+                        let far_entry = (node.children[far], enter[far]);
+                        self.prefetch(far_entry.0);
+                        stack.push(far_entry);
+                        current = node.children[near];
                         continue;
                     }
                     // Children entered, sorted far to near: the nearest is
