@@ -11,6 +11,7 @@ use rtgi_math::glam::BVec4A;
 use rtgi_math::{Vec3A, Vec4};
 
 use super::arith;
+use crate::triangle::TriangleHit;
 
 /// Four triangles, structure-of-arrays: `corners[c][axis]` holds the
 /// coordinate along `axis` of corner `c` of the four triangles. Lanes
@@ -59,15 +60,30 @@ impl TriangleBlock {
 }
 
 /// What a block test found: bit `i` of `exact` says that lane `i` was hit,
-/// at `t[i]` with barycentrics `beta[i]`, `gamma[i]`; bit `i` of `rescan`
-/// that the scalar test must decide lane `i`.
+/// at `t[i]` with barycentrics `beta[i]`, `gamma[i]` ([`BlockHits::hit`]);
+/// bit `i` of `rescan` that the scalar test must decide lane `i`.
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct BlockHits {
     pub(crate) exact: u32,
     pub(crate) rescan: u32,
     pub(crate) t: Vec4,
-    pub(crate) beta: Vec4,
-    pub(crate) gamma: Vec4,
+    /// The barycentrics are `beta_scaled / scale` and `gamma_scaled /
+    /// scale`, divided only for the lanes that are hit (the watertight
+    /// test's scaled barycentrics and determinant; Möller-Trumbore's
+    /// barycentrics over 1, which divides exactly).
+    beta_scaled: Vec4,
+    gamma_scaled: Vec4,
+    scale: Vec4,
+}
+
+impl BlockHits {
+    /// The hit in lane `lane` of [`BlockHits::exact`]: the bits the scalar
+    /// test computes for that lane's triangle.
+    #[inline(always)]
+    pub(crate) fn hit(&self, lane: usize) -> TriangleHit {
+        let scale = self.scale[lane];
+        TriangleHit { t: self.t[lane], beta: self.beta_scaled[lane] / scale, gamma: self.gamma_scaled[lane] / scale }
+    }
 }
 
 #[inline(always)]
@@ -95,7 +111,14 @@ pub(crate) fn watertight_block(
     let (det, t_scaled) = arith::watertight_det_and_scaled_t(uvw, zs);
     let t = t_scaled / det;
     let hit = !(negative & positive) & det.cmpne(zero) & det.is_finite_mask() & in_range(t, t_min, t_max);
-    BlockHits { exact: (hit & !rescan).bitmask(), rescan: rescan.bitmask(), t, beta: uvw[1] / det, gamma: uvw[2] / det }
+    BlockHits {
+        exact: (hit & !rescan).bitmask(),
+        rescan: rescan.bitmask(),
+        t,
+        beta_scaled: uvw[1],
+        gamma_scaled: uvw[2],
+        scale: det,
+    }
 }
 
 /// [`crate::triangle::MollerTrumbore`] on four triangles.
@@ -116,5 +139,12 @@ pub(crate) fn moller_trumbore_block(
         & beta.cmple(one)
         & !gamma.cmplt(zero)
         & !(beta + gamma).cmpgt(one);
-    BlockHits { exact: (inside & in_range(t, t_min, t_max)).bitmask(), rescan: 0, t, beta, gamma }
+    BlockHits {
+        exact: (inside & in_range(t, t_min, t_max)).bitmask(),
+        rescan: 0,
+        t,
+        beta_scaled: beta,
+        gamma_scaled: gamma,
+        scale: one,
+    }
 }

@@ -14,7 +14,7 @@ use crate::simd::boxes::PlaneRay;
 use crate::simd::triangles::TriangleBlock;
 use crate::simd::{Isa, Kernel, dispatch, prefetch};
 use crate::slab::BoxRay;
-use crate::triangle::{MollerTrumbore, TriangleHit, TriangleTest, Watertight};
+use crate::triangle::{MollerTrumbore, TriangleTest, Watertight};
 use crate::{Counter, Hit, Intersector};
 
 /// Children waiting to be visited, with the distance at which the ray
@@ -205,8 +205,7 @@ impl<const W: usize> WideBvh<W> {
                 let hit = if hits.rescan & (1 << lane) != 0 {
                     hit_triangle(ray, &triangle, best.t_max)
                 } else {
-                    let hit = TriangleHit { t: hits.t[lane], beta: hits.beta[lane], gamma: hits.gamma[lane] };
-                    box_rule(&ray.boxes, &triangle, hit, best.t_max)
+                    box_rule(&ray.boxes, &triangle, hits.hit(lane), best.t_max)
                 };
                 if let Some(hit) = hit
                     && best.offer(block.ids[lane], hit, filter)
