@@ -10,7 +10,7 @@ use std::time::Duration;
 use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
 use obvhs::BvhBuildParams;
 use obvhs::bvh2::builder::build_bvh2_from_tris;
-use rtgi_accel::{AccelKind, BuildParams};
+use rtgi_accel::AccelKind;
 use rtgi_benches::shared_scene;
 use rtgi_math::Ray;
 use rtgi_math::glam::Vec3A;
@@ -38,7 +38,7 @@ fn bvh(c: &mut Criterion) {
             .measurement_time(Duration::from_secs(3))
             .throughput(Throughput::Elements(triangles.len() as u64));
         for &kind in &variants {
-            group.bench_function(kind.name(), |b| b.iter(|| kind.build(&triangles, &BuildParams::default())));
+            group.bench_function(kind.name(), |b| b.iter(|| kind.build(&triangles, &kind.default_params())));
         }
         group.bench_function("obvhs-bvh2", |b| {
             b.iter(|| build_bvh2_from_tris(&peer_triangles, BvhBuildParams::medium_build(), &mut Duration::default()))
@@ -58,10 +58,20 @@ fn bvh(c: &mut Criterion) {
                 .measurement_time(Duration::from_secs(3))
                 .throughput(Throughput::Elements(rays.len() as u64));
             for &kind in &variants {
-                let accel = kind.build(&triangles, &BuildParams::default());
+                let accel = kind.build(&triangles, &kind.default_params());
                 group.bench_function(BenchmarkId::new("rtgi", kind.name()), |b| {
                     b.iter(|| rays.iter().filter(|r| accel.intersect(r).is_some()).count())
                 });
+                // The batch API: packets of 16 for the wide BVHs where rays are coherent.
+                if kind.node_width().is_some_and(|width| width > 2) {
+                    let mut hits = vec![None; rays.len()];
+                    group.bench_function(BenchmarkId::new("rtgi-batch", kind.name()), |b| {
+                        b.iter(|| {
+                            accel.intersect_batch(rays, &mut hits);
+                            hits.iter().filter(|h| h.is_some()).count()
+                        })
+                    });
+                }
             }
             group.bench_function(BenchmarkId::new("obvhs", "bvh2"), |b| {
                 b.iter(|| {

@@ -9,7 +9,8 @@
 //! Follows the method of `../shared/notes/peers.md`: 1024×1024 primary rays
 //! framing the bounding sphere with a 40° field of view, and 1,000,000
 //! incoherent rays from uniform points in the bounding box in uniform
-//! directions; closest hit. Timings on a shared machine drift, so the
+//! directions; closest hit. Each of our structures is built with its own
+//! defaults (`AccelKind::default_params`). Timings on a shared machine drift, so the
 //! contenders' runs alternate and each figure is the median of 15 runs
 //! (builds: 15 builds).
 
@@ -73,8 +74,9 @@ fn main() {
     println!("{}: {} triangles; medians of {RUNS} alternating runs", path.display(), triangles.len());
 
     let params = BuildParams::default();
-    let ours: Vec<(AccelKind, Box<dyn Accel>)> =
-        [AccelKind::Sah, AccelKind::Bvh4, AccelKind::Bvh8].map(|kind| (kind, kind.build(&triangles, &params))).into();
+    let ours: Vec<(AccelKind, Box<dyn Accel>)> = [AccelKind::Sah, AccelKind::Bvh4, AccelKind::Bvh8]
+        .map(|kind| (kind, kind.build(&triangles, &kind.default_params())))
+        .into();
     let peer_triangles: Vec<obvhs::triangle::Triangle> = triangles
         .iter()
         .map(|t| obvhs::triangle::Triangle { v0: Vec3A::from(t[0]), v1: Vec3A::from(t[1]), v2: Vec3A::from(t[2]) })
@@ -95,7 +97,7 @@ fn main() {
         hits.iter().filter(|h| h.is_some()).count()
     };
     let mut contenders = Vec::new();
-    let (triangles_ref, params_ref) = (&triangles, &params);
+    let triangles_ref = &triangles;
     for (kind, accel) in &ours {
         let (kind, accel) = (*kind, accel.as_ref());
         let names: [&'static str; 2] = match kind {
@@ -105,13 +107,13 @@ fn main() {
         };
         contenders.push(Contender {
             name: names[0],
-            build: Box::new(move || drop(kind.build(triangles_ref, params_ref))),
+            build: Box::new(move || drop(kind.build(triangles_ref, &kind.default_params()))),
             trace: Box::new(move |rays| one_at_a_time(accel, rays)),
         });
         if !names[1].is_empty() {
             contenders.push(Contender {
                 name: names[1],
-                build: Box::new(move || drop(kind.build(triangles_ref, params_ref))),
+                build: Box::new(move || drop(kind.build(triangles_ref, &kind.default_params()))),
                 trace: Box::new(move |rays| batched(accel, rays)),
             });
         }
