@@ -19,7 +19,7 @@ use std::time::{Duration, Instant};
 use obvhs::BvhBuildParams;
 use obvhs::bvh2::builder::build_bvh2_from_tris;
 use rayon::prelude::*;
-use rtgi_accel::{Accel, AccelKind, BuildParams, Hit};
+use rtgi_accel::{Accel, AccelKind, Hit};
 use rtgi_benches::workspace_root;
 use rtgi_math::Ray;
 use rtgi_math::glam::Vec3A;
@@ -73,7 +73,6 @@ fn main() {
     let incoherent = box_rays(&scene, 1_000_000, 1);
     println!("{}: {} triangles; medians of {RUNS} alternating runs", path.display(), triangles.len());
 
-    let params = BuildParams::default();
     let ours: Vec<(AccelKind, Box<dyn Accel>)> = [AccelKind::Sah, AccelKind::Bvh4, AccelKind::Bvh8]
         .map(|kind| (kind, kind.build(&triangles, &kind.default_params())))
         .into();
@@ -89,7 +88,8 @@ fn main() {
     let one_at_a_time = |accel: &dyn Accel, rays: &[Ray]| rays.iter().filter(|r| accel.intersect(r).is_some()).count();
 
     #[cfg(feature = "embree")]
-    let embree = AccelKind::Embree.try_build(&triangles, &params).unwrap_or_else(|e| panic!("{e}"));
+    let embree =
+        AccelKind::Embree.try_build(&triangles, &AccelKind::Embree.default_params()).unwrap_or_else(|e| panic!("{e}"));
     #[cfg_attr(not(feature = "embree"), allow(unused_mut))]
     let batched = |accel: &dyn Accel, rays: &[Ray]| {
         let mut hits: Vec<Option<Hit>> = vec![None; rays.len()];
@@ -133,7 +133,13 @@ fn main() {
     }]);
     #[cfg(feature = "embree")]
     {
-        let build_embree = || drop(AccelKind::Embree.try_build(&triangles, &params).unwrap_or_else(|e| panic!("{e}")));
+        let build_embree = || {
+            drop(
+                AccelKind::Embree
+                    .try_build(&triangles, &AccelKind::Embree.default_params())
+                    .unwrap_or_else(|e| panic!("{e}")),
+            )
+        };
         contenders.push(Contender {
             name: "embree 1",
             build: Box::new(build_embree),
