@@ -2,8 +2,10 @@
 //! obvhs do: each wide node takes the two children of a binary node and
 //! keeps opening the child with the largest surface area until it has `W`
 //! children or only leaves are left. Binary leaves become wide leaves whose
-//! triangles are copied, in order, into blocks of four.
+//! triangles are copied, in order, into blocks of four. The top levels'
+//! subtrees are collapsed in parallel and appended in depth-first order.
 
+use rayon::prelude::*;
 use rtgi_math::Vec3A;
 
 use super::node::{ChildRef, WideNode};
@@ -24,17 +26,42 @@ pub(crate) struct WideTree<const W: usize> {
     pub(crate) sah_cost: f32,
 }
 
+/// Wide nodes shallower than this collapse their children in parallel.
+const PARALLEL_DEPTH: usize = 2;
+
+impl<const W: usize> WideTree<W> {
+    fn empty(nodes: usize, blocks: usize) -> Self {
+        Self {
+            nodes: Vec::with_capacity(nodes),
+            blocks: Vec::with_capacity(blocks),
+            leaves: 0,
+            depth: 0,
+            sah_cost: 0.0,
+        }
+    }
+
+    /// Appends `subtree` (its root at its index 0), moving its references
+    /// past this tree's nodes and blocks; returns its root's reference.
+    fn append(&mut self, subtree: WideTree<W>) -> ChildRef {
+        let (node_offset, block_offset) = (self.nodes.len(), self.blocks.len());
+        self.nodes.extend(subtree.nodes.into_iter().map(|mut node| {
+            for child in &mut node.children {
+                *child = child.relocated(node_offset, block_offset);
+            }
+            node
+        }));
+        self.blocks.extend(subtree.blocks);
+        self.leaves += subtree.leaves;
+        self.depth = self.depth.max(subtree.depth);
+        ChildRef::node(node_offset)
+    }
+}
+
 pub(crate) fn collapse<const W: usize>(binary: &Bvh, traversal_cost: f32) -> WideTree<W> {
     const { assert!(W >= 2 && W <= 32) };
     let (triangles, ids) = binary.leaf_order();
     // Each wide node replaces at least one binary node; each block holds at least one triangle.
-    let mut tree = WideTree {
-        nodes: Vec::with_capacity(binary.nodes().len().div_ceil(2)),
-        blocks: Vec::with_capacity(triangles.len()),
-        leaves: 0,
-        depth: 0,
-        sah_cost: 0.0,
-    };
+    let mut tree = WideTree::empty(binary.nodes().len().div_ceil(2), triangles.len());
     let Some(root) = binary.nodes().first() else {
         return tree;
     };
@@ -109,10 +136,39 @@ impl Collapser<'_> {
             len += 1;
         }
         let mut wide = WideNode::EMPTY;
-        for (lane, &(child, _)) in children[..len].iter().enumerate() {
-            wide.boxes.set(lane, child.min().to_array(), child.max().to_array());
-            wide.children[lane] =
-                if child.is_leaf() { self.leaf(child, tree, cost) } else { self.node(child, depth + 1, tree, cost) };
+        let children = &children[..len];
+        if depth < PARALLEL_DEPTH {
+            // Near the root, the children's subtrees are collapsed in
+            // parallel into trees of their own, then appended in order.
+            let subtrees: Vec<Option<(WideTree<W>, f64)>> = children
+                .par_iter()
+                .map(|&(child, _)| {
+                    (!child.is_leaf()).then(|| {
+                        let (mut subtree, mut subtree_cost) = (WideTree::empty(0, 0), 0.0);
+                        self.node(child, depth + 1, &mut subtree, &mut subtree_cost);
+                        (subtree, subtree_cost)
+                    })
+                })
+                .collect();
+            for (lane, (&(child, _), subtree)) in children.iter().zip(subtrees).enumerate() {
+                wide.boxes.set(lane, child.min().to_array(), child.max().to_array());
+                wide.children[lane] = match subtree {
+                    None => self.leaf(child, tree, cost),
+                    Some((subtree, subtree_cost)) => {
+                        *cost += subtree_cost;
+                        tree.append(subtree)
+                    }
+                };
+            }
+        } else {
+            for (lane, &(child, _)) in children.iter().enumerate() {
+                wide.boxes.set(lane, child.min().to_array(), child.max().to_array());
+                wide.children[lane] = if child.is_leaf() {
+                    self.leaf(child, tree, cost)
+                } else {
+                    self.node(child, depth + 1, tree, cost)
+                };
+            }
         }
         tree.nodes[index] = wide;
         ChildRef::node(index)

@@ -128,3 +128,82 @@ impl<const W: usize> Structure for WideBvh<W> {
         &self.stats
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::simd::triangles::TriangleBlock;
+    use rtgi_math::Rng;
+
+    /// Every hittable triangle in exactly one block, every child box holding
+    /// what lies below it, and references that stay inside the arrays: the
+    /// invariants the parallel collapse must keep when it appends subtrees.
+    fn check_tree<const W: usize>(bvh: &WideBvh<W>, triangles: &[[Vec3; 3]]) {
+        let mut seen = vec![0u32; triangles.len()];
+        let mut stack = vec![0usize];
+        let mut visited = 0;
+        while let Some(index) = stack.pop() {
+            visited += 1;
+            let node = &bvh.nodes[index];
+            for lane in 0..W {
+                let child = node.children[lane];
+                if child == ChildRef::NONE {
+                    continue;
+                }
+                let p = &node.boxes.planes;
+                let (min, max) =
+                    (Vec3::new(p[0][lane], p[1][lane], p[2][lane]), Vec3::new(p[3][lane], p[4][lane], p[5][lane]));
+                let holds = |point: Vec3| point.cmpge(min).all() && point.cmple(max).all();
+                if child.is_leaf() {
+                    for block in &bvh.blocks[child.blocks()] {
+                        for lane in 0..TriangleBlock::LANES {
+                            if block.ids[lane] == TriangleBlock::NO_TRIANGLE {
+                                continue;
+                            }
+                            seen[block.ids[lane] as usize] += 1;
+                            assert!(
+                                block.triangle(lane).iter().all(|&c| holds(c.into())),
+                                "triangle outside its leaf's box"
+                            );
+                        }
+                    }
+                } else {
+                    let below = &bvh.nodes[child.node_index()];
+                    for l in 0..W {
+                        if below.children[l] != ChildRef::NONE {
+                            let q = &below.boxes.planes;
+                            assert!(
+                                holds(Vec3::new(q[0][l], q[1][l], q[2][l]))
+                                    && holds(Vec3::new(q[3][l], q[4][l], q[5][l]))
+                            );
+                        }
+                    }
+                    stack.push(child.node_index());
+                }
+            }
+        }
+        assert_eq!(visited, bvh.nodes.len(), "every node reachable once");
+        for (index, triangle) in triangles.iter().enumerate() {
+            assert_eq!(seen[index], crate::is_hittable(triangle) as u32, "triangle {index}");
+        }
+    }
+
+    #[test]
+    fn collapsed_trees_hold_every_triangle_once_inside_their_boxes() {
+        let mut rng = Rng::new(17, 3);
+        let mut point = |scale: f32| Vec3::new(rng.next_f32(), rng.next_f32(), rng.next_f32()) * scale;
+        let mut triangles: Vec<[Vec3; 3]> = (0..20_000)
+            .map(|_| {
+                let base = point(100.0);
+                [base, base + point(2.0), base + point(2.0)]
+            })
+            .collect();
+        triangles.push([Vec3::ZERO, Vec3::X, 2.0 * Vec3::X]);
+        for max_leaf_size in [1, 4, 8, 16] {
+            let params = BuildParams { max_leaf_size, ..BuildParams::default() };
+            check_tree(&Bvh4::new(&triangles, SplitMethod::BinnedSah, &params), &triangles);
+            check_tree(&Bvh8::new(&triangles, SplitMethod::BinnedSah, &params), &triangles);
+        }
+        check_tree(&Bvh8::new(&triangles[..1], SplitMethod::BinnedSah, &BuildParams::default()), &triangles[..1]);
+    }
+}
