@@ -8,7 +8,7 @@ use rayon::prelude::*;
 use rtgi_accel::{Accel, AccelKind, BuildParams, BuildStats, Intersector, Traversal, TraversalCounters};
 use rtgi_math::Ray;
 use rtgi_render::probes::{closed_mesh_probe, shared_edge_probe};
-use rtgi_render::rays::{primary_rays, surface_rays, throughput};
+use rtgi_render::rays::{batch_throughput, primary_rays, surface_rays, throughput};
 use serde::Serialize;
 
 use crate::cli::BenchArgs;
@@ -207,8 +207,8 @@ fn measure_variant(
             accel.intersect_batch(chunk, &mut hits);
             hits.iter().filter(|h| h.is_some()).count()
         };
-        let batch_mrays_1_thread = batch_throughput(&rays, single, timed_repeats, &batch_trace);
-        let batch_mrays_all_threads = batch_throughput(&rays, pool, timed_repeats, &batch_trace);
+        let batch_mrays_1_thread = batch_throughput(&rays, single, timed_repeats, batch_trace);
+        let batch_mrays_all_threads = batch_throughput(&rays, pool, timed_repeats, batch_trace);
         let (counters, hits) = count(accel.as_ref(), &rays, pool);
         let per_ray = |n: u64| n as f64 / rays.len().max(1) as f64;
         BatchReport {
@@ -239,26 +239,6 @@ fn measure_variant(
         primary,
         incoherent,
     })
-}
-
-/// Million rays a second through `trace`, which answers a chunk of rays
-/// and returns its hits: the median of `repeats` runs after a warm-up.
-fn batch_throughput(
-    rays: &[Ray],
-    pool: &rayon::ThreadPool,
-    repeats: usize,
-    trace: &(dyn Fn(&[Ray]) -> usize + Sync),
-) -> f64 {
-    let run = || {
-        let start = Instant::now();
-        let hits: usize = pool.install(|| rays.par_chunks(1024).map(trace).sum());
-        std::hint::black_box(hits);
-        start.elapsed().as_secs_f64()
-    };
-    run();
-    let mut seconds: Vec<f64> = (0..repeats.max(1)).map(|_| run()).collect();
-    seconds.sort_by(f64::total_cmp);
-    rays.len() as f64 / seconds[seconds.len() / 2].max(1e-12) * 1e-6
 }
 
 /// Traversal work and hits of a batch.

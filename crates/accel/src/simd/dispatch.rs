@@ -204,49 +204,15 @@ impl Isa for Portable {
 
 /// Proof that the CPU runs AVX2 and FMA: made only by `run_avx2`, which
 /// `dispatch` calls after detecting those features.
+#[cfg(target_arch = "x86_64")]
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct Avx2(());
 
 /// Proof that the CPU runs AVX-512 (F, VL, BW, DQ, CD) and AVX2: made only
 /// by `run_avx512`, which `dispatch` calls after detecting those features.
+#[cfg(target_arch = "x86_64")]
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct Avx512(());
-
-#[cfg(not(target_arch = "x86_64"))]
-impl Isa for Avx2 {
-    fn enter_boxes<const W: usize>(self, boxes: &WideBoxes<W>, ray: &PlaneRay, t_max: f32) -> (u32, [f32; W]) {
-        Portable.enter_boxes(boxes, ray, t_max)
-    }
-
-    fn enter_box_packet(
-        self,
-        near: [f32; 3],
-        far: [f32; 3],
-        rays: &PacketRays,
-        t_max: &Lanes,
-        active: u32,
-    ) -> (u32, f32) {
-        Portable.enter_box_packet(near, far, rays, t_max, active)
-    }
-}
-
-#[cfg(not(target_arch = "x86_64"))]
-impl Isa for Avx512 {
-    fn enter_boxes<const W: usize>(self, boxes: &WideBoxes<W>, ray: &PlaneRay, t_max: f32) -> (u32, [f32; W]) {
-        Portable.enter_boxes(boxes, ray, t_max)
-    }
-
-    fn enter_box_packet(
-        self,
-        near: [f32; 3],
-        far: [f32; 3],
-        rays: &PacketRays,
-        t_max: &Lanes,
-        active: u32,
-    ) -> (u32, f32) {
-        Portable.enter_box_packet(near, far, rays, t_max, active)
-    }
-}
 
 #[cfg(target_arch = "x86_64")]
 impl Isa for Avx2 {
