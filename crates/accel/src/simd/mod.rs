@@ -1,14 +1,16 @@
 //! SIMD kernels of the wide BVHs, and the run-time choice of instruction
-//! set ([`dispatch`](self::dispatch), the crate's one module with `unsafe`).
+//! set: [`SimdLevel`], detected once ([`active_simd_level`]) and lowered
+//! on request ([`limit_simd_level`]), to compare levels.
 //!
-//! - [`boxes`](self::boxes): one ray against the `W` child boxes of a wide
-//!   node, stored structure-of-arrays, with the robust slab test's
-//!   arithmetic lane by lane.
-//! - [`triangles`](self::triangles): one ray against a block of four
-//!   triangles, stored structure-of-arrays.
-//! - [`arith`](self::arith): the ray/triangle arithmetic written once,
-//!   generic over one lane (`f32`) or four (`Vec4`), so that the scalar
-//!   tests and the block tests compute the same values, bit for bit.
+//! Inside the crate: `boxes.rs` tests one ray against the `W` child boxes
+//! of a wide node, stored structure-of-arrays, with the robust slab test's
+//! arithmetic lane by lane; `triangles.rs` tests one ray against a block of
+//! four triangles, stored structure-of-arrays; `arith.rs` holds the
+//! ray/triangle arithmetic written once, generic over one lane (`f32`) or
+//! four (`Vec4`), so that the scalar tests and the block tests compute the
+//! same values, bit for bit; `dispatch.rs` (with the Embree binding, one of
+//! the two modules allowed `unsafe`) runs each hot loop compiled for the
+//! widest level the CPU has, with intrinsic kernels beside portable twins.
 
 pub(crate) mod arith;
 pub(crate) mod boxes;
