@@ -376,6 +376,94 @@ fn enter_box_packet_avx512(near: [f32; 3], far: [f32; 3], rays: &PacketRays, t_m
     }
     let entered = _mm512_cmp_ps_mask::<_CMP_LE_OQ>(enter, exit)
         & _mm512_cmp_ps_mask::<_CMP_LT_OQ>(enter, _mm512_set1_ps(f32::INFINITY));
-    let earliest = _mm512_mask_reduce_min_ps(entered, enter);
+    // The masked reduction of no lanes gives f32::MAX; the portable kernel's +∞ is kept.
+    let earliest = if entered == 0 { f32::INFINITY } else { _mm512_mask_reduce_min_ps(entered, enter) };
     (entered as u32 & active, earliest)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::slab::BoxRay;
+    use rtgi_math::{Ray, Rng, Vec3};
+
+    /// Runs the box kernels of the active level on one case, beside the
+    /// portable ones: node boxes for one ray, and one box for a packet.
+    struct Compare<'a> {
+        boxes: &'a WideBoxes<8>,
+        ray: &'a PlaneRay,
+        packet: &'a PacketRays,
+        t_max: f32,
+        packet_t_max: &'a Lanes,
+    }
+
+    impl Kernel for Compare<'_> {
+        type Output = ((u32, [f32; 8]), (u32, [f32; 8]), Vec<((u32, f32), (u32, f32))>);
+
+        #[inline(always)]
+        fn run<I: Isa>(self, isa: I) -> Self::Output {
+            let node = (
+                isa.enter_boxes(self.boxes, self.ray, self.t_max),
+                Portable.enter_boxes(self.boxes, self.ray, self.t_max),
+            );
+            let packets = (0..8)
+                .map(|lane| {
+                    let planes = &self.boxes.planes;
+                    let near = [0, 1, 2].map(|axis| planes[self.packet.near[axis]][lane]);
+                    let far = [0, 1, 2].map(|axis| planes[self.packet.near[axis] ^ FAR_OF_NEAR[axis]][lane]);
+                    (
+                        isa.enter_box_packet(near, far, self.packet, self.packet_t_max, 0xffff),
+                        Portable.enter_box_packet(near, far, self.packet, self.packet_t_max, 0xffff),
+                    )
+                })
+                .collect();
+            (node.0, node.1, packets)
+        }
+    }
+
+    /// The intrinsic kernels of every level the CPU has compute the bits
+    /// of the portable ones, on boxes and rays with zeros, ±0 direction
+    /// components, origins on box planes and NaN-producing `0 · ∞`.
+    #[test]
+    fn every_level_computes_the_portable_kernels_bits() {
+        let detected = SimdLevel::detected();
+        let mut rng = Rng::new(41, 7);
+        let coordinate = |rng: &mut Rng| match rng.next_u32() % 6 {
+            0 => 0.0,
+            1 => 1.0,
+            2 => -0.0,
+            _ => rng.next_f32() * 8.0 - 4.0,
+        };
+        for _ in 0..3000 {
+            let mut boxes = WideBoxes::<8>::EMPTY;
+            for lane in 0..7 {
+                let (a, b) = ([0; 3].map(|_| coordinate(&mut rng)), [0; 3].map(|_| coordinate(&mut rng)));
+                boxes.set(
+                    lane,
+                    Vec3::from(a).min(Vec3::from(b)).to_array(),
+                    Vec3::from(a).max(Vec3::from(b)).to_array(),
+                );
+            }
+            let direction = Vec3::from([0; 3].map(|_| coordinate(&mut rng)));
+            let direction = if direction == Vec3::ZERO { Vec3::new(-0.0, 0.5, 1.0) } else { direction };
+            let rays: Vec<Ray> =
+                (0..PACKET).map(|_| Ray::new(Vec3::from([0; 3].map(|_| coordinate(&mut rng))), direction)).collect();
+            let packet = PacketRays::new(&rays).expect("equal directions are coherent");
+            let ray = PlaneRay::new(&BoxRay::new(&rays[0]));
+            let t_max = if rng.next_u32().is_multiple_of(2) { f32::INFINITY } else { rng.next_f32() * 4.0 };
+            let packet_t_max = Lanes(std::array::from_fn(|_| rng.next_f32() * 8.0));
+            for &level in SimdLevel::ALL.iter().filter(|&&level| level <= detected) {
+                limit_simd_level(level);
+                let (node, portable_node, packets) =
+                    dispatch(Compare { boxes: &boxes, ray: &ray, packet: &packet, t_max, packet_t_max: &packet_t_max });
+                assert_eq!(node.0, portable_node.0, "{level}");
+                assert_eq!(node.1.map(f32::to_bits), portable_node.1.map(f32::to_bits), "{level}");
+                for (ours, portable) in packets {
+                    assert_eq!(ours.0, portable.0, "{level}");
+                    assert_eq!(ours.1.to_bits(), portable.1.to_bits(), "{level}");
+                }
+            }
+        }
+        limit_simd_level(detected);
+    }
 }

@@ -56,7 +56,7 @@ impl PacketRays {
     /// The packet of `rays` (at most [`PACKET`]), or `None` if they are
     /// not coherent: an invalid ray, direction signs that differ, or
     /// directions too far apart.
-    fn new(rays: &[Ray]) -> Option<Self> {
+    pub(crate) fn new(rays: &[Ray]) -> Option<Self> {
         debug_assert!(rays.len() <= PACKET);
         let first = rays.first()?;
         let sign_bits = |ray: &Ray| ray.direction.is_negative_bitmask();
