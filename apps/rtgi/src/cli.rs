@@ -526,7 +526,7 @@ pub(crate) struct BuildArgs {
     #[arg(long, default_value_t = Intersector::default())]
     pub(crate) intersector: Intersector,
 
-    /// BVH slab test: robust, fast
+    /// Slab test of the binary BVHs: robust, fast (the wide BVHs always use the robust one)
     #[arg(long, default_value_t = Traversal::default())]
     pub(crate) traversal: Traversal,
 }

@@ -36,7 +36,7 @@ pub struct BuildParams {
     pub traversal_cost: f32,
     /// The ray/triangle test every query uses.
     pub intersector: Intersector,
-    /// The slab test of BVH traversal.
+    /// The slab test of the binary BVHs' traversal (the wide BVHs always use the robust one).
     pub traversal: Traversal,
 }
 
