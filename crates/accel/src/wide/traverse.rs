@@ -122,6 +122,19 @@ impl<const W: usize> WideBvh<W> {
                         current = node.children[first];
                         continue;
                     }
+                    if Q::STOP_AT_FIRST_HIT {
+                        // Any hit ends the search, wherever it is: no order
+                        // pays for sorting. The first child is visited now.
+                        let mut lanes = entered & (entered - 1);
+                        while lanes != 0 {
+                            let lane = lanes.trailing_zeros() as usize;
+                            lanes &= lanes - 1;
+                            self.prefetch(node.children[lane]);
+                            stack.push((node.children[lane], enter[lane]));
+                        }
+                        current = node.children[first];
+                        continue;
+                    }
                     let second = (entered & (entered - 1)).trailing_zeros() as usize;
                     if entered.count_ones() == 2 {
                         let (near, far) = if enter[second] < enter[first] { (second, first) } else { (first, second) };
