@@ -8,6 +8,13 @@
 //! the hit point, so that the caller can interpolate its own vertex data:
 //! `p = (1 - beta - gamma) * v0 + beta * v1 + gamma * v2`.
 //!
+//! The structures ([`AccelKind`]): the linear scan ([`LinearScan`]), binary
+//! BVHs ([`Bvh`]) and wide BVHs ([`Bvh4`], [`Bvh8`]) whose nodes and leaves
+//! are tested with SIMD instructions chosen at run time ([`simd`]). Many
+//! rays can be answered at once ([`Accel::intersect_batch`],
+//! [`Accel::occluded_batch`]); the wide BVHs then trace coherent runs of
+//! sixteen rays as packets, with the same answers.
+//!
 //! ```
 //! use rtgi_accel::{Accel, AccelKind, BuildParams};
 //! use rtgi_math::{Ray, Vec3};
