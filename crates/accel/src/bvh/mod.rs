@@ -264,6 +264,23 @@ mod tests {
     }
 
     #[test]
+    fn long_ranges_partitioned_in_parallel_give_valid_exact_trees() {
+        // Ranges of at least 32k primitives are binned and partitioned on
+        // all threads; the tree must still be valid and exact.
+        let triangles = random_soup(100_000, 5);
+        let linear = crate::LinearScan::new(&triangles, crate::Intersector::default());
+        let bvh = Bvh::new(&triangles, SplitMethod::BinnedSah, &BuildParams::default());
+        bvh.validate().unwrap();
+        let mut rng = Rng::new(6, 0);
+        for _ in 0..300 {
+            let o = Vec3::new(rng.next_f32(), rng.next_f32(), rng.next_f32()) * 14.0 - 2.0;
+            let d = Vec3::new(rng.next_f32(), rng.next_f32(), rng.next_f32()) - 0.5;
+            let ray = Ray::new(o, d);
+            assert_eq!(bvh.intersect(&ray), linear.intersect(&ray));
+        }
+    }
+
+    #[test]
     fn identical_centroids_build_shallow_trees_with_small_leaves() {
         // 70,000 copies of one triangle: no heuristic can separate them.
         let triangle = [Vec3::ZERO, Vec3::X, Vec3::Y];
