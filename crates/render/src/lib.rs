@@ -327,32 +327,15 @@ fn render_pixels(
     progress: &(dyn Fn(u64) + Sync),
     pixel: impl Fn(u32, u32) -> (Vec3, u64) + Sync,
 ) -> (HdrImage, u64) {
-    let tile_pixels: Vec<(Vec<Vec3>, u64)> = tiles(width, height)
-        .into_par_iter()
-        .map(|(x0, y0, x1, y1)| {
-            let mut rays = 0;
-            let pixels: Vec<Vec3> = (y0..y1)
-                .flat_map(|y| (x0..x1).map(move |x| (x, y)))
-                .map(|(x, y)| {
-                    let (value, traced) = pixel(x, y);
-                    rays += traced;
-                    value
-                })
-                .collect();
-            progress(pixels.len() as u64);
-            (pixels, rays)
-        })
-        .collect();
-    let mut image = HdrImage::new(width, height);
-    let mut rays = 0;
-    for ((x0, y0, x1, _), (pixels, traced)) in tiles(width, height).into_iter().zip(tile_pixels) {
-        let tile_width = (x1 - x0) as usize;
-        rays += traced;
-        for (i, value) in pixels.into_iter().enumerate() {
-            image.set(x0 + (i % tile_width) as u32, y0 + (i / tile_width) as u32, value);
+    render_blocks(width, height, progress, |pixels, values| {
+        let mut traced = 0;
+        for (&(x, y), value) in pixels.iter().zip(values) {
+            let (computed, rays) = pixel(x, y);
+            *value = computed;
+            traced += rays;
         }
-    }
-    (image, rays)
+        traced
+    })
 }
 
 /// [`render_pixels`] a block of pixels at a time: each tile is cut into
@@ -366,24 +349,21 @@ fn render_blocks(
 ) -> (HdrImage, u64) {
     // Per tile: its pixels, their values, and the rays traced.
     type Tile = (Vec<(u32, u32)>, Vec<Vec3>, u64);
+    let step = rays::TILE as usize;
     let tile_pixels: Vec<Tile> = tiles(width, height)
         .into_par_iter()
         .map(|(x0, y0, x1, y1)| {
-            let pixels: Vec<(u32, u32)> = rays::tile_order(x1 - x0, y1 - y0).map(|(x, y)| (x0 + x, y0 + y)).collect();
-            let mut values = vec![Vec3::ZERO; pixels.len()];
-            let block_size = (rays::TILE * rays::TILE) as usize;
-            let mut traced = 0;
-            // `tile_order` lists whole blocks first-to-last; cut at block borders.
-            let mut start = 0;
-            while start < pixels.len() {
-                let (bx, by) = ((pixels[start].0 - x0) / rays::TILE, (pixels[start].1 - y0) / rays::TILE);
-                let len = pixels[start..]
-                    .iter()
-                    .take(block_size)
-                    .take_while(|&&(x, y)| (x - x0) / rays::TILE == bx && (y - y0) / rays::TILE == by)
-                    .count();
-                traced += block(&pixels[start..start + len], &mut values[start..start + len]);
-                start += len;
+            let (mut pixels, mut values, mut traced) = (Vec::new(), Vec::new(), 0);
+            for by in (y0..y1).step_by(step) {
+                for bx in (x0..x1).step_by(step) {
+                    let start = pixels.len();
+                    pixels.extend(
+                        (by..(by + rays::TILE).min(y1))
+                            .flat_map(|y| (bx..(bx + rays::TILE).min(x1)).map(move |x| (x, y))),
+                    );
+                    values.resize(pixels.len(), Vec3::ZERO);
+                    traced += block(&pixels[start..], &mut values[start..]);
+                }
             }
             progress(pixels.len() as u64);
             (pixels, values, traced)

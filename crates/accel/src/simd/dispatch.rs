@@ -243,14 +243,11 @@ impl Isa for Avx2 {
 
 #[cfg(target_arch = "x86_64")]
 impl Isa for Avx512 {
+    /// Eight lanes fit a 256-bit register: the AVX2 kernel, which this
+    /// level's CPUs run (`SimdLevel::detected` requires AVX2 for AVX-512).
     #[inline(always)]
     fn enter_boxes<const W: usize>(self, boxes: &WideBoxes<W>, ray: &PlaneRay, t_max: f32) -> (u32, [f32; W]) {
-        if !W.is_multiple_of(8) {
-            return boxes.enter(ray, t_max);
-        }
-        // SAFETY: an `Avx512` exists only where the CPU was seen to run
-        // AVX-512 and AVX2 (see the type); the kernel needs AVX2.
-        unsafe { enter_boxes_avx2(boxes, ray, t_max) }
+        Avx2(()).enter_boxes(boxes, ray, t_max)
     }
 
     #[inline(always)]

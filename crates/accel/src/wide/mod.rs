@@ -71,6 +71,18 @@ impl<const W: usize> WideBvh<W> {
     }
 }
 
+/// Inserts `entry` among the first `count` entries of `sorted`, kept in
+/// decreasing order of `enter` (far to near, so that the nearest is last).
+#[inline(always)]
+fn insert_far_to_near<T: Copy>(sorted: &mut [T], count: usize, entry: T, enter: impl Fn(&T) -> f32) {
+    let mut at = count;
+    while at > 0 && enter(&sorted[at - 1]) < enter(&entry) {
+        sorted[at] = sorted[at - 1];
+        at -= 1;
+    }
+    sorted[at] = entry;
+}
+
 impl<const W: usize> WideBvh<W> {
     /// The boxes of all nodes and leaves at the given depths (the root, the
     /// union of its children's boxes, is depth 0); a leaf shallower than a

@@ -17,9 +17,9 @@ use std::marker::PhantomData;
 
 use rtgi_math::{Ray, Vec4};
 
-use super::WideBvh;
 use super::node::ChildRef;
 use super::traverse::TraversalStack;
+use super::{WideBvh, insert_far_to_near};
 use crate::contract::{AcceptAll, Best, PreparedRay, QueryKind};
 use crate::simd::boxes::FAR_OF_NEAR;
 use crate::simd::{Isa, Kernel, dispatch};
@@ -203,14 +203,8 @@ impl<const W: usize> WideBvh<W> {
                     let far = [0, 1, 2].map(|axis| planes[packet.near[axis] ^ FAR_OF_NEAR[axis]][lane]);
                     let (rays_in, enter) = isa.enter_box_packet(near, far, packet, &t_max, active);
                     if rays_in != 0 {
-                        // Sorted far to near.
                         let entry = PacketEntry { child, rays: rays_in, enter };
-                        let mut at = count;
-                        while at > 0 && entered[at - 1].enter < enter {
-                            entered[at] = entered[at - 1];
-                            at -= 1;
-                        }
-                        entered[at] = entry;
+                        insert_far_to_near(&mut entered, count, entry, |e| e.enter);
                         count += 1;
                     }
                 }

@@ -7,8 +7,8 @@ use std::marker::PhantomData;
 
 use rtgi_math::Ray;
 
-use super::WideBvh;
 use super::node::{ChildRef, WideNode};
+use super::{WideBvh, insert_far_to_near};
 use crate::contract::{Best, HitFilter, PreparedRay, QueryKind, box_rule, hit_triangle};
 use crate::simd::boxes::PlaneRay;
 use crate::simd::triangles::TriangleBlock;
@@ -152,13 +152,7 @@ impl<const W: usize> WideBvh<W> {
                     while lanes != 0 {
                         let lane = lanes.trailing_zeros() as usize;
                         lanes &= lanes - 1;
-                        let entry = (node.children[lane], enter[lane]);
-                        let mut at = count;
-                        while at > 0 && sorted[at - 1].1 < entry.1 {
-                            sorted[at] = sorted[at - 1];
-                            at -= 1;
-                        }
-                        sorted[at] = entry;
+                        insert_far_to_near(&mut sorted, count, (node.children[lane], enter[lane]), |e| e.1);
                         count += 1;
                     }
                     for &entry in &sorted[..count - 1] {
