@@ -29,4 +29,4 @@ pub use glam;
 pub use glam::{BVec3A, Mat3, Mat4, Vec2, Vec3, Vec3A, Vec4, vec2, vec3};
 pub use ray::{Ray, RayWithInverse};
 pub use rng::{Rng, hash_u64};
-pub use spawn::{MAX_ELONGATION, SurfacePoint, elongation, geometric_normal, offset_ray_origin};
+pub use spawn::{MAX_ELONGATION, SurfacePoint, TriangleShape, elongation, geometric_normal, offset_ray_origin};

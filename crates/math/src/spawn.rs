@@ -34,14 +34,15 @@ impl SurfacePoint {
     /// ray/triangle test's distances, so that rays leaving the point never
     /// hit the triangle again.
     pub fn on_triangle(corners: &[Vec3; 3], beta: f32, gamma_: f32) -> Self {
-        Self::on_triangle_with_normal(corners, beta, gamma_, geometric_normal(corners))
+        Self::on_triangle_with_shape(corners, beta, gamma_, TriangleShape::of(corners))
     }
 
-    /// [`SurfacePoint::on_triangle`] for a triangle whose unit normal is
-    /// already known (renderers keep them, as the square roots and divisions
-    /// of [`geometric_normal`] are a noticeable share of a path tracer's time).
+    /// [`SurfacePoint::on_triangle`] for a triangle whose shape is already
+    /// known (renderers keep them: the double-precision square roots and
+    /// divisions of [`TriangleShape::of`] are a noticeable share of a path
+    /// tracer's time).
     #[inline]
-    pub fn on_triangle_with_normal(corners: &[Vec3; 3], beta: f32, gamma_: f32, normal: Vec3) -> Self {
+    pub fn on_triangle_with_shape(corners: &[Vec3; 3], beta: f32, gamma_: f32, shape: TriangleShape) -> Self {
         let alpha = 1.0 - beta - gamma_;
         let [p0, p1, p2] = corners;
         let position = alpha * *p0 + beta * *p1 + gamma_ * *p2;
@@ -58,8 +59,8 @@ impl SurfacePoint {
         // capped at 64 so that needles do not open gaps that leak light;
         // needles more elongated than that may still be hit again.
         let extent = (*p0 - position).abs().max((*p1 - position).abs()).max((*p2 - position).abs()).max_element();
-        let error = rounding + Vec3::splat(16.0 * f32::EPSILON * extent * elongation(corners).min(MAX_ELONGATION));
-        Self { position, error, normal }
+        let error = rounding + Vec3::splat(16.0 * f32::EPSILON * extent * shape.elongation.min(MAX_ELONGATION));
+        Self { position, error, normal: shape.normal }
     }
 
     /// The origin for a ray leaving this point towards `direction`.
@@ -92,6 +93,21 @@ impl SurfacePoint {
     pub fn spawn_ray_to_point(&self, target: Vec3) -> Ray {
         let from = self.offset_origin(target - self.position);
         Ray::with_range(from, target - from, SPAWN_T_MIN, SHADOW_T_MAX)
+    }
+}
+
+/// What rays leaving a triangle need of it besides its corners: its unit
+/// geometric normal and its [`elongation`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TriangleShape {
+    /// Unit geometric normal (either side), or zero for a degenerate triangle.
+    pub normal: Vec3,
+    pub elongation: f32,
+}
+
+impl TriangleShape {
+    pub fn of(corners: &[Vec3; 3]) -> Self {
+        Self { normal: geometric_normal(corners), elongation: elongation(corners) }
     }
 }
 

@@ -7,7 +7,7 @@
 //! as one with the effect forced on: the images agree, which the tests check.
 
 use rtgi_accel::{Accel, Hit};
-use rtgi_math::{Frame, Ray, Rng, SurfacePoint, Vec2, Vec3, Vec4, geometric_normal};
+use rtgi_math::{Frame, Ray, Rng, SurfacePoint, TriangleShape, Vec2, Vec3, Vec4};
 use rtgi_scene::{Material, Scene, SurfaceModel, Triangle};
 
 use crate::bsdf::Bsdf;
@@ -134,8 +134,8 @@ pub(crate) struct Transport<'a, A: Accel + ?Sized> {
     glossy: bool,
     refraction: bool,
     normal_maps: bool,
-    /// Unit geometric normal of every triangle.
-    normals: Vec<Vec3>,
+    /// Normal and elongation of every triangle, for the points spawning rays.
+    shapes: Vec<TriangleShape>,
 }
 
 /// A surface hit, ready to scatter light.
@@ -181,10 +181,10 @@ impl<'a, A: Accel + ?Sized> Transport<'a, A> {
             glossy: plan.has(Effect::Glossy),
             refraction: plan.has(Effect::Refraction),
             normal_maps: plan.has(Effect::NormalMaps),
-            normals: scene
+            shapes: scene
                 .triangles
                 .iter()
-                .map(|t| geometric_normal(&t.vertices.map(|v| scene.vertices[v as usize].position)))
+                .map(|t| TriangleShape::of(&t.vertices.map(|v| scene.vertices[v as usize].position)))
                 .collect(),
         }
     }
@@ -357,8 +357,7 @@ impl<'a, A: Accel + ?Sized> Transport<'a, A> {
     fn interact<const S: u32>(&self, hit: &Hit, triangle: &Triangle, material: &Material, u_lobe: f32) -> Interaction {
         let scene = self.scene;
         let corners = triangle.vertices.map(|v| scene.vertices[v as usize].position);
-        let point =
-            SurfacePoint::on_triangle_with_normal(&corners, hit.beta, hit.gamma, self.normals[hit.triangle as usize]);
+        let point = SurfacePoint::on_triangle_with_shape(&corners, hit.beta, hit.gamma, self.shapes[hit.triangle as usize]);
         let mut normal = scene.interpolate(triangle, hit.beta, hit.gamma, |v| v.normal);
         let mut base_color = material.base_color;
         let mut roughness = material.roughness;

@@ -10,7 +10,7 @@ use std::f32::consts::PI;
 use std::path::Path;
 
 use rtgi_image::{HdrImage, ImageError};
-use rtgi_math::{Ray, SurfacePoint, Vec2, Vec3};
+use rtgi_math::{Ray, SurfacePoint, TriangleShape, Vec2, Vec3};
 use rtgi_scene::{LightKind, Scene, SurfaceModel, TextureId};
 
 use crate::distribution::Distribution1D;
@@ -198,6 +198,8 @@ pub struct EmissiveTriangle {
     pub uvs: [Vec2; 3],
     /// Unit geometric normal (right-hand rule); the front side.
     pub normal: Vec3,
+    /// The triangle's [`rtgi_math::elongation`], for the error bound of points on it.
+    pub elongation: f32,
     pub area: f32,
     pub emission: Vec3,
     pub texture: Option<TextureId>,
@@ -310,6 +312,7 @@ impl LightSet {
                     corners,
                     uvs: triangle.vertices.map(|v| scene.vertices[v as usize].uv),
                     normal: cross / (2.0 * area),
+                    elongation: rtgi_math::elongation(&corners),
                     area,
                     emission: material.emission,
                     texture: material.emission_texture,
@@ -395,7 +398,12 @@ impl LightSet {
                 // Uniform on the triangle (the square-root warp of Turk 1990).
                 let s = u.x.sqrt();
                 let (beta, gamma) = (s * (1.0 - u.y), s * u.y);
-                let target = SurfacePoint::on_triangle_with_normal(&emitter.corners, beta, gamma, emitter.normal);
+                let target = SurfacePoint::on_triangle_with_shape(
+                    &emitter.corners,
+                    beta,
+                    gamma,
+                    TriangleShape { normal: emitter.normal, elongation: emitter.elongation },
+                );
                 let offset = target.position - p;
                 let distance2 = offset.length_squared();
                 let wi = offset / distance2.sqrt();
