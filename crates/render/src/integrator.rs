@@ -10,6 +10,7 @@ use rtgi_accel::{Accel, Hit};
 use rtgi_math::{Frame, Ray, Rng, SurfacePoint, TriangleShape, Vec2, Vec3, Vec4};
 use rtgi_scene::{Material, Scene, SurfaceModel, Triangle};
 
+use crate::RenderSettings;
 use crate::bsdf::Bsdf;
 use crate::effects::{Effect, EffectPlan, bits, is_glossy, transmits};
 use crate::lights::{Environment, LightSet};
@@ -131,6 +132,7 @@ pub(crate) struct Transport<'a, A: Accel + ?Sized> {
     max_depth: u32,
     strategy: DirectStrategy,
     indirect_clamp: Option<f32>,
+    russian_roulette: bool,
     glossy: bool,
     refraction: bool,
     normal_maps: bool,
@@ -164,9 +166,7 @@ impl<'a, A: Accel + ?Sized> Transport<'a, A> {
         accel: &'a A,
         plan: &EffectPlan,
         environment: Option<&'a Environment>,
-        background: Vec3,
-        strategy: DirectStrategy,
-        indirect_clamp: Option<f32>,
+        settings: &RenderSettings,
     ) -> Self {
         let environment = environment.filter(|_| plan.has(Effect::Environment));
         Self {
@@ -174,10 +174,11 @@ impl<'a, A: Accel + ?Sized> Transport<'a, A> {
             accel,
             lights: LightSet::new(scene, plan.has(Effect::Emission), environment),
             environment,
-            background,
+            background: settings.background,
             max_depth: plan.max_depth,
-            strategy,
-            indirect_clamp,
+            strategy: settings.direct_strategy,
+            indirect_clamp: settings.indirect_clamp,
+            russian_roulette: settings.russian_roulette,
             glossy: plan.has(Effect::Glossy),
             refraction: plan.has(Effect::Refraction),
             normal_maps: plan.has(Effect::NormalMaps),
@@ -310,7 +311,7 @@ impl<'a, A: Accel + ?Sized> Transport<'a, A> {
             // Russian roulette ends paths that carry little, in proportion;
             // paths that lose nothing (mirrors, glass) are left to the depth limit.
             let survival = (throughput * radiance_scale).max_element();
-            if depth >= ROULETTE_AFTER && survival < 1.0 {
+            if self.russian_roulette && depth >= ROULETTE_AFTER && survival < 1.0 {
                 if u[dim::ROULETTE] >= survival {
                     break;
                 }
@@ -357,7 +358,8 @@ impl<'a, A: Accel + ?Sized> Transport<'a, A> {
     fn interact<const S: u32>(&self, hit: &Hit, triangle: &Triangle, material: &Material, u_lobe: f32) -> Interaction {
         let scene = self.scene;
         let corners = triangle.vertices.map(|v| scene.vertices[v as usize].position);
-        let point = SurfacePoint::on_triangle_with_shape(&corners, hit.beta, hit.gamma, self.shapes[hit.triangle as usize]);
+        let point =
+            SurfacePoint::on_triangle_with_shape(&corners, hit.beta, hit.gamma, self.shapes[hit.triangle as usize]);
         let mut normal = scene.interpolate(triangle, hit.beta, hit.gamma, |v| v.normal);
         let mut base_color = material.base_color;
         let mut roughness = material.roughness;

@@ -75,6 +75,10 @@ pub struct RenderSettings {
     /// after two or more bounces: removes the fireflies of caustics at the
     /// price of a bias (darker caustics and highlights). `None` keeps every path exact.
     pub indirect_clamp: Option<f32>,
+    /// Russian roulette: after two bounces, end paths that carry little
+    /// light with a probability that grows as they dim, and weigh the
+    /// survivors up. Unbiased; off, every path runs to `max_depth`.
+    pub russian_roulette: bool,
     /// Light from far away; `None` leaves it to the planner (a white sky
     /// when the scene has no light of its own).
     pub environment: Option<Environment>,
@@ -95,6 +99,7 @@ impl Default for RenderSettings {
             max_depth: 8,
             direct_strategy: DirectStrategy::Mis,
             indirect_clamp: None,
+            russian_roulette: true,
             environment: None,
             effects: EffectOverrides::default(),
         }
@@ -193,15 +198,7 @@ fn render_transport<A: Accel + ?Sized>(
 ) -> (HdrImage, u64) {
     let white_sky = Environment::Uniform(Vec3::ONE);
     let environment = if plan.default_environment { Some(&white_sky) } else { settings.environment.as_ref() };
-    let transport = Transport::new(
-        scene,
-        accel,
-        plan,
-        environment,
-        settings.background,
-        settings.direct_strategy,
-        settings.indirect_clamp,
-    );
+    let transport = Transport::new(scene, accel, plan, environment, settings);
     fn run<const S: u32, A: Accel + ?Sized>(
         transport: &Transport<'_, A>,
         camera: &Camera,
