@@ -41,6 +41,79 @@ pub(crate) enum Command {
     /// Check that every acceleration structure answers hard rays exactly as the linear scan does,
     /// bit for bit, and that rays aimed inside closed surfaces never leak
     Verify(VerifyArgs),
+    /// What accuracy costs in time: vary one knob (spp, depth, accel, scaling, or all) and write
+    /// a table (KNOB.md), every measurement (KNOB.json) and SVG plots
+    Experiment(ExperimentArgs),
+}
+
+/// `rtgi experiment`: one knob measured as time against error.
+#[derive(Debug, Args)]
+pub(crate) struct ExperimentArgs {
+    /// The knob: spp, depth, accel, scaling, or all
+    pub(crate) knob: KnobChoice,
+
+    /// Scene file (.obj, .gltf, .glb or .toml); the built-in Cornell box when omitted
+    pub(crate) scene: Option<PathBuf>,
+
+    /// Folder for the results [default: experiments/KNOB]; with 'all', one folder per knob inside it
+    #[arg(long)]
+    pub(crate) out: Option<PathBuf>,
+
+    /// Timed runs per measurement; times are reported as median, min and max
+    #[arg(long, default_value_t = 5, value_parser = clap::value_parser!(u32).range(1..=1000))]
+    pub(crate) repeats: u32,
+
+    /// A reduced version that runs in seconds (small images, few points): for tests, not conclusions
+    #[arg(long)]
+    pub(crate) quick: bool,
+
+    /// Samples per pixel of the converged references [default: 4096; 256 with --quick]
+    #[arg(long, value_parser = clap::value_parser!(u32).range(2..=1_048_576))]
+    pub(crate) reference_spp: Option<u32>,
+
+    /// Where references are cached between runs [default: experiments/.references]
+    #[arg(long)]
+    pub(crate) cache: Option<PathBuf>,
+
+    /// Render every reference again instead of reading the cache
+    #[arg(long)]
+    pub(crate) no_cache: bool,
+
+    /// Image width of the measured renders [default: 128; 32 with --quick]
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=MAX_IMAGE_SIDE as i64))]
+    pub(crate) width: Option<u32>,
+
+    /// Image height of the measured renders [default: 128; 32 with --quick]
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=MAX_IMAGE_SIDE as i64))]
+    pub(crate) height: Option<u32>,
+
+    #[command(flatten)]
+    pub(crate) lighting: LightingArgs,
+
+    #[command(flatten)]
+    pub(crate) accel: AccelArgs,
+
+    #[command(flatten)]
+    pub(crate) camera: CameraArgs,
+
+    /// Worker threads [default: one per core]
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1024))]
+    pub(crate) threads: Option<u32>,
+}
+
+/// One knob, or all of them.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum KnobChoice {
+    One(rtgi_experiment::Knob),
+    All,
+}
+
+impl std::str::FromStr for KnobChoice {
+    type Err = String;
+
+    fn from_str(text: &str) -> Result<Self, String> {
+        if text == "all" { Ok(KnobChoice::All) } else { text.parse().map(KnobChoice::One) }
+    }
 }
 
 /// `rtgi verify`: the exactness contract, checked on a scene or on the built-in adversarial set.

@@ -9,6 +9,7 @@ mod common;
 mod debug_cmd;
 mod default_scene;
 mod effects_cmd;
+mod experiment_cmd;
 mod info_cmd;
 mod render_cmd;
 mod trace_cmd;
@@ -34,6 +35,7 @@ pub fn main() -> ExitCode {
         cli::Command::Compare(args) => info_cmd::compare(&args),
         cli::Command::BenchEffects(args) => effects_cmd::run(&args),
         cli::Command::Verify(args) => verify_cmd::run(&args),
+        cli::Command::Experiment(args) => experiment_cmd::run(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

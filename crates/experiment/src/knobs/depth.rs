@@ -1,0 +1,131 @@
+//! `depth`: the most bounces a path may take, with Russian roulette on and
+//! off: time, RMSE, and the energy missing against a converged reference
+//! (the same scene at a depth no path of it reaches).
+
+use rtgi_render::{Integrator, RenderSettings};
+
+use crate::plot::{Corner, Curve, Plot};
+use crate::reference::reference;
+use crate::report::{Report, Series, Table, format_number, format_timing};
+use crate::runner::measure;
+use crate::{ExperimentError, Options, Steps, Subject};
+
+/// The reference's depth: deeper than any depth measured, and deep enough
+/// that what a path brings back after it is below the reference's noise.
+const CONVERGED_DEPTH: u32 = 64;
+
+pub(super) fn run(
+    subject: &Subject,
+    options: &Options,
+    mut report: Report,
+    progress: &dyn Fn(&str),
+) -> Result<Report, ExperimentError> {
+    if !subject.settings.integrator.simulates_light() || subject.settings.integrator == Integrator::Direct {
+        return Err(ExperimentError::Unsuitable(format!(
+            "the depth experiment needs the path integrator (the subject uses '{}')",
+            subject.settings.integrator
+        )));
+    }
+    let depths: Vec<u32> = if options.quick { vec![1, 2, 4] } else { vec![1, 2, 3, 4, 6, 8, 12, 16, 32] };
+    let spp = if options.quick { 4 } else { 64 };
+    let base = RenderSettings { samples_per_pixel: spp, ..subject.settings.clone() };
+    let mut steps = Steps::new(1 + 2 * depths.len(), progress);
+    steps.next("reference");
+    let converged = RenderSettings { max_depth: CONVERGED_DEPTH, ..base.clone() };
+    let reference = reference(subject, &converged, options.reference_spp(), options.cache.as_deref(), progress)?;
+    let mut table = Table {
+        title: format!("{spp} spp per render"),
+        header: ["Russian roulette", "max depth", "time ms", "RMSE", "relMSE", "energy missing"]
+            .map(String::from)
+            .to_vec(),
+        rows: Vec::new(),
+    };
+    let (mut energy, mut times, mut errors) = (Vec::new(), Vec::new(), Vec::new());
+    for roulette in [true, false] {
+        let name = if roulette { "roulette on" } else { "roulette off" };
+        let mut series = Series { name: name.to_owned(), points: Vec::new() };
+        for &depth in &depths {
+            steps.next(&format!("{name}, depth {depth}"));
+            let settings = RenderSettings { max_depth: depth, russian_roulette: roulette, ..base.clone() };
+            let mut point = measure(subject, &settings, options, &reference);
+            let error = point.error.expect("measured");
+            let missing = 1.0 - error.mean / error.reference_mean.max(1e-30);
+            point.x = depth as f64;
+            point.label = depth.to_string();
+            point = point.with("energy_missing", missing);
+            let time = point.time.expect("measured");
+            table.rows.push(vec![
+                name.to_owned(),
+                depth.to_string(),
+                format_timing(&time),
+                format_number(error.rmse),
+                format_number(error.relative_mse),
+                format!("{:.2}%", missing * 100.0),
+            ]);
+            series.points.push(point);
+        }
+        let xs = || series.points.iter().map(|p| p.x);
+        energy.push(Curve::new(
+            name,
+            xs().zip(series.points.iter().map(|p| p.values["energy_missing"] * 100.0)).collect(),
+        ));
+        times.push(
+            Curve::new(name, xs().zip(series.points.iter().map(|p| p.time.expect("measured").median_ms)).collect())
+                .with_bars(series.points.iter().map(|p| p.time.map(|t| (t.min_ms, t.max_ms))).collect()),
+        );
+        errors
+            .push(Curve::new(name, xs().zip(series.points.iter().map(|p| p.error.expect("measured").rmse)).collect()));
+        report.series.push(series);
+    }
+    for series in &report.series {
+        if let Some(first) = series.points.iter().find(|p| p.values["energy_missing"].abs() < 0.01) {
+            report
+                .findings
+                .push(format!("{}: less than 1% of the energy is missing from depth {} on", series.name, first.label));
+        }
+    }
+    if let [on, off] = &report.series[..]
+        && let (Some(a), Some(b)) = (on.points.last(), off.points.last())
+    {
+        let (ta, tb) = (a.time.expect("measured").median_ms, b.time.expect("measured").median_ms);
+        report.findings.push(format!(
+            "at depth {}, Russian roulette takes {:.2}× the time of running every path to the end, at {:.2}× its RMSE",
+            a.label,
+            ta / tb,
+            a.error.expect("measured").rmse / b.error.expect("measured").rmse.max(1e-30)
+        ));
+    }
+    report.plots.push(Plot {
+        file: "depth-energy.svg".into(),
+        title: "Energy missing against max depth".into(),
+        x_label: "max bounces".into(),
+        y_label: "energy missing (% of the reference's mean)".into(),
+        log_x: true,
+        log_y: false,
+        curves: energy,
+        legend: Corner::UpperRight,
+    });
+    report.plots.push(Plot {
+        file: "depth-time.svg".into(),
+        title: format!("Render time against max depth, {spp} spp"),
+        x_label: "max bounces".into(),
+        y_label: "render time (ms)".into(),
+        log_x: true,
+        log_y: false,
+        curves: times,
+        legend: Corner::UpperLeft,
+    });
+    report.plots.push(Plot {
+        file: "depth-error.svg".into(),
+        title: format!("RMSE against max depth, {spp} spp"),
+        x_label: "max bounces".into(),
+        y_label: "RMSE of linear radiance".into(),
+        log_x: true,
+        log_y: true,
+        curves: errors,
+        legend: Corner::UpperRight,
+    });
+    report.tables.push(table);
+    report.reference = Some(reference.info);
+    Ok(report)
+}

@@ -1,0 +1,89 @@
+//! The knobs: one file each, each answering one question a user of the
+//! course asks about what accuracy costs.
+
+use crate::report::Report;
+use crate::{ExperimentError, Machine, Options, Subject};
+
+mod accel;
+mod depth;
+mod scaling;
+mod spp;
+
+/// Something an experiment varies.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Knob {
+    /// Samples per pixel, for each pixel sampler.
+    Spp,
+    /// Bounces, with Russian roulette on and off.
+    Depth,
+    /// The acceleration structures and their build parameters.
+    Accel,
+    /// The naive O(n) search against the BVH, over triangle counts.
+    Scaling,
+}
+
+impl Knob {
+    pub const ALL: &'static [Knob] = &[Knob::Spp, Knob::Depth, Knob::Accel, Knob::Scaling];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            Knob::Spp => "spp",
+            Knob::Depth => "depth",
+            Knob::Accel => "accel",
+            Knob::Scaling => "scaling",
+        }
+    }
+
+    /// The question the knob's experiment answers.
+    pub fn question(self) -> &'static str {
+        match self {
+            Knob::Spp => {
+                "how fast does the error fall with samples per pixel, for each pixel sampler, and at equal time?"
+            }
+            Knob::Depth => "what do bounces cost, and how much light is missing without them?",
+            Knob::Accel => {
+                "what does each acceleration structure cost to build and to trace, and does it change any answer?"
+            }
+            Knob::Scaling => {
+                "how does the time per ray grow with the triangle count, for the naive search and for the BVH?"
+            }
+        }
+    }
+
+    /// Whether the knob renders the subject (and so needs a reference);
+    /// `scaling` makes its own meshes.
+    pub fn uses_scene(self) -> bool {
+        !matches!(self, Knob::Scaling)
+    }
+}
+
+rtgi_math::named_choices!(Knob, "experiment");
+
+pub(crate) fn run(
+    knob: Knob,
+    subject: &Subject,
+    options: &Options,
+    progress: &dyn Fn(&str),
+) -> Result<Report, ExperimentError> {
+    let report = Report {
+        knob: knob.name().to_owned(),
+        question: knob.question().to_owned(),
+        scene: if knob.uses_scene() { subject.name.clone() } else { "generated meshes".to_owned() },
+        machine: Machine::this(options.threads),
+        rtgi_version: env!("CARGO_PKG_VERSION").to_owned(),
+        command: options.command.clone(),
+        repeats: options.repeats.max(1),
+        quick: options.quick,
+        reference: None,
+        series: Vec::new(),
+        findings: Vec::new(),
+        tables: Vec::new(),
+        plots: Vec::new(),
+    };
+    match knob {
+        Knob::Spp => spp::run(subject, options, report, progress),
+        Knob::Depth => depth::run(subject, options, report, progress),
+        Knob::Accel => accel::run(subject, options, report, progress),
+        Knob::Scaling => scaling::run(options, report, progress),
+    }
+}

@@ -1,0 +1,159 @@
+//! `scaling`: the naive O(n) search against the BVHs over triangle counts
+//! from 10 to 10^6, time per ray on log-log axes with fitted exponents:
+//! where the course's warning that naive timings mislead is checked
+//! against measurement.
+//!
+//! The meshes are spheres tessellated ever finer (closed, every edge
+//! shared by two triangles), and the rays run from random points around
+//! the sphere to random points inside it, so every ray hits.
+
+use std::time::Instant;
+
+use rayon::prelude::*;
+use rtgi_accel::{AccelKind, BuildParams};
+use rtgi_math::{Ray, Rng, Vec3, uniform_sphere};
+
+use crate::plot::{Corner, Curve, Plot};
+use crate::report::{Point, Report, Series, Table, format_ms, format_number};
+use crate::stats::{PowerLaw, Timing};
+use crate::{ExperimentError, Options, Steps};
+
+/// A unit sphere of about `count` triangles: `rows` bands of `2 rows`
+/// quads, the poles' quads folded to single triangles.
+fn sphere(count: usize) -> Vec<[Vec3; 3]> {
+    // Triangles: 2 · columns · (rows − 1) with columns = 2 · rows.
+    let rows = ((count as f64 / 4.0).sqrt().round() as usize).max(2);
+    let columns = 2 * rows;
+    let at = |row: usize, column: usize| {
+        let theta = std::f32::consts::PI * row as f32 / rows as f32;
+        let phi = std::f32::consts::TAU * (column % columns) as f32 / columns as f32;
+        Vec3::new(theta.sin() * phi.cos(), theta.cos(), theta.sin() * phi.sin())
+    };
+    let mut triangles = Vec::with_capacity(2 * rows * columns);
+    for row in 0..rows {
+        for column in 0..columns {
+            let (a, b, c, d) = (at(row, column), at(row, column + 1), at(row + 1, column), at(row + 1, column + 1));
+            if row > 0 {
+                triangles.push([a, c, b]);
+            }
+            if row + 1 < rows {
+                triangles.push([b, c, d]);
+            }
+        }
+    }
+    triangles
+}
+
+/// Rays from random points on a sphere of radius 3 to random points in the unit sphere's inner half.
+fn rays(count: usize, seed: u64) -> Vec<Ray> {
+    let mut rng = Rng::new(seed, 0);
+    (0..count)
+        .map(|_| {
+            let origin = 3.0 * uniform_sphere(rng.next_f32(), rng.next_f32());
+            let target = 0.5 * rng.next_f32().cbrt() * uniform_sphere(rng.next_f32(), rng.next_f32());
+            Ray::new(origin, target - origin)
+        })
+        .collect()
+}
+
+/// Meshes from this many triangles up are fitted: below, the per-ray
+/// overheads (setting the ray up, the first node) dominate the time.
+const LARGE: f64 = 500.0;
+
+/// Triangle tests the linear scan may spend per count.
+const LINEAR_BUDGET: usize = 200_000_000;
+
+pub(super) fn run(options: &Options, mut report: Report, progress: &dyn Fn(&str)) -> Result<Report, ExperimentError> {
+    let counts: Vec<usize> = if options.quick {
+        vec![10, 100, 1000, 10_000]
+    } else {
+        vec![10, 30, 100, 300, 1000, 3000, 10_000, 30_000, 100_000, 300_000, 1_000_000]
+    };
+    let ray_count = if options.quick { 2000 } else { 200_000 };
+    let all_rays = rays(ray_count, 7);
+    let kinds = [AccelKind::Linear, AccelKind::Sah, AccelKind::Bvh8];
+    let mut steps = Steps::new(counts.len() * kinds.len(), progress);
+    let mut series: Vec<Series> =
+        kinds.iter().map(|k| Series { name: k.name().to_owned(), points: Vec::new() }).collect();
+    let mut table = Table {
+        title: "time per ray (ns, median with min and max) and build time".into(),
+        header: ["triangles", "structure", "ns per ray", "build ms", "rays timed"].map(String::from).to_vec(),
+        rows: Vec::new(),
+    };
+    for &count in &counts {
+        let triangles = sphere(count);
+        for (kind, series) in kinds.iter().zip(&mut series) {
+            steps.next(&format!("{kind} over {} triangles", triangles.len()));
+            let params = kind.default_params();
+            let start = Instant::now();
+            let accel = kind.build(&triangles, &BuildParams { ..params });
+            let build_ms = start.elapsed().as_secs_f64() * 1e3;
+            let limit = if *kind == AccelKind::Linear {
+                (LINEAR_BUDGET / triangles.len()).clamp(64, ray_count)
+            } else {
+                ray_count
+            };
+            let rays = &all_rays[..limit];
+            let run = || {
+                let start = Instant::now();
+                let hits: usize =
+                    rays.par_chunks(256).map(|c| c.iter().filter(|r| accel.intersect(r).is_some()).count()).sum();
+                std::hint::black_box(hits);
+                start.elapsed().as_secs_f64() * 1e3
+            };
+            run();
+            let timing = Timing::of(&(0..options.repeats.max(1)).map(|_| run()).collect::<Vec<_>>());
+            let per_ray = |ms: f64| ms * 1e6 / rays.len() as f64;
+            let mut point = Point::new(triangles.len() as f64, triangles.len().to_string())
+                .with("ns_per_ray", per_ray(timing.median_ms))
+                .with("ns_per_ray_min", per_ray(timing.min_ms))
+                .with("ns_per_ray_max", per_ray(timing.max_ms))
+                .with("build_ms", build_ms)
+                .with("rays_timed", rays.len() as f64);
+            point.time = Some(timing);
+            table.rows.push(vec![
+                triangles.len().to_string(),
+                kind.to_string(),
+                format!(
+                    "{} ({}–{})",
+                    format_number(per_ray(timing.median_ms)),
+                    format_number(per_ray(timing.min_ms)),
+                    format_number(per_ray(timing.max_ms))
+                ),
+                format_ms(build_ms),
+                rays.len().to_string(),
+            ]);
+            series.points.push(point);
+        }
+    }
+    let mut curves = Vec::new();
+    for s in &series {
+        let xy: Vec<(f64, f64)> = s.points.iter().map(|p| (p.x, p.values["ns_per_ray"])).collect();
+        let large: Vec<(f64, f64)> = xy.iter().copied().filter(|p| p.0 >= LARGE).collect();
+        let label = match PowerLaw::fit(&large) {
+            Some(fit) => {
+                report.findings.push(format!(
+                    "{}: time per ray ∝ n^{:.3}, fitted over the {} meshes of {LARGE} triangles or more",
+                    s.name, fit.exponent, fit.points
+                ));
+                format!("{} (n^{:.2})", s.name, fit.exponent)
+            }
+            None => s.name.clone(),
+        };
+        let bars = s.points.iter().map(|p| Some((p.values["ns_per_ray_min"], p.values["ns_per_ray_max"]))).collect();
+        curves.push(Curve::new(label, xy).with_bars(bars));
+    }
+    report.series = series;
+    report.plots.push(Plot {
+        file: "scaling.svg".into(),
+        title: "Time per ray against triangle count".into(),
+        x_label: "triangles".into(),
+        y_label: "time per closest-hit ray (ns)".into(),
+        log_x: true,
+        log_y: true,
+        curves,
+        legend: Corner::UpperLeft,
+    });
+    report.tables.push(table);
+    Ok(report)
+}

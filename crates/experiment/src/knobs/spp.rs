@@ -1,0 +1,139 @@
+//! `spp`: error against samples per pixel for each pixel sampler, on
+//! log-log axes with the fitted slope beside the O(N^-1/2) line, and
+//! error against time, so that samplers are compared at equal time.
+//!
+//! The pixel samplers place only the camera ray in the pixel; the path's
+//! other random numbers are independent. So the experiment measures two
+//! integrands: the scene's own (light transport, where placement in the
+//! pixel is one dimension of many) and the camera-ray integrand alone
+//! (the `primary` integrator: edges and texture detail), where
+//! stratification shows.
+
+use rtgi_render::{Integrator, PixelSampler, RenderSettings};
+
+use crate::plot::{Corner, Curve, Plot};
+use crate::reference::reference;
+use crate::report::{Report, Series, Table, format_number, format_timing};
+use crate::runner::measure;
+use crate::stats::PowerLaw;
+use crate::{ExperimentError, Options, Steps, Subject};
+
+const SAMPLERS: [PixelSampler; 3] = [PixelSampler::Uniform, PixelSampler::Stratified, PixelSampler::LowDiscrepancy];
+
+/// Errors within this factor of the reference's own noise are left out of the fits.
+const NOISE_MARGIN: f64 = 3.0;
+
+pub(super) fn run(
+    subject: &Subject,
+    options: &Options,
+    mut report: Report,
+    progress: &dyn Fn(&str),
+) -> Result<Report, ExperimentError> {
+    let counts: Vec<u32> = if options.quick { vec![1, 4, 16] } else { (0..=8).map(|k| 1 << k).collect() };
+    let mut integrands = vec![("light transport", subject.settings.integrator, "")];
+    if subject.settings.integrator != Integrator::Primary {
+        integrands.push(("camera ray only", Integrator::Primary, "-pixel"));
+    }
+    let mut steps = Steps::new(integrands.len() * (1 + SAMPLERS.len() * counts.len()), progress);
+    for (integrand, integrator, suffix) in integrands {
+        let base = RenderSettings { integrator, ..subject.settings.clone() };
+        steps.next(&format!("{integrand}: reference"));
+        let reference = reference(subject, &base, options.reference_spp(), options.cache.as_deref(), progress)?;
+        let noise = reference.info.noise_rmse;
+        let mut error_curves = Vec::new();
+        let mut time_curves = Vec::new();
+        let mut table = Table {
+            title: format!(
+                "{integrand} ({integrator} integrator; reference {} spp, noise RMSE ≈ {})",
+                reference.info.samples_per_pixel,
+                format_number(noise)
+            ),
+            header: ["sampler", "spp", "time ms", "RMSE (min–max)", "relMSE", "mean / reference"]
+                .map(String::from)
+                .to_vec(),
+            rows: Vec::new(),
+        };
+        for sampler in SAMPLERS {
+            let mut series = Series { name: format!("{sampler}, {integrand}"), points: Vec::new() };
+            for &spp in &counts {
+                steps.next(&format!("{integrand}: {sampler} at {spp} spp"));
+                let settings = RenderSettings { sampler, samples_per_pixel: spp, ..base.clone() };
+                let point = measure(subject, &settings, options, &reference);
+                let (time, error) = (point.time.expect("measured"), point.error.expect("measured"));
+                table.rows.push(vec![
+                    sampler.to_string(),
+                    spp.to_string(),
+                    format_timing(&time),
+                    format!(
+                        "{} ({}–{})",
+                        format_number(error.rmse),
+                        format_number(error.rmse_min),
+                        format_number(error.rmse_max)
+                    ),
+                    format_number(error.relative_mse),
+                    format!("{:.4}", error.mean / error.reference_mean.max(1e-30)),
+                ]);
+                series.points.push(point);
+            }
+            let rmse = |p: &crate::Point| p.error.expect("measured").rmse;
+            let resolved: Vec<(f64, f64)> =
+                series.points.iter().filter(|p| rmse(p) > NOISE_MARGIN * noise).map(|p| (p.x, rmse(p))).collect();
+            let label = match PowerLaw::fit(&resolved) {
+                Some(fit) => {
+                    report.findings.push(format!(
+                        "{integrand}, {sampler}: RMSE ∝ spp^{:.3} (fitted on {} of {} counts whose error is above {NOISE_MARGIN}× the reference's noise)",
+                        fit.exponent,
+                        fit.points,
+                        series.points.len()
+                    ));
+                    format!("{sampler} (slope {:.2})", fit.exponent)
+                }
+                None => {
+                    report.findings.push(format!(
+                        "{integrand}, {sampler}: too few counts above the reference's noise to fit a slope"
+                    ));
+                    sampler.to_string()
+                }
+            };
+            let bars = series.points.iter().map(|p| p.error.map(|e| (e.rmse_min, e.rmse_max))).collect();
+            error_curves
+                .push(Curve::new(&label, series.points.iter().map(|p| (p.x, rmse(p))).collect()).with_bars(bars));
+            time_curves.push(Curve::new(
+                sampler.to_string(),
+                series.points.iter().map(|p| (p.time.expect("measured").median_ms, rmse(p))).collect(),
+            ));
+            report.series.push(series);
+        }
+        // The O(N^-1/2) law through the first uniform point, and the reference's noise floor.
+        if let Some(&(x0, y0)) = error_curves.first().and_then(|c| c.points.first()) {
+            let last = *counts.last().expect("counts") as f64;
+            error_curves.push(Curve::guide("∝ spp^-1/2", vec![(x0, y0), (last, y0 * (last / x0).powf(-0.5))]));
+            error_curves.push(Curve::guide("reference noise", vec![(x0, noise), (last, noise)]));
+        }
+        report.plots.push(Plot {
+            file: format!("spp{suffix}-error.svg"),
+            title: format!("RMSE against spp, {integrand}"),
+            x_label: "samples per pixel".into(),
+            y_label: "RMSE of linear radiance".into(),
+            log_x: true,
+            log_y: true,
+            curves: error_curves,
+            legend: Corner::LowerLeft,
+        });
+        report.plots.push(Plot {
+            file: format!("spp{suffix}-time.svg"),
+            title: format!("RMSE against render time, {integrand}"),
+            x_label: "render time (ms, median)".into(),
+            y_label: "RMSE of linear radiance".into(),
+            log_x: true,
+            log_y: true,
+            curves: time_curves,
+            legend: Corner::UpperRight,
+        });
+        report.tables.push(table);
+        if integrator == subject.settings.integrator {
+            report.reference = Some(reference.info);
+        }
+    }
+    Ok(report)
+}

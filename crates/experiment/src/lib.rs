@@ -1,0 +1,128 @@
+//! What accuracy costs in time: each knob of the renderer and of the
+//! acceleration structures, measured as time against error.
+//!
+//! An experiment takes a [`Subject`] (a scene, a camera, a structure and
+//! base render settings, prepared by the caller) and [`Options`], varies one
+//! [`Knob`], and returns a [`Report`]: every measurement, the machine, the
+//! command, tables, findings (fitted slopes...) and plots, which
+//! [`Report::write`] turns into `KNOB.md`, `KNOB.json` and SVG files.
+//!
+//! What makes the numbers trustworthy:
+//! - errors are RMSE and relative MSE of linear radiance over the image,
+//!   against a converged reference rendered with seeds of its own and
+//!   cached on disk ([`mod@reference`]), whose own noise is
+//!   reported beside;
+//! - every time is the median of [`Options::repeats`] runs with min and max;
+//! - each repeat of a measured render uses another seed, and its error is
+//!   averaged as mean squared error.
+
+use std::path::PathBuf;
+
+use rtgi_accel::Accel;
+use rtgi_render::RenderSettings;
+use rtgi_scene::{Camera, Scene};
+
+mod knobs;
+pub mod machine;
+pub mod plot;
+pub mod reference;
+pub mod report;
+mod runner;
+pub mod stats;
+
+pub use knobs::Knob;
+pub use machine::Machine;
+pub use report::{Point, Report, Series, Table};
+
+/// What an experiment renders: the caller loads the scene, chooses the
+/// camera and builds the structure, as it would for a render.
+pub struct Subject {
+    /// The scene's file, or the built-in scene's name.
+    pub name: String,
+    pub scene: Scene,
+    pub camera: Camera,
+    /// The structure renders use, unless the knob varies it.
+    pub accel: Box<dyn Accel>,
+    /// Everything the knob does not vary: size, integrator, depth, lighting...
+    pub settings: RenderSettings,
+}
+
+impl std::fmt::Debug for Subject {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Subject").field("name", &self.name).field("settings", &self.settings).finish_non_exhaustive()
+    }
+}
+
+#[derive(Clone, Debug)]
+pub struct Options {
+    /// Timed runs per measurement (renders: each with its own seed).
+    pub repeats: usize,
+    /// A reduced version that runs in seconds, for tests.
+    pub quick: bool,
+    /// The command line, recorded in the report.
+    pub command: String,
+    /// Worker threads (the caller runs the experiment in a pool of this size).
+    pub threads: usize,
+    /// Where references are cached; `None` renders them every time.
+    pub cache: Option<PathBuf>,
+    /// Samples per pixel of the references [default: 4096; 256 quick].
+    pub reference_spp: Option<u32>,
+}
+
+impl Options {
+    pub(crate) fn reference_spp(&self) -> u32 {
+        self.reference_spp.unwrap_or(if self.quick { 256 } else { 4096 })
+    }
+}
+
+#[derive(Debug, thiserror::Error)]
+pub enum ExperimentError {
+    #[error("{path}: cannot write: {source}")]
+    Write { path: PathBuf, source: std::io::Error },
+    #[error("{path}: {message}")]
+    Image { path: PathBuf, message: String },
+    #[error("plot {file}: {message}")]
+    Plot { file: String, message: String },
+    #[error("cannot build the structure: {0}")]
+    Build(String),
+    #[error("{0}")]
+    Unsuitable(String),
+}
+
+/// Runs `knob` on `subject`; `progress` receives a line per step, with the
+/// time spent and an estimate of the time left.
+pub fn run(
+    knob: Knob,
+    subject: &Subject,
+    options: &Options,
+    progress: &dyn Fn(&str),
+) -> Result<Report, ExperimentError> {
+    knobs::run(knob, subject, options, progress)
+}
+
+/// Counts the steps of an experiment and estimates the time left from the
+/// mean time of the steps done.
+pub(crate) struct Steps<'a> {
+    total: usize,
+    done: usize,
+    start: std::time::Instant,
+    progress: &'a dyn Fn(&str),
+}
+
+impl<'a> Steps<'a> {
+    pub(crate) fn new(total: usize, progress: &'a dyn Fn(&str)) -> Self {
+        Steps { total, done: 0, start: std::time::Instant::now(), progress }
+    }
+
+    /// Announces the next step.
+    pub(crate) fn next(&mut self, what: &str) {
+        let elapsed = self.start.elapsed().as_secs_f64();
+        let left = if self.done > 0 {
+            format!(", about {:.0} s left", elapsed / self.done as f64 * (self.total - self.done) as f64)
+        } else {
+            String::new()
+        };
+        (self.progress)(&format!("[{}/{}] {what} ({elapsed:.0} s{left})", self.done + 1, self.total));
+        self.done += 1;
+    }
+}

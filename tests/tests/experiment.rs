@@ -1,0 +1,126 @@
+//! `rtgi experiment --quick`, run as a user would: every knob writes its
+//! table, its JSON with the promised fields, and SVG plots with its curves.
+
+use std::path::Path;
+
+use rtgi_tests::{Run, run_cli, scratch_dir};
+
+const RTGI: &str = env!("CARGO_BIN_EXE_rtgi-under-test");
+
+fn rtgi(args: &[&str]) -> Run {
+    run_cli(RTGI, args)
+}
+
+fn path_str(p: &Path) -> &str {
+    p.to_str().expect("scratch paths are UTF-8")
+}
+
+/// The plot's SVG is a whole document with a drawn line and a legend entry for each curve named.
+fn check_svg(path: &Path, labels: &[&str]) {
+    let svg = std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    assert!(svg.trim_start().starts_with("<svg") && svg.trim_end().ends_with("</svg>"), "{}", path.display());
+    assert!(svg.matches("<polyline").count() >= labels.len(), "{}: too few lines", path.display());
+    for label in labels {
+        assert!(svg.contains(label), "{}: no curve '{label}'", path.display());
+    }
+}
+
+#[test]
+fn every_knob_writes_its_table_json_and_plots() {
+    let dir = scratch_dir("experiment-all");
+    let run = rtgi(&["experiment", "all", "--quick", "--repeats", "2", "--out", path_str(&dir)]);
+    assert!(run.success, "{run:?}");
+    for knob in ["spp", "depth", "accel", "scaling"] {
+        let folder = dir.join(knob);
+        let md = std::fs::read_to_string(folder.join(format!("{knob}.md"))).expect("the table");
+        assert!(md.contains(&format!("# `{knob}`")) && md.contains("|---|"), "{md}");
+        let json: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(folder.join(format!("{knob}.json"))).expect("the JSON"))
+                .expect("valid JSON");
+        assert_eq!(json["knob"], knob);
+        assert!(json["machine"]["cpu"].as_str().is_some_and(|c| !c.is_empty()), "{json}");
+        assert!(json["machine"]["cores"].as_u64().is_some_and(|c| c >= 1));
+        assert!(json["machine"]["threads"].as_u64().is_some_and(|c| c >= 1));
+        assert!(json["rtgi_version"].as_str().is_some());
+        assert!(json["command"].as_str().is_some_and(|c| c.contains("experiment all")), "{}", json["command"]);
+        assert_eq!(json["repeats"], 2);
+        let series = json["series"].as_array().expect("series");
+        assert!(!series.is_empty());
+        for s in series {
+            for point in s["points"].as_array().expect("points") {
+                let time = &point["time"];
+                assert_eq!(time["runs"], 2, "{point}");
+                let (min, median, max) = (
+                    time["min_ms"].as_f64().unwrap(),
+                    time["median_ms"].as_f64().unwrap(),
+                    time["max_ms"].as_f64().unwrap(),
+                );
+                assert!(min <= median && median <= max && min > 0.0, "{point}");
+            }
+        }
+        let plots = json["plots"].as_array().expect("plots");
+        assert!(!plots.is_empty());
+        for plot in plots {
+            let file = plot.as_str().expect("plot file name");
+            assert!(md.contains(&format!("]({file})")), "{knob}.md does not show {file}");
+            check_svg(&folder.join(file), &[]);
+        }
+    }
+    // The curves that the knobs promise.
+    check_svg(
+        &dir.join("spp/spp-error.svg"),
+        &["uniform (slope", "stratified (slope", "low-discrepancy (slope", "spp^-1/2"],
+    );
+    check_svg(&dir.join("spp/spp-time.svg"), &["uniform", "stratified", "low-discrepancy"]);
+    check_svg(&dir.join("depth/depth-energy.svg"), &["roulette on", "roulette off"]);
+    check_svg(&dir.join("scaling/scaling.svg"), &["linear (n^", "sah (n^", "bvh8 (n^"]);
+    check_svg(&dir.join("accel/accel-incoherent.svg"), &["linear", "sah", "bvh4", "bvh8"]);
+
+    // Errors are measured against a reference, with its noise.
+    let spp: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("spp/spp.json")).unwrap()).unwrap();
+    assert!(spp["reference"]["noise_rmse"].as_f64().is_some_and(|n| n > 0.0), "{}", spp["reference"]);
+    let first = &spp["series"][0]["points"][0]["error"];
+    assert!(first["rmse"].as_f64().is_some_and(|e| e > 0.0) && first["relative_mse"].as_f64().is_some(), "{first}");
+    // More samples, less error, for every sampler.
+    for s in spp["series"].as_array().unwrap() {
+        let errors: Vec<f64> =
+            s["points"].as_array().unwrap().iter().map(|p| p["error"]["rmse"].as_f64().unwrap()).collect();
+        assert!(errors.windows(2).all(|w| w[1] < w[0]), "{}: {errors:?}", s["name"]);
+    }
+    // No structure changes an answer.
+    let accel: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("accel/accel.json")).unwrap()).unwrap();
+    for s in accel["series"].as_array().unwrap() {
+        let point = &s["points"][0]["values"];
+        assert_eq!(point["camera_disagreements"], 0.0, "{}", s["name"]);
+        assert_eq!(point["incoherent_disagreements"], 0.0, "{}", s["name"]);
+    }
+    // The second run reads the references from the cache.
+    let again = rtgi(&[
+        "experiment",
+        "depth",
+        "--quick",
+        "--repeats",
+        "1",
+        "--out",
+        path_str(&dir.join("again")),
+        "--cache",
+        path_str(&dir.join(".references")),
+    ]);
+    assert!(again.success, "{again:?}");
+    assert!(!again.stderr.contains("rendering a reference"), "{}", again.stderr);
+}
+
+#[test]
+fn unknown_knobs_and_unsuitable_subjects_are_refused_clearly() {
+    let run = rtgi(&["experiment", "bounces", "--quick"]);
+    assert!(!run.success);
+    assert!(run.stderr.contains("spp") && run.stderr.contains("scaling"), "{}", run.stderr);
+    let dir = scratch_dir("experiment-unsuitable");
+    let run = rtgi(&["experiment", "depth", "--quick", "--integrator", "primary", "--out", path_str(&dir)]);
+    assert!(!run.success);
+    assert!(run.stderr.contains("needs the path integrator"), "{}", run.stderr);
+    assert!(!run.stderr.contains("panicked"), "{}", run.stderr);
+    assert!(!dir.join("depth.json").exists());
+}
