@@ -124,3 +124,21 @@ fn unknown_knobs_and_unsuitable_subjects_are_refused_clearly() {
     assert!(!run.stderr.contains("panicked"), "{}", run.stderr);
     assert!(!dir.join("depth.json").exists());
 }
+
+#[test]
+fn all_writes_an_index_of_every_plot_with_its_findings() {
+    let dir = scratch_dir("experiment-index");
+    let run = rtgi(&["experiment", "all", "--quick", "--repeats", "1", "--out", path_str(&dir)]);
+    assert!(run.success, "{run:?}");
+    let index = std::fs::read_to_string(dir.join("index.md")).expect("index.md");
+    assert!(index.contains("cargo run --release -p rtgi -- experiment all --quick"), "{index}");
+    let mut plots = 0;
+    for line in index.lines().filter(|l| l.starts_with("![")) {
+        let file = line.rsplit_once("](").and_then(|(_, f)| f.strip_suffix(')')).expect("an image link");
+        assert!(dir.join(file).is_file(), "index.md links {file}, which does not exist");
+        plots += 1;
+    }
+    assert!(plots >= 8, "{index}");
+    // Findings are sentences with measured figures, under their knob.
+    assert!(index.contains("## `scaling`") && index.contains("time per ray ∝ n^"), "{index}");
+}

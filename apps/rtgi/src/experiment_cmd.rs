@@ -1,27 +1,122 @@
-//! `rtgi experiment`: parses the options, prepares the subject as a render
+//! `rtgi experiment`: parses the options, prepares each subject as a render
 //! would, and hands it to `rtgi-experiment`, which measures and writes.
+//!
+//! With a scene, every chosen knob runs on it. `rtgi experiment all`
+//! without a scene runs the report: each knob on the shared scenes it is
+//! meant for (found in `$RTGI_SCENES` or `../shared/scenes`; missing ones
+//! are skipped with a message), and writes `index.md` beside the results.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use anyhow::Result;
-use rtgi_experiment::{Knob, Options, Subject};
+use rtgi_experiment::{IndexEntry, Knob, Options, Report, Subject};
 use rtgi_render::{PixelSampler, RenderSettings};
 
 use crate::cli::{ExperimentArgs, KnobChoice};
 use crate::common::{LoadedScene, apply_lighting, choose_camera, load_scene, thread_pool};
+
+/// The shared scenes of the report, relative to the scenes folder.
+const CORNELL: &str = "cornell-box/CornellBox-Original.obj";
+const BUNNY: &str = "bunny/stanford-bunny.obj";
+const SPONZA: &str = "sponza-dabrovic/sponza.obj";
+const CONFERENCE: &str = "conference/conference.obj";
+
+/// The scenes each knob is measured on in the report: the Cornell box
+/// (small, closed, converges), the bunny (one mesh under the sky), Sponza
+/// and the conference room (large, many materials).
+fn report_scenes(knob: Knob) -> &'static [&'static str] {
+    match knob {
+        Knob::Spp => &[CORNELL, BUNNY],
+        Knob::Depth => &[CORNELL, SPONZA],
+        Knob::Accel => &[CORNELL, BUNNY, SPONZA, CONFERENCE],
+        _ => &[CORNELL],
+    }
+}
+
+/// The folder of shared scenes: `$RTGI_SCENES`, else `../shared/scenes`
+/// beside the workspace this program was built in, else beside the current folder.
+fn scenes_folder() -> PathBuf {
+    if let Some(folder) = std::env::var_os("RTGI_SCENES") {
+        return folder.into();
+    }
+    let built_in = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/scenes");
+    if built_in.is_dir() { built_in } else { PathBuf::from("../shared/scenes") }
+}
 
 pub(crate) fn run(args: &ExperimentArgs) -> Result<()> {
     let knobs: Vec<Knob> = match args.knob {
         KnobChoice::One(knob) => vec![knob],
         KnobChoice::All => Knob::ALL.to_vec(),
     };
+    let report_mode = args.knob == KnobChoice::All && args.scene.is_none() && !args.quick;
     let out_root = args.out.clone().unwrap_or_else(|| PathBuf::from("experiments"));
-    let folder = |knob: Knob| match (args.knob, &args.out) {
-        (KnobChoice::One(_), Some(out)) => out.clone(),
-        _ => out_root.join(knob.name()),
-    };
     let pool = thread_pool(args.threads)?;
-    let LoadedScene { mut scene, name, .. } = load_scene(args.scene.as_deref())?;
+    let options = Options {
+        repeats: args.repeats as usize,
+        quick: args.quick,
+        // As typed, with the program's name rather than the path it ran from.
+        command: std::iter::once("rtgi".to_owned()).chain(std::env::args().skip(1)).collect::<Vec<_>>().join(" "),
+        threads: pool.current_num_threads(),
+        cache: (!args.no_cache).then(|| args.cache.clone().unwrap_or_else(|| out_root.join(".references"))),
+        reference_spp: args.reference_spp,
+    };
+    // (knob, scene, folder) for every run.
+    let mut runs: Vec<(Knob, Option<PathBuf>, PathBuf)> = Vec::new();
+    for &knob in &knobs {
+        let single_folder = match (args.knob, &args.out) {
+            (KnobChoice::One(_), Some(out)) => out.clone(),
+            _ => out_root.join(knob.name()),
+        };
+        if !report_mode || !knob.uses_scene() {
+            runs.push((knob, args.scene.clone(), single_folder));
+            continue;
+        }
+        let scenes = report_scenes(knob);
+        for scene in scenes {
+            let path = scenes_folder().join(scene);
+            if !path.is_file() {
+                eprintln!(
+                    "skipping {knob} on {}: not found (set RTGI_SCENES to the shared scenes' folder)",
+                    path.display()
+                );
+                continue;
+            }
+            let stem = path.file_stem().map_or_else(|| "scene".into(), |s| s.to_string_lossy().to_lowercase());
+            let folder = if scenes.len() > 1 { single_folder.join(stem) } else { single_folder.clone() };
+            runs.push((knob, Some(path), folder));
+        }
+    }
+    let mut written: Vec<(PathBuf, Report)> = Vec::new();
+    for (knob, scene, folder) in runs {
+        let subject = pool.install(|| prepare(args, scene.as_deref()))?;
+        eprintln!("experiment {knob} on {}: {}", subject.name, knob.question());
+        let report = pool.install(|| rtgi_experiment::run(knob, &subject, &options, &|line| eprintln!("  {line}")))?;
+        for finding in &report.findings {
+            println!("{knob}: {finding}");
+        }
+        for path in report.write(&folder)? {
+            println!("wrote {}", path.display());
+        }
+        written.push((folder, report));
+    }
+    if args.knob == KnobChoice::All {
+        let entries: Vec<IndexEntry<'_>> = written
+            .iter()
+            .map(|(folder, report)| IndexEntry {
+                folder: folder.strip_prefix(&out_root).unwrap_or(folder).to_owned(),
+                report,
+            })
+            .collect();
+        let path = rtgi_experiment::write_index(&out_root, &entries, &options.command)?;
+        println!("wrote {}", path.display());
+    }
+    Ok(())
+}
+
+/// Loads the scene (the built-in Cornell box when `None`), applies the
+/// lighting options, builds the structure and chooses the camera, as `rtgi render` does.
+fn prepare(args: &ExperimentArgs, scene: Option<&Path>) -> Result<Subject> {
+    let LoadedScene { mut scene, name, .. } = load_scene(scene)?;
     let side = if args.quick { 32 } else { 128 };
     let (width, height) = (args.width.unwrap_or(side), args.height.unwrap_or(side));
     let mut settings = RenderSettings {
@@ -32,26 +127,7 @@ pub(crate) fn run(args: &ExperimentArgs) -> Result<()> {
         ..RenderSettings::default()
     };
     apply_lighting(&args.lighting, &mut scene, &mut settings)?;
-    let accel = pool.install(|| args.accel.build(&scene))?;
+    let accel = args.accel.build(&scene)?;
     let camera = choose_camera(&scene, accel.as_ref(), &args.camera, width as f32 / height as f32)?;
-    let subject = Subject { name, scene, camera, accel, settings };
-    let options = Options {
-        repeats: args.repeats as usize,
-        quick: args.quick,
-        command: std::env::args().collect::<Vec<_>>().join(" "),
-        threads: pool.current_num_threads(),
-        cache: (!args.no_cache).then(|| args.cache.clone().unwrap_or_else(|| out_root.join(".references"))),
-        reference_spp: args.reference_spp,
-    };
-    for knob in knobs {
-        eprintln!("experiment {knob}: {}", knob.question());
-        let report = pool.install(|| rtgi_experiment::run(knob, &subject, &options, &|line| eprintln!("  {line}")))?;
-        for finding in &report.findings {
-            println!("{knob}: {finding}");
-        }
-        for path in report.write(&folder(knob))? {
-            println!("wrote {}", path.display());
-        }
-    }
-    Ok(())
+    Ok(Subject { name, scene, camera, accel, settings })
 }

@@ -22,6 +22,7 @@ use rtgi_accel::Accel;
 use rtgi_render::RenderSettings;
 use rtgi_scene::{Camera, Scene};
 
+mod index;
 mod knobs;
 pub mod machine;
 pub mod plot;
@@ -30,6 +31,7 @@ pub mod report;
 mod runner;
 pub mod stats;
 
+pub use index::{IndexEntry, write_index};
 pub use knobs::Knob;
 pub use machine::Machine;
 pub use report::{Point, Report, Series, Table};

@@ -95,6 +95,14 @@ pub(super) fn run(
                     sampler.to_string()
                 }
             };
+            // Relative MSE weighs dark pixels as much as bright ones, so it
+            // shows whether a sampler helps the whole image or only the
+            // bright edges that dominate RMSE.
+            let relative: Vec<(f64, f64)> =
+                series.points.iter().map(|p| (p.x, p.error.expect("measured").relative_mse)).collect();
+            if let Some(fit) = PowerLaw::fit(&relative) {
+                report.findings.push(format!("{integrand}, {sampler}: relative MSE ∝ spp^{:.3}", fit.exponent));
+            }
             let bars = series.points.iter().map(|p| p.error.map(|e| (e.rmse_min, e.rmse_max))).collect();
             error_curves
                 .push(Curve::new(&label, series.points.iter().map(|p| (p.x, rmse(p))).collect()).with_bars(bars));
