@@ -60,6 +60,13 @@ fn rays(count: usize, seed: u64) -> Vec<Ray> {
 /// overheads (setting the ray up, the first node) dominate the time.
 const LARGE: f64 = 500.0;
 
+/// Bytes the linear scan reads per triangle: three 16-byte corners and a 4-byte index.
+const TRIANGLE_BYTES: f64 = 52.0;
+
+/// Triangle data up to this size stays in the caches of a typical server
+/// core (a few MiB of L2 and a share of L3).
+const CACHED_BYTES: f64 = 2.0 * 1024.0 * 1024.0;
+
 /// Triangle tests the linear scan may spend per count.
 const LINEAR_BUDGET: usize = 200_000_000;
 
@@ -142,6 +149,30 @@ pub(super) fn run(options: &Options, mut report: Report, progress: &dyn Fn(&str)
         };
         let bars = s.points.iter().map(|p| Some((p.values["ns_per_ray_min"], p.values["ns_per_ray_max"]))).collect();
         curves.push(Curve::new(label, xy).with_bars(bars));
+    }
+    // The naive search's cost per triangle: constant while the triangles
+    // fit in the caches, higher once every ray streams them from memory,
+    // which bends the fitted exponent above 1.
+    if let Some(linear) = series.iter().find(|s| s.name == AccelKind::Linear.name()) {
+        let per_triangle: Vec<String> =
+            linear.points.iter().map(|p| format!("{:.1} ns at {}", p.values["ns_per_ray"] / p.x, p.label)).collect();
+        report
+            .findings
+            .push(format!("linear: time per ray per triangle (wall time on all threads): {}", per_triangle.join(", ")));
+        let cached: Vec<(f64, f64)> = linear
+            .points
+            .iter()
+            .filter(|p| p.x >= LARGE && p.x * TRIANGLE_BYTES <= CACHED_BYTES)
+            .map(|p| (p.x, p.values["ns_per_ray"]))
+            .collect();
+        if let Some(fit) = PowerLaw::fit(&cached) {
+            report.findings.push(format!(
+                "linear: time per ray ∝ n^{:.3} over the {} meshes from {LARGE} triangles up whose triangles take at most {} MiB",
+                fit.exponent,
+                fit.points,
+                CACHED_BYTES / (1024.0 * 1024.0)
+            ));
+        }
     }
     report.series = series;
     report.plots.push(Plot {
