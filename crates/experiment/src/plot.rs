@@ -84,14 +84,15 @@ fn axis_range(values: impl Iterator<Item = f64>, log: bool) -> (f64, f64) {
 }
 
 impl Plot {
-    /// The plot as an SVG document; the machine goes into the title.
-    pub fn to_svg(&self, machine: &Machine) -> Result<String, ExperimentError> {
+    /// The plot as an SVG document; the scene and the machine go into the title.
+    pub fn to_svg(&self, scene: &str, machine: &Machine) -> Result<String, ExperimentError> {
         let mut svg = String::new();
-        self.draw(&mut svg, machine).map_err(|message| ExperimentError::Plot { file: self.file.clone(), message })?;
+        self.draw(&mut svg, scene, machine)
+            .map_err(|message| ExperimentError::Plot { file: self.file.clone(), message })?;
         Ok(svg)
     }
 
-    fn draw(&self, svg: &mut String, machine: &Machine) -> Result<(), String> {
+    fn draw(&self, svg: &mut String, scene: &str, machine: &Machine) -> Result<(), String> {
         let xs = self.curves.iter().flat_map(|c| c.points.iter().map(|p| p.0));
         let ys = self
             .curves
@@ -101,7 +102,14 @@ impl Plot {
         let y_range = axis_range(ys, self.log_y);
         let root = SVGBackend::with_string(svg, SIZE).into_drawing_area();
         root.fill(&WHITE).map_err(|e| e.to_string())?;
-        let caption = format!("{} ({})", self.title, machine.short());
+        // A scene file is named by its file name (the folder says nothing in
+        // a title), a built-in scene by its name without the explanation.
+        let path = std::path::Path::new(scene);
+        let scene = match path.file_name() {
+            Some(name) if path.is_file() => name.to_string_lossy().into_owned(),
+            _ => scene.split(" (").next().unwrap_or(scene).to_owned(),
+        };
+        let caption = format!("{}, {scene} ({})", self.title, machine.short());
         let mut builder = ChartBuilder::on(&root);
         builder.caption(caption, ("sans-serif", 18)).margin(14).x_label_area_size(44).y_label_area_size(70);
         // The four combinations of linear and log axes are different types.

@@ -155,7 +155,7 @@ impl Report {
             Ok(())
         };
         for plot in &self.plots {
-            write(&plot.file, &plot.to_svg(&self.machine)?)?;
+            write(&plot.file, &plot.to_svg(&self.scene, &self.machine)?)?;
         }
         let json = serde_json::to_string_pretty(self).expect("reports serialise");
         write(&format!("{}.json", self.knob), &json)?;
