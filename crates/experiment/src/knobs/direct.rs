@@ -223,7 +223,7 @@ pub(super) fn run(
         curves.push(Curve::guide("reference noise", vec![(fastest, noise), (slowest, noise)]));
         report.plots.push(Plot {
             file: format!("direct-{name}.svg"),
-            title: format!("Direct light, {}: RMSE against time", direct_scene.case),
+            title: format!("Direct light, {name}: RMSE against time"),
             x_label: "render time (ms, median)".into(),
             y_label: "RMSE of linear radiance".into(),
             log_x: true,

@@ -14,7 +14,7 @@ use rtgi_render::{EffectPlan, RenderSettings};
 
 use crate::plot::{Corner, Curve, Plot};
 use crate::reference::reference;
-use crate::report::{Point, Report, Series, Table, format_number, format_timing};
+use crate::report::{Point, Report, Series, Table, format_ms, format_number, format_timing};
 use crate::runner::measure;
 use crate::{ExperimentError, Options, Steps, Subject};
 
@@ -169,7 +169,7 @@ pub(super) fn run(
         plan.enabled(),
         plan.omitted(),
         reversals.len(),
-        format_number(planned_time.median_ms),
+        format_ms(planned_time.median_ms),
         format_number(planned_error.rmse)
     ));
     if !free.is_empty() {
@@ -203,7 +203,8 @@ pub(super) fn run(
         title: format!("Each decision of the plan reversed, {spp} spp"),
         x_label: "render time / the plan's (median)".into(),
         y_label: "RMSE / the plan's".into(),
-        log_x: true,
+        // Time ratios stay within a decade; the error's span decades.
+        log_x: false,
         log_y: true,
         curves,
         legend: Corner::UpperRight,
