@@ -30,7 +30,7 @@ fn every_knob_writes_its_table_json_and_plots() {
     let dir = scratch_dir("experiment-all");
     let run = rtgi(&["experiment", "all", "--quick", "--repeats", "2", "--out", path_str(&dir)]);
     assert!(run.success, "{run:?}");
-    for knob in ["spp", "depth", "accel", "scaling"] {
+    for knob in ["spp", "depth", "accel", "scaling", "direct", "effects"] {
         let folder = dir.join(knob);
         let md = std::fs::read_to_string(folder.join(format!("{knob}.md"))).expect("the table");
         assert!(md.contains(&format!("# `{knob}`")) && md.contains("|---|"), "{md}");
@@ -75,6 +75,50 @@ fn every_knob_writes_its_table_json_and_plots() {
     check_svg(&dir.join("depth/depth-energy.svg"), &["roulette on", "roulette off"]);
     check_svg(&dir.join("scaling/scaling.svg"), &["linear (n^", "sah (n^", "bvh8 (n^"]);
     check_svg(&dir.join("accel/accel-incoherent.svg"), &["linear", "sah", "bvh4", "bvh8"]);
+    for scene in ["small-light", "large-light", "glossy"] {
+        check_svg(&dir.join(format!("direct/direct-{scene}.svg")), &["light", "bsdf", "mis", "reference noise"]);
+    }
+    check_svg(&dir.join("effects/effects.svg"), &["-emission", "-indirect", "+glossy", "+textures"]);
+
+    // Sampling points on a small light beats sampling the BSDF towards it, at equal time, by far.
+    let direct: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("direct/direct.json")).unwrap()).unwrap();
+    let at_equal_time = |name: &str| {
+        let series = direct["series"].as_array().unwrap().iter().find(|s| s["name"] == name).expect(name);
+        let last = series["points"].as_array().unwrap().last().unwrap();
+        last["values"]["rmse_at_equal_time"].as_f64().unwrap_or_else(|| panic!("{name}: {last}"))
+    };
+    let (light, bsdf) = (at_equal_time("small-light, light"), at_equal_time("small-light, bsdf"));
+    assert!(light > 0.0 && light * 2.0 < bsdf, "small light: light sampling {light}, BSDF sampling {bsdf}");
+    // Every strategy converges to the same image: the means agree with the MIS reference.
+    for s in direct["series"].as_array().unwrap() {
+        let last = s["points"].as_array().unwrap().last().unwrap();
+        let (mean, reference) =
+            (last["error"]["mean"].as_f64().unwrap(), last["error"]["reference_mean"].as_f64().unwrap());
+        assert!((mean / reference - 1.0).abs() < 0.15, "{}: mean {mean} against {reference}", s["name"]);
+    }
+
+    // Effects: forcing on what the Cornell box does not call for changes no error (the same paths);
+    // forcing off what it calls for shows.
+    let effects: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("effects/effects.json")).unwrap()).unwrap();
+    let points = effects["series"][0]["points"].as_array().unwrap();
+    let value = |label: &str, name: &str| {
+        let point = points.iter().find(|p| p["label"] == label).unwrap_or_else(|| panic!("no {label}"));
+        point["values"][name].as_f64().unwrap_or_else(|| panic!("{label}: no {name}"))
+    };
+    let forced_on: Vec<&serde_json::Value> = points.iter().filter(|p| p["values"]["planned"] == 0.0).collect();
+    assert!(forced_on.len() >= 4, "{forced_on:?}");
+    for p in forced_on {
+        let ratio = p["values"]["rmse_ratio"].as_f64().unwrap();
+        assert!((ratio - 1.0).abs() < 1e-3, "{}: RMSE ×{ratio}", p["label"]);
+    }
+    assert!(value("-emission", "energy_ratio") < 0.05, "without emission the box is dark");
+    assert!(value("-emission", "rmse_ratio") > 1.5);
+    assert!(value("-indirect", "energy_ratio") < 0.9, "without bounces light is missing");
+    // Without light sampling the emitter is still found by the BSDF's rays: no energy lost, more noise.
+    assert!((value("-direct-light", "energy_ratio") - 1.0).abs() < 0.2);
+    assert!(value("-direct-light", "rmse_ratio") > 1.2);
 
     // Errors are measured against a reference, with its noise.
     let spp: serde_json::Value =

@@ -10,7 +10,7 @@ use rtgi_image::HdrImage;
 use rtgi_math::{Vec2, Vec3};
 use rtgi_render::probes::icosphere;
 use rtgi_render::{
-    CameraRays, DirectStrategy, Effect, EffectOverrides, EffectPlan, Environment, Integrator, PixelSampler,
+    CameraRays, DirectStrategy, Effect, EffectOverrides, EffectPlan, EffectSet, Environment, Integrator, PixelSampler,
     RenderSettings, render,
 };
 use rtgi_scene::{Camera, Light, LightKind, Material, MeshBuilder, Scene, SurfaceModel};
@@ -201,12 +201,15 @@ fn cornell_box() -> (Scene, Camera) {
 fn assert_omissions_change_nothing(scene: &Scene, camera: &Camera, settings: &RenderSettings) -> usize {
     let planned = render_scene(scene, camera, settings);
     let plan = EffectPlan::new(scene, settings);
-    let omitted: Vec<Effect> = plan.omitted().collect();
-    for &effect in &omitted {
+    let omitted = plan.omitted();
+    for effect in omitted.iter() {
         if effect == Effect::Indirect && settings.integrator != Integrator::Path {
             continue;
         }
-        let forced = RenderSettings { effects: EffectOverrides { on: vec![effect], off: vec![] }, ..settings.clone() };
+        let forced = RenderSettings {
+            effects: EffectOverrides { on: EffectSet::of(&[effect]), off: EffectSet::EMPTY },
+            ..settings.clone()
+        };
         assert!(EffectPlan::new(scene, &forced).has(effect));
         let image = render_scene(scene, camera, &forced);
         let worst = planned
@@ -244,8 +247,10 @@ fn effects_the_plan_omits_change_nothing_when_forced_on() {
         assert!(EffectPlan::new(&scene, &settings).has(Effect::Textures));
         assert_omissions_change_nothing(&scene, &camera, &settings);
         // Forcing a needed effect off does change the image.
-        let untextured =
-            RenderSettings { effects: EffectOverrides { on: vec![], off: vec![Effect::Textures] }, ..settings.clone() };
+        let untextured = RenderSettings {
+            effects: EffectOverrides { on: EffectSet::EMPTY, off: EffectSet::of(&[Effect::Textures]) },
+            ..settings.clone()
+        };
         let a = render_scene(&scene, &camera, &settings);
         let b = render_scene(&scene, &camera, &untextured);
         assert!(rtgi_image::compare(&a, &b).unwrap().max_abs > 0.05);

@@ -49,7 +49,8 @@ pub(crate) enum Command {
 /// `rtgi experiment`: one knob measured as time against error.
 #[derive(Debug, Args)]
 pub(crate) struct ExperimentArgs {
-    /// The knob: spp, depth, accel, scaling, or all
+    /// The knob: spp, depth, accel, scaling, direct (light/BSDF/MIS sampling on scenes of its own), effects
+    /// (each decision of the effects planner reversed), or all
     pub(crate) knob: KnobChoice,
 
     /// Scene file (.obj, .gltf, .glb or .toml); the built-in Cornell box when omitted

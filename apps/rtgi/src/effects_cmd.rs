@@ -11,7 +11,7 @@ use std::time::Instant;
 
 use anyhow::Result;
 use rtgi_image::{Difference, HdrImage, compare};
-use rtgi_render::{Effect, EffectPlan, RenderSettings, render};
+use rtgi_render::{EffectPlan, RenderSettings, render};
 use serde::Serialize;
 
 use crate::cli::BenchEffectsArgs;
@@ -76,23 +76,10 @@ pub(crate) fn run(args: &BenchEffectsArgs) -> Result<()> {
     let (planned_ms, planned) = measure(&settings);
     let mut rows = vec![Row { label: "plan".into(), median_ms: planned_ms, relative_time: 1.0, difference: None }];
     // Effects the user forced stay as forced; every other decision is reversed once.
-    for entry in plan.effects.iter().filter(|e| !e.forced) {
-        let effect: Effect = entry.effect;
-        let mut overrides = settings.effects.clone();
-        let label = if entry.enabled {
-            overrides.off.push(effect);
-            format!("-{effect}")
-        } else {
-            overrides.on.push(effect);
-            format!("+{effect}")
-        };
-        let reversed = RenderSettings { effects: overrides, ..settings.clone() };
-        // Reversing an effect that depends on another may change nothing (normal maps without textures).
-        if EffectPlan::new(&scene, &reversed).has(effect) == entry.enabled {
-            continue;
-        }
+    for reversal in plan.reversals(&scene, &settings) {
+        let label = reversal.label();
         eprintln!("measuring {label} ...");
-        let (ms, image) = measure(&reversed);
+        let (ms, image) = measure(&reversal.settings);
         rows.push(Row { label, median_ms: ms, relative_time: ms / planned_ms, difference: compare(&image, &planned) });
     }
 

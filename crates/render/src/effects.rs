@@ -13,9 +13,9 @@ use std::str::FromStr;
 use rtgi_scene::{AlphaMode, Material, Scene, SurfaceModel};
 use serde::Serialize;
 
-use crate::{Integrator, RenderSettings};
+use crate::{EffectSet, Integrator, RenderSettings};
 
-/// Something a render may simulate.
+/// Something a render may simulate. Sets of effects are [`EffectSet`]s.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub enum Effect {
     /// Light sampled from lights, emitters and the environment at every
@@ -40,6 +40,7 @@ pub enum Effect {
 }
 
 impl Effect {
+    /// Every effect, in declaration order (the order of [`EffectSet`]'s bits).
     pub const ALL: &'static [Effect] = &[
         Effect::DirectLight,
         Effect::Emission,
@@ -73,8 +74,8 @@ rtgi_math::named_choices!(Effect, "effect");
 /// comma-separated list such as `+glossy,-textures`.
 #[derive(Clone, Debug, Default, PartialEq, Eq)]
 pub struct EffectOverrides {
-    pub on: Vec<Effect>,
-    pub off: Vec<Effect>,
+    pub on: EffectSet,
+    pub off: EffectSet,
 }
 
 impl FromStr for EffectOverrides {
@@ -83,7 +84,7 @@ impl FromStr for EffectOverrides {
     fn from_str(text: &str) -> Result<Self, String> {
         let mut overrides = EffectOverrides::default();
         for item in text.split(',').map(str::trim).filter(|s| !s.is_empty()) {
-            let (list, name) = if let Some(name) = item.strip_prefix('+') {
+            let (set, name) = if let Some(name) = item.strip_prefix('+') {
                 (&mut overrides.on, name)
             } else if let Some(name) = item.strip_prefix('-') {
                 (&mut overrides.off, name)
@@ -91,9 +92,9 @@ impl FromStr for EffectOverrides {
                 return Err(format!("'{item}': write +effect to force an effect on, -effect to force it off"));
             };
             let effect: Effect = name.parse()?;
-            list.push(effect);
+            set.insert(effect);
         }
-        if let Some(both) = overrides.on.iter().find(|e| overrides.off.contains(e)) {
+        if let Some(both) = overrides.on.intersection(overrides.off).iter().next() {
             return Err(format!("effect '{both}' is forced both on and off"));
         }
         Ok(overrides)
@@ -130,17 +131,32 @@ pub struct EffectPlan {
     pub max_depth: u32,
 }
 
-/// The specialisation bits the renderer is compiled for.
-pub(crate) mod bits {
-    pub(crate) const ALPHA: u32 = 1;
-    pub(crate) const TEXTURES: u32 = 2;
-    /// Any model besides Lambert: glossy, mirror or refracting surfaces.
-    pub(crate) const SPECULAR: u32 = 4;
-    /// Next-event estimation.
-    pub(crate) const LIGHTS: u32 = 8;
-    /// Radiance picked up where rays hit emitters or leave the scene.
-    pub(crate) const EMITTED: u32 = 16;
-    pub(crate) const COUNT: u32 = 32;
+/// The effects whose code the light-transport loop is compiled with or
+/// without: the renderer has one loop per subset of them
+/// ([`EffectPlan::specialisation`]). The other effects are tested at run
+/// time, where their cost is small. Two of the set stand for more than
+/// themselves: [`Effect::Glossy`] for every lobe besides Lambert's
+/// (refraction too), [`Effect::Emission`] for every light picked up where a
+/// ray ends (the environment's too).
+pub const SPECIALISED: EffectSet =
+    EffectSet::of(&[Effect::Alpha, Effect::Textures, Effect::Glossy, Effect::DirectLight, Effect::Emission]);
+
+/// One decision of a plan reversed: an effect the plan simulates, forced
+/// off, or one it leaves out, forced on.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Reversal {
+    pub effect: Effect,
+    /// Whether the plan simulates the effect (and the reversal forces it off).
+    pub planned: bool,
+    /// The render's settings with the reversing override added.
+    pub settings: RenderSettings,
+}
+
+impl Reversal {
+    /// `-effect` for an effect forced off, `+effect` for one forced on.
+    pub fn label(&self) -> String {
+        format!("{}{}", if self.planned { '-' } else { '+' }, self.effect)
+    }
 }
 
 fn names(materials: &[&Material]) -> String {
@@ -203,8 +219,8 @@ impl EffectPlan {
         let overrides = &settings.effects;
         let mut effects = Vec::new();
         let mut decide = |effect: Effect, needed: bool, reason: String| {
-            let forced_on = overrides.on.contains(&effect);
-            let forced_off = overrides.off.contains(&effect);
+            let forced_on = overrides.on.contains(effect);
+            let forced_off = overrides.off.contains(effect);
             let enabled = (needed || forced_on) && !forced_off;
             let forced = enabled != needed;
             let reason = match (forced_on, forced_off) {
@@ -367,35 +383,63 @@ impl EffectPlan {
         Self { integrator, effects, default_environment, max_depth }
     }
 
+    /// The effects the plan simulates.
+    pub fn enabled(&self) -> EffectSet {
+        self.effects.iter().filter(|e| e.enabled).map(|e| e.effect).collect()
+    }
+
     /// Whether the plan simulates `effect`.
     pub fn has(&self, effect: Effect) -> bool {
-        self.effects.iter().any(|e| e.effect == effect && e.enabled)
+        self.enabled().contains(effect)
     }
 
     /// The effects the plan leaves out.
-    pub fn omitted(&self) -> impl Iterator<Item = Effect> + '_ {
-        self.effects.iter().filter(|e| !e.enabled).map(|e| e.effect)
+    pub fn omitted(&self) -> EffectSet {
+        EffectSet::ALL.difference(self.enabled())
     }
 
-    /// The set of specialisations the renderer runs for this plan.
-    pub(crate) fn specialisation(&self) -> u32 {
-        let mut mask = 0;
-        if self.has(Effect::Alpha) {
-            mask |= bits::ALPHA;
+    /// The loop the renderer runs for this plan: the subset of
+    /// [`SPECIALISED`] whose code it needs.
+    pub fn specialisation(&self) -> EffectSet {
+        let enabled = self.enabled();
+        let mut loop_effects = enabled.intersection(SPECIALISED);
+        // Refraction runs in the same non-Lambert code as glossy lobes.
+        if enabled.contains(Effect::Refraction) {
+            loop_effects.insert(Effect::Glossy);
         }
-        if self.has(Effect::Textures) {
-            mask |= bits::TEXTURES;
+        // The environment is light picked up where a ray leaves the scene, as emission is where it ends on an emitter.
+        if enabled.contains(Effect::Environment) {
+            loop_effects.insert(Effect::Emission);
         }
-        if self.has(Effect::Glossy) || self.has(Effect::Refraction) {
-            mask |= bits::SPECULAR;
-        }
-        if self.has(Effect::DirectLight) {
-            mask |= bits::LIGHTS;
-        }
-        if self.has(Effect::Emission) || self.has(Effect::Environment) {
-            mask |= bits::EMITTED;
-        }
-        mask
+        loop_effects
+    }
+
+    /// Every decision of the plan (for `scene` and `settings`) that the
+    /// user did not force, reversed, in the order of [`Effect::ALL`].
+    /// Decisions that cannot be reversed alone (normal maps while textures
+    /// are off) are left out.
+    pub fn reversals(&self, scene: &Scene, settings: &RenderSettings) -> Vec<Reversal> {
+        let forced = settings.effects.on.union(settings.effects.off);
+        let enabled = self.enabled();
+        EffectSet::ALL
+            .difference(forced)
+            .iter()
+            .filter_map(|effect| {
+                let planned = enabled.contains(effect);
+                let mut effects = settings.effects.clone();
+                if planned {
+                    effects.off.insert(effect);
+                } else {
+                    effects.on.insert(effect);
+                }
+                let settings = RenderSettings { effects, ..settings.clone() };
+                (EffectPlan::new(scene, &settings).has(effect) != planned).then_some(Reversal {
+                    effect,
+                    planned,
+                    settings,
+                })
+            })
+            .collect()
     }
 }
 
@@ -424,8 +468,8 @@ mod tests {
     #[test]
     fn overrides_parse() {
         let o: EffectOverrides = "+glossy, -textures,+alpha".parse().unwrap();
-        assert_eq!(o.on, vec![Effect::Glossy, Effect::Alpha]);
-        assert_eq!(o.off, vec![Effect::Textures]);
+        assert_eq!(o.on, EffectSet::of(&[Effect::Glossy, Effect::Alpha]));
+        assert_eq!(o.off, EffectSet::of(&[Effect::Textures]));
         assert!("glossy".parse::<EffectOverrides>().unwrap_err().contains("+effect"));
         assert!("+shiny".parse::<EffectOverrides>().unwrap_err().contains("unknown effect 'shiny'"));
         assert!("+alpha,-alpha".parse::<EffectOverrides>().is_err());

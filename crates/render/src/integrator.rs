@@ -1,6 +1,7 @@
 //! Light transport: direct lighting and path tracing with next-event
 //! estimation, multiple importance sampling and Russian roulette, compiled
-//! once per set of effects ([`EffectPlan::specialisation`]).
+//! once per set of effects ([`EffectPlan::specialisation`], a const
+//! generic `S`: the bits of an [`EffectSet`]).
 //!
 //! Every bounce draws the same block of random numbers whatever the plan,
 //! so that a render whose plan leaves an effect out follows the same paths
@@ -10,11 +11,11 @@ use rtgi_accel::{Accel, Hit};
 use rtgi_math::{Frame, Ray, Rng, SurfacePoint, TriangleShape, Vec2, Vec3, Vec4};
 use rtgi_scene::{Material, Scene, SurfaceModel, Triangle};
 
-use crate::RenderSettings;
 use crate::bsdf::Bsdf;
-use crate::effects::{Effect, EffectPlan, bits, is_glossy, transmits};
+use crate::effects::{Effect, EffectPlan, is_glossy, transmits};
 use crate::lights::{Environment, LightSet};
 use crate::shade::{alpha_accepts, closest_hit};
+use crate::{EffectSet, RenderSettings};
 
 /// What the renderer computes for each pixel.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -151,6 +152,13 @@ struct Interaction {
     weight: Vec3,
 }
 
+/// Whether the loop compiled for the effect set of bits `s` runs `effect`'s
+/// code: a constant in each compiled loop, so the code of the others is
+/// left out ([`crate::effects::SPECIALISED`] says what stands for what).
+const fn compiled(s: u16, effect: Effect) -> bool {
+    EffectSet::from_bits(s).contains(effect)
+}
+
 fn power_heuristic(a: f32, b: f32) -> f32 {
     let (a2, b2) = (a * a, b * b);
     if a2.is_infinite() { 1.0 } else { a2 / (a2 + b2).max(f32::MIN_POSITIVE) }
@@ -190,12 +198,12 @@ impl<'a, A: Accel + ?Sized> Transport<'a, A> {
         }
     }
 
-    fn closest<const S: u32>(&self, ray: &Ray, u_alpha: f32) -> Option<Hit> {
-        closest_hit(self.scene, self.accel, ray, (S & bits::ALPHA != 0).then_some(u_alpha))
+    fn closest<const S: u16>(&self, ray: &Ray, u_alpha: f32) -> Option<Hit> {
+        closest_hit(self.scene, self.accel, ray, compiled(S, Effect::Alpha).then_some(u_alpha))
     }
 
-    fn occluded<const S: u32>(&self, ray: &Ray, u_alpha: f32) -> bool {
-        if S & bits::ALPHA != 0 {
+    fn occluded<const S: u16>(&self, ray: &Ray, u_alpha: f32) -> bool {
+        if compiled(S, Effect::Alpha) {
             self.accel.occluded_filtered(ray, &|t, b, g| alpha_accepts(self.scene, t, b, g, u_alpha))
         } else {
             self.accel.occluded(ray)
@@ -204,7 +212,7 @@ impl<'a, A: Accel + ?Sized> Transport<'a, A> {
 
     /// The radiance arriving along `ray` (a camera ray); adds the rays it
     /// traces to `rays`.
-    pub(crate) fn radiance<const S: u32>(
+    pub(crate) fn radiance<const S: u16>(
         &self,
         mut ray: Ray,
         mut first_hit: Option<Option<Hit>>,
@@ -231,7 +239,7 @@ impl<'a, A: Accel + ?Sized> Transport<'a, A> {
             };
             let Some(hit) = hit else {
                 match self.environment {
-                    Some(environment) if S & bits::EMITTED != 0 => {
+                    Some(environment) if compiled(S, Effect::Emission) => {
                         let direction = ray.direction.normalize();
                         let weight = self
                             .emitted_weight::<S>(previous_pdf, || self.lights.pdf_environment(environment, direction));
@@ -246,7 +254,7 @@ impl<'a, A: Accel + ?Sized> Transport<'a, A> {
             let material = &scene.materials[triangle.material as usize];
             let direction_length = ray.direction.length();
             let wo = -ray.direction / direction_length;
-            if S & bits::EMITTED != 0
+            if compiled(S, Effect::Emission)
                 && let Some(emitter) = self.lights.emitter(hit.triangle)
             {
                 let emitted = emitter.radiance(scene, hit.beta, hit.gamma, wo);
@@ -268,7 +276,7 @@ impl<'a, A: Accel + ?Sized> Transport<'a, A> {
             let geometric = interaction.point.normal;
             let wo_side = wo.dot(geometric);
 
-            if S & bits::LIGHTS != 0 && self.strategy != DirectStrategy::Bsdf && !bsdf.is_delta() {
+            if compiled(S, Effect::DirectLight) && self.strategy != DirectStrategy::Bsdf && !bsdf.is_delta() {
                 let u_light = Vec2::new(u[dim::LIGHT], u[dim::LIGHT + 1]);
                 if let Some(light) =
                     self.lights.sample(scene, self.environment, &interaction.point, u[dim::LIGHT_CHOICE], u_light)
@@ -341,11 +349,11 @@ impl<'a, A: Accel + ?Sized> Transport<'a, A> {
     /// BSDF's density for it (`None` after the camera or a specular bounce)
     /// and the density with which light sampling would have found it.
     #[inline]
-    fn emitted_weight<const S: u32>(&self, bsdf_pdf: Option<f32>, light_pdf: impl FnOnce() -> f32) -> f32 {
+    fn emitted_weight<const S: u16>(&self, bsdf_pdf: Option<f32>, light_pdf: impl FnOnce() -> f32) -> f32 {
         match bsdf_pdf {
             None => 1.0,
             // Without light sampling, BSDF sampling is the only estimator.
-            Some(_) if S & bits::LIGHTS == 0 => 1.0,
+            Some(_) if !compiled(S, Effect::DirectLight) => 1.0,
             Some(pdf) => match self.strategy {
                 DirectStrategy::Light => 0.0,
                 DirectStrategy::Bsdf => 1.0,
@@ -355,7 +363,7 @@ impl<'a, A: Accel + ?Sized> Transport<'a, A> {
     }
 
     /// The shading frame and BSDF at a hit.
-    fn interact<const S: u32>(&self, hit: &Hit, triangle: &Triangle, material: &Material, u_lobe: f32) -> Interaction {
+    fn interact<const S: u16>(&self, hit: &Hit, triangle: &Triangle, material: &Material, u_lobe: f32) -> Interaction {
         let scene = self.scene;
         let corners = triangle.vertices.map(|v| scene.vertices[v as usize].position);
         let point =
@@ -365,7 +373,7 @@ impl<'a, A: Accel + ?Sized> Transport<'a, A> {
         let mut roughness = material.roughness;
         let mut metallic = material.metallic;
         let mut transmission = material.transmission;
-        if S & bits::TEXTURES != 0 {
+        if compiled(S, Effect::Textures) {
             let uv = scene.interpolate(triangle, hit.beta, hit.gamma, |v| v.uv);
             let texture = |id: rtgi_scene::TextureId| scene.textures[id.0 as usize].sample(uv);
             if let Some(id) = material.base_color_texture {
@@ -403,10 +411,10 @@ impl<'a, A: Accel + ?Sized> Transport<'a, A> {
 
     /// The material's BSDF; layered materials choose one lobe at random
     /// (by `u`), with the weight that keeps the estimate unbiased.
-    fn choose_bsdf<const S: u32>(&self, material: &Material, surface: &SurfaceValues, u: f32) -> (Bsdf, Vec3) {
+    fn choose_bsdf<const S: u16>(&self, material: &Material, surface: &SurfaceValues, u: f32) -> (Bsdf, Vec3) {
         let SurfaceValues { base_color, roughness, metallic, transmission } = *surface;
         let lambert = (Bsdf::Lambert { albedo: base_color }, Vec3::ONE);
-        if S & bits::SPECULAR == 0 {
+        if !compiled(S, Effect::Glossy) {
             return lambert;
         }
         let transmission = if self.refraction && transmits(material) {

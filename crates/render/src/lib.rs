@@ -23,6 +23,7 @@
 pub mod bsdf;
 mod camera;
 mod distribution;
+mod effect_set;
 pub mod effects;
 mod framing;
 mod integrator;
@@ -34,7 +35,8 @@ mod shade;
 
 pub use camera::CameraRays;
 pub use distribution::Distribution1D;
-pub use effects::{Effect, EffectOverrides, EffectPlan, PlannedEffect};
+pub use effect_set::EffectSet;
+pub use effects::{Effect, EffectOverrides, EffectPlan, PlannedEffect, Reversal};
 pub use framing::frame_scene;
 pub use integrator::{DirectStrategy, Integrator};
 pub use lights::{Environment, EnvironmentMap, LightSet};
@@ -50,7 +52,7 @@ use rtgi_math::{Ray, Rng, Vec2, Vec3};
 use rtgi_scene::{Camera, Scene};
 use serde::Serialize;
 
-use crate::effects::bits;
+use crate::effects::SPECIALISED;
 use crate::integrator::Transport;
 
 /// Side of the square tiles that threads take one at a time.
@@ -186,7 +188,7 @@ pub fn render<A: Accel + ?Sized>(
 }
 
 /// Light transport, specialised to the plan's effects: one compiled
-/// version of the path loop per combination of the specialisation bits.
+/// version of the path loop per subset of [`SPECIALISED`].
 fn render_transport<A: Accel + ?Sized>(
     scene: &Scene,
     accel: &A,
@@ -199,7 +201,7 @@ fn render_transport<A: Accel + ?Sized>(
     let white_sky = Environment::Uniform(Vec3::ONE);
     let environment = if plan.default_environment { Some(&white_sky) } else { settings.environment.as_ref() };
     let transport = Transport::new(scene, accel, plan, environment, settings);
-    fn run<const S: u32, A: Accel + ?Sized>(
+    fn run<const S: u16, A: Accel + ?Sized>(
         transport: &Transport<'_, A>,
         camera: &Camera,
         settings: &RenderSettings,
@@ -210,16 +212,29 @@ fn render_transport<A: Accel + ?Sized>(
             transport.radiance::<S>(ray, first, rng, rays)
         })
     }
+    // Decides the specialised effects one at a time, each both ways: the
+    // leaves are the 2^n loops, one per subset, each compiled for its set's bits.
     macro_rules! specialised {
-        ($($bits:literal)*) => {
-            match plan.specialisation() {
-                $($bits => run::<$bits, A>(&transport, camera, settings, first_hits, progress),)*
-                other => unreachable!("specialisation {other} out of range"),
+        (for $set:ident over [$($effect:expr),*]) => {{
+            const _: () = assert!(
+                EffectSet::of(&[$($effect),*]).bits() == SPECIALISED.bits(),
+                "the loops must be dispatched over exactly the specialised effects"
+            );
+            specialised!($set; [] [$($effect),*])
+        }};
+        ($set:ident; [$($chosen:expr),*] []) => {
+            run::<{ EffectSet::of(&[$($chosen),*]).bits() }, A>(&transport, camera, settings, first_hits, progress)
+        };
+        ($set:ident; [$($chosen:expr),*] [$next:expr $(, $rest:expr)*]) => {
+            if $set.contains($next) {
+                specialised!($set; [$($chosen,)* $next] [$($rest),*])
+            } else {
+                specialised!($set; [$($chosen),*] [$($rest),*])
             }
         };
     }
-    const _: () = assert!(bits::COUNT == 32);
-    specialised!(0 1 2 3 4 5 6 7 8 9 10 11 12 13 14 15 16 17 18 19 20 21 22 23 24 25 26 27 28 29 30 31)
+    let specialisation = plan.specialisation();
+    specialised!(for specialisation over [Effect::Alpha, Effect::Textures, Effect::Glossy, Effect::DirectLight, Effect::Emission])
 }
 
 /// Closest hits of a batch of camera rays ([`Accel::intersect_batch`]).

@@ -6,6 +6,8 @@ use crate::{ExperimentError, Machine, Options, Subject};
 
 mod accel;
 mod depth;
+mod direct;
+mod effects;
 mod scaling;
 mod spp;
 
@@ -20,10 +22,14 @@ pub enum Knob {
     Accel,
     /// The naive O(n) search against the BVH, over triangle counts.
     Scaling,
+    /// Light, BSDF and MIS sampling of direct light, on scenes built for each.
+    Direct,
+    /// Each decision of the effects planner reversed.
+    Effects,
 }
 
 impl Knob {
-    pub const ALL: &'static [Knob] = &[Knob::Spp, Knob::Depth, Knob::Accel, Knob::Scaling];
+    pub const ALL: &'static [Knob] = &[Knob::Spp, Knob::Depth, Knob::Accel, Knob::Scaling, Knob::Direct, Knob::Effects];
 
     pub fn name(self) -> &'static str {
         match self {
@@ -31,6 +37,8 @@ impl Knob {
             Knob::Depth => "depth",
             Knob::Accel => "accel",
             Knob::Scaling => "scaling",
+            Knob::Direct => "direct",
+            Knob::Effects => "effects",
         }
     }
 
@@ -47,13 +55,20 @@ impl Knob {
             Knob::Scaling => {
                 "how does the time per ray grow with the triangle count, for the naive search and for the BVH?"
             }
+            Knob::Direct => {
+                "which sampling of direct light (light, BSDF or MIS) gives the least error in equal time, and where?"
+            }
+            Knob::Effects => {
+                "what does each effect cost, and does leaving out one the scene does not call for cost accuracy?"
+            }
         }
     }
 
-    /// Whether the knob renders the subject (and so needs a reference);
-    /// `scaling` makes its own meshes.
+    /// Whether the knob renders the subject's scene (and so needs a
+    /// reference of it); `scaling` makes its own meshes and `direct`
+    /// renders scenes of its own, at the subject's size.
     pub fn uses_scene(self) -> bool {
-        !matches!(self, Knob::Scaling)
+        !matches!(self, Knob::Scaling | Knob::Direct)
     }
 }
 
@@ -68,7 +83,13 @@ pub(crate) fn run(
     let report = Report {
         knob: knob.name().to_owned(),
         question: knob.question().to_owned(),
-        scene: if knob.uses_scene() { subject.name.clone() } else { "generated meshes".to_owned() },
+        scene: match knob {
+            _ if knob.uses_scene() => subject.name.clone(),
+            Knob::Direct => {
+                "scenes/direct-small-light.toml, direct-large-light.toml and direct-glossy.toml (built in)".to_owned()
+            }
+            _ => "generated meshes".to_owned(),
+        },
         machine: Machine::this(options.threads),
         rtgi_version: env!("CARGO_PKG_VERSION").to_owned(),
         command: options.command.clone(),
@@ -85,5 +106,7 @@ pub(crate) fn run(
         Knob::Depth => depth::run(subject, options, report, progress),
         Knob::Accel => accel::run(subject, options, report, progress),
         Knob::Scaling => scaling::run(options, report, progress),
+        Knob::Direct => direct::run(subject, options, report, progress),
+        Knob::Effects => effects::run(subject, options, report, progress),
     }
 }
