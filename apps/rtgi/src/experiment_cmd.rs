@@ -20,15 +20,18 @@ const CORNELL: &str = "cornell-box/CornellBox-Original.obj";
 const BUNNY: &str = "bunny/stanford-bunny.obj";
 const SPONZA: &str = "sponza-dabrovic/sponza.obj";
 const CONFERENCE: &str = "conference/conference.obj";
+const HELMET: &str = "gltf/DamagedHelmet/glTF/DamagedHelmet.gltf";
 
 /// The scenes each knob is measured on in the report: the Cornell box
 /// (small, closed, converges), the bunny (one mesh under the sky), Sponza
-/// and the conference room (large, many materials).
+/// and the conference room (large, many materials), and the damaged helmet
+/// (textures, normal maps, emissive details: effects the box does not need).
 fn report_scenes(knob: Knob) -> &'static [&'static str] {
     match knob {
         Knob::Spp => &[CORNELL, BUNNY],
         Knob::Depth => &[CORNELL, SPONZA],
         Knob::Accel => &[CORNELL, BUNNY, SPONZA, CONFERENCE],
+        Knob::Effects => &[CORNELL, HELMET],
         _ => &[CORNELL],
     }
 }
