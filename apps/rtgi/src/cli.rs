@@ -49,7 +49,7 @@ pub(crate) enum Command {
 /// `rtgi experiment`: one knob measured as time against error.
 #[derive(Debug, Args)]
 pub(crate) struct ExperimentArgs {
-    /// The knob: spp, depth, accel, scaling, or all
+    /// The knob: spp, depth, accel, scaling, intersector, precision, or all
     pub(crate) knob: KnobChoice,
 
     /// Scene file (.obj, .gltf, .glb or .toml); the built-in Cornell box when omitted
@@ -595,7 +595,7 @@ pub(crate) struct BuildArgs {
     #[arg(long)]
     pub(crate) traversal_cost: Option<f32>,
 
-    /// Ray/triangle test: watertight, moller-trumbore
+    /// Ray/triangle test: watertight, moller-trumbore, watertight-f64 (the watertight test in double precision)
     #[arg(long, default_value_t = Intersector::default())]
     pub(crate) intersector: Intersector,
 

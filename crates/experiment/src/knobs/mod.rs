@@ -6,6 +6,8 @@ use crate::{ExperimentError, Machine, Options, Subject};
 
 mod accel;
 mod depth;
+mod intersector;
+mod precision;
 mod scaling;
 mod spp;
 
@@ -20,10 +22,16 @@ pub enum Knob {
     Accel,
     /// The naive O(n) search against the BVH, over triangle counts.
     Scaling,
+    /// The ray/triangle tests: time, and failures on the hard cases of `rtgi verify`.
+    Intersector,
+    /// The triangle test in single against double precision: time, and
+    /// error against the exact answer on near-degenerate and far triangles.
+    Precision,
 }
 
 impl Knob {
-    pub const ALL: &'static [Knob] = &[Knob::Spp, Knob::Depth, Knob::Accel, Knob::Scaling];
+    pub const ALL: &'static [Knob] =
+        &[Knob::Spp, Knob::Depth, Knob::Accel, Knob::Scaling, Knob::Intersector, Knob::Precision];
 
     pub fn name(self) -> &'static str {
         match self {
@@ -31,6 +39,8 @@ impl Knob {
             Knob::Depth => "depth",
             Knob::Accel => "accel",
             Knob::Scaling => "scaling",
+            Knob::Intersector => "intersector",
+            Knob::Precision => "precision",
         }
     }
 
@@ -47,13 +57,21 @@ impl Knob {
             Knob::Scaling => {
                 "how does the time per ray grow with the triangle count, for the naive search and for the BVH?"
             }
+            Knob::Intersector => {
+                "what does each ray/triangle test cost, and how often do rays slip through shared edges or hit \
+                 the surface they leave?"
+            }
+            Knob::Precision => {
+                "how far are t and the barycentrics from the exact answer in single and double precision, on \
+                 near-degenerate and far-from-origin triangles, and what does double precision cost?"
+            }
         }
     }
 
-    /// Whether the knob renders the subject (and so needs a reference);
-    /// `scaling` makes its own meshes.
+    /// Whether the knob measures on the subject's scene; `scaling` and
+    /// `precision` make their own triangles.
     pub fn uses_scene(self) -> bool {
-        !matches!(self, Knob::Scaling)
+        !matches!(self, Knob::Scaling | Knob::Precision)
     }
 }
 
@@ -68,7 +86,7 @@ pub(crate) fn run(
     let report = Report {
         knob: knob.name().to_owned(),
         question: knob.question().to_owned(),
-        scene: if knob.uses_scene() { subject.name.clone() } else { "generated meshes".to_owned() },
+        scene: if knob.uses_scene() { subject.name.clone() } else { "generated triangles".to_owned() },
         machine: Machine::this(options.threads),
         rtgi_version: env!("CARGO_PKG_VERSION").to_owned(),
         command: options.command.clone(),
@@ -85,5 +103,7 @@ pub(crate) fn run(
         Knob::Depth => depth::run(subject, options, report, progress),
         Knob::Accel => accel::run(subject, options, report, progress),
         Knob::Scaling => scaling::run(options, report, progress),
+        Knob::Intersector => intersector::run(subject, options, report, progress),
+        Knob::Precision => precision::run(options, report, progress),
     }
 }
