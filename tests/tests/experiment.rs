@@ -30,7 +30,7 @@ fn every_knob_writes_its_table_json_and_plots() {
     let dir = scratch_dir("experiment-all");
     let run = rtgi(&["experiment", "all", "--quick", "--repeats", "2", "--out", path_str(&dir)]);
     assert!(run.success, "{run:?}");
-    for knob in ["spp", "depth", "accel", "scaling", "direct", "effects"] {
+    for knob in ["spp", "depth", "accel", "scaling", "direct", "effects", "intersector", "precision"] {
         let folder = dir.join(knob);
         let md = std::fs::read_to_string(folder.join(format!("{knob}.md"))).expect("the table");
         assert!(md.contains(&format!("# `{knob}`")) && md.contains("|---|"), "{md}");
@@ -75,6 +75,16 @@ fn every_knob_writes_its_table_json_and_plots() {
     check_svg(&dir.join("depth/depth-energy.svg"), &["roulette on", "roulette off"]);
     check_svg(&dir.join("scaling/scaling.svg"), &["linear (n^", "sah (n^", "bvh8 (n^"]);
     check_svg(&dir.join("accel/accel-incoherent.svg"), &["linear", "sah", "bvh4", "bvh8"]);
+    let intersectors = ["watertight", "moller-trumbore", "watertight-f64"];
+    for plot in ["intersector-speed.svg", "intersector-self-hits.svg", "intersector-leaks.svg"] {
+        check_svg(&dir.join("intersector").join(plot), &intersectors);
+    }
+    for plot in
+        ["precision-far-t.svg", "precision-far-barycentrics.svg", "precision-sliver-t.svg", "precision-time.svg"]
+    {
+        check_svg(&dir.join("precision").join(plot), &intersectors);
+    }
+
     for scene in ["small-light", "large-light", "glossy"] {
         check_svg(&dir.join(format!("direct/direct-{scene}.svg")), &["light", "bsdf", "mis", "reference noise"]);
     }
@@ -140,6 +150,62 @@ fn every_knob_writes_its_table_json_and_plots() {
         assert_eq!(point["camera_disagreements"], 0.0, "{}", s["name"]);
         assert_eq!(point["incoherent_disagreements"], 0.0, "{}", s["name"]);
     }
+    // The watertight tests let no ray through a shared edge or out of a
+    // closed mesh, nor hit the surface a spawned ray leaves, at any
+    // distance; Möller-Trumbore loses some of the rays through shared edges.
+    let intersector: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("intersector/intersector.json")).unwrap()).unwrap();
+    let values = |name: &str| -> Vec<serde_json::Value> {
+        let series = intersector["series"].as_array().unwrap().iter().find(|s| s["name"] == name);
+        series.unwrap_or_else(|| panic!("no series {name}"))["points"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|p| p["values"].clone())
+            .collect()
+    };
+    for name in ["watertight", "watertight-f64"] {
+        let scene = &values(name)[0];
+        assert!(scene["shared_edge_rays"].as_f64().unwrap() > 0.0, "{scene}");
+        assert_eq!(scene["shared_edge_leaks"], 0.0, "{name}: {scene}");
+        assert_eq!(scene["closed_mesh_leaks"], 0.0, "{name}: {scene}");
+        let by_distance = values(&format!("{name} by distance"));
+        assert!(by_distance.len() >= 3, "{name}: {by_distance:?}");
+        for point in by_distance {
+            assert!(point["secondary_rays"].as_f64().unwrap() > 0.0, "{point}");
+            assert_eq!(point["self_hits"], 0.0, "{name}: {point}");
+            assert!(point["escaping_rays"].as_f64().unwrap() > 0.0, "{point}");
+            assert_eq!(point["escaped"], 0.0, "{name}: {point}");
+        }
+    }
+    let moller = &values("moller-trumbore")[0];
+    assert!(moller["shared_edge_leaks"].as_f64().unwrap() > 0.0, "{moller}");
+    // Double precision is at least as close to the exact answer as single
+    // precision far from the origin, and its barycentrics much closer at 2^24.
+    let precision: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("precision/precision.json")).unwrap()).unwrap();
+    let far = |name: &str, value: &str| -> Vec<(f64, f64)> {
+        let series = precision["series"].as_array().unwrap().iter().find(|s| s["name"] == name).expect(name);
+        series["points"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|p| (p["x"].as_f64().unwrap(), p["values"][value].as_f64().unwrap()))
+            .collect()
+    };
+    let t_error = "t_relative_error_max";
+    let (single, double) = (far("watertight far", t_error), far("watertight-f64 far", t_error));
+    assert_eq!(single.len(), double.len());
+    for ((x, e32), (_, e64)) in single.iter().zip(&double) {
+        assert!(e64 <= e32, "at {x}: f64 error {e64} above f32 error {e32}");
+        // Rounded to f32 at the end: within a little over half an ulp.
+        assert!(*e64 <= 1.01 * 2f64.powi(-24), "at {x}: f64 error {e64}");
+    }
+    let barycentric_error = "barycentric_error_max";
+    let (single, double) = (far("watertight far", barycentric_error), far("watertight-f64 far", barycentric_error));
+    let (far_x, far_e32) = *single.last().unwrap();
+    assert!(far_x >= 2f64.powi(24) && far_e32 > 100.0 * double.last().unwrap().1, "{single:?} {double:?}");
+
     // The second run reads the references from the cache.
     let again = rtgi(&[
         "experiment",

@@ -8,7 +8,7 @@
 //! edge" is true in floating point: rays are built as `origin` and
 //! `target - origin` from dyadic numbers whose difference is exact.
 
-use rtgi_accel::{AccelKind, BuildParams, Intersector};
+use rtgi_accel::{AccelKind, BuildParams};
 use rtgi_math::{Ray, Rng, SurfacePoint, Vec3};
 use rtgi_render::probes::{ClosedMesh, icosphere, quad, rays_through_diagonal};
 use rtgi_tests::for_every_variant;
@@ -24,7 +24,7 @@ fn expect_all_hit(case: &str, triangles: &[[Vec3; 3]], rays: &[Ray]) {
 }
 
 fn report(case: &str, label: &str, params: &BuildParams, failures: usize, total: usize) {
-    if params.intersector == Intersector::Watertight {
+    if params.intersector.is_watertight() {
         assert_eq!(failures, 0, "{case}: {label}: {failures} of {total} rays fell through");
     } else if failures > 0 {
         eprintln!(

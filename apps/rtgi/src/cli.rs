@@ -50,7 +50,7 @@ pub(crate) enum Command {
 #[derive(Debug, Args)]
 pub(crate) struct ExperimentArgs {
     /// The knob: spp, depth, accel, scaling, direct (light/BSDF/MIS sampling on scenes of its own), effects
-    /// (each decision of the effects planner reversed), or all
+    /// (each decision of the effects planner reversed), intersector, precision, or all
     pub(crate) knob: KnobChoice,
 
     /// Scene file (.obj, .gltf, .glb or .toml); the built-in Cornell box when omitted
@@ -596,7 +596,7 @@ pub(crate) struct BuildArgs {
     #[arg(long)]
     pub(crate) traversal_cost: Option<f32>,
 
-    /// Ray/triangle test: watertight, moller-trumbore
+    /// Ray/triangle test: watertight, moller-trumbore, watertight-f64 (the watertight test in double precision)
     #[arg(long, default_value_t = Intersector::default())]
     pub(crate) intersector: Intersector,
 

@@ -171,7 +171,7 @@ fn check_case(
         }
     };
     for &intersector in intersectors {
-        let watertight = intersector == Intersector::Watertight;
+        let watertight = intersector.is_watertight();
         let linear = LinearScan::new(&case.triangles, intersector);
         let chosen: Vec<&(AccelKind, BuildParams)> =
             configurations.iter().filter(|(_, p)| p.intersector == intersector).collect();

@@ -21,7 +21,7 @@
 //! - **Any hit.** True exactly when the closest hit would return a hit.
 //!
 //! This holds for the linear scan, every BVH variant, leaf size and bin
-//! count with the robust traversal, at any thread count, with either
+//! count with the robust traversal, at any thread count, with every
 //! intersector, and for rays in every direction, including axis-parallel
 //! ones and directions with zero or negative-zero components. (The fast
 //! traversal drops boxes that rays graze and is outside the contract.)

@@ -32,7 +32,7 @@
 //! The structure is a pure speed choice: swapping it changes the time,
 //! never the answer. Every structure (the linear scan, every BVH variant,
 //! leaf size and bin count with the robust traversal, and every structure
-//! added later), at any thread count and with either intersector, returns
+//! added later), at any thread count and with every intersector, returns
 //! for every ray, in any direction including axis-parallel ones and
 //! directions with zero or negative-zero components:
 //!

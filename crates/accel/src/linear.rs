@@ -3,7 +3,7 @@ use std::time::Instant;
 use rtgi_math::{Ray, Vec3, Vec3A};
 
 use crate::contract::{Best, HitFilter, PreparedRay, QueryKind, Structure, is_hittable, test_triangles};
-use crate::triangle::{MollerTrumbore, TriangleTest, Watertight};
+use crate::triangle::{MollerTrumbore, TriangleTest, Watertight, WatertightF64};
 use crate::{BuildStats, Counter, Hit, Intersector};
 
 /// The reference structure: every ray is tested against every hittable
@@ -61,6 +61,7 @@ impl Structure for LinearScan {
         match self.intersector {
             Intersector::Watertight => self.scan::<Q, C, Watertight, F>(ray, counter, filter),
             Intersector::MollerTrumbore => self.scan::<Q, C, MollerTrumbore, F>(ray, counter, filter),
+            Intersector::WatertightF64 => self.scan::<Q, C, WatertightF64, F>(ray, counter, filter),
         }
     }
 

@@ -22,6 +22,7 @@ use rtgi_accel::Accel;
 use rtgi_render::RenderSettings;
 use rtgi_scene::{Camera, Scene};
 
+pub mod exact;
 mod index;
 mod knobs;
 pub mod machine;

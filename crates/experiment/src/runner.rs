@@ -2,8 +2,11 @@
 
 use std::time::Instant;
 
+use rayon::prelude::*;
+
 use rtgi_accel::{Accel, AccelKind};
 use rtgi_image::HdrImage;
+use rtgi_math::Ray;
 use rtgi_render::RenderSettings;
 
 use crate::reference::Reference;
@@ -71,4 +74,16 @@ pub(crate) fn build_timed(
         built = Some(accel);
     }
     Ok((built.expect("at least one build"), Timing::of(&times)))
+}
+
+/// Times `trace` over `rays` in chunks of 1024 on all threads, `repeats` times after a warm-up.
+pub(crate) fn time_rays(rays: &[Ray], repeats: usize, trace: impl Fn(&[Ray]) -> usize + Sync) -> Timing {
+    let run = || {
+        let start = Instant::now();
+        let hits: usize = rays.par_chunks(1024).map(&trace).sum();
+        std::hint::black_box(hits);
+        start.elapsed().as_secs_f64() * 1e3
+    };
+    run();
+    Timing::of(&(0..repeats.max(1)).map(|_| run()).collect::<Vec<_>>())
 }

@@ -7,7 +7,7 @@ use rtgi_math::Ray;
 use super::{Bvh, BvhNode};
 use crate::contract::{Best, HitFilter, PreparedRay, QueryKind, test_triangles};
 use crate::slab::{BoxRay, FastSlabs, RobustSlabs, SlabTest};
-use crate::triangle::{MollerTrumbore, TriangleTest, Watertight};
+use crate::triangle::{MollerTrumbore, TriangleTest, Watertight, WatertightF64};
 use crate::{Counter, Hit, Intersector};
 
 /// Entries of the largest traversal stack. A stack holds at most one entry
@@ -48,7 +48,7 @@ rtgi_math::named_choices!(Traversal, "traversal");
 
 /// Calls `$method` monomorphised for the structure's intersector, slab test
 /// and stack size (32, 64 or 128 entries, the smallest the depth allows):
-/// one branch per ray picks among the twelve compiled loops.
+/// one branch per ray picks among the eighteen compiled loops.
 macro_rules! monomorphise {
     ($self:ident, $method:ident, $q:ty, $c:ty, $f:ty, $($arg:expr),*) => {{
         macro_rules! sized {
@@ -65,6 +65,8 @@ macro_rules! monomorphise {
             (Intersector::Watertight, Traversal::Fast) => sized!(Watertight, FastSlabs),
             (Intersector::MollerTrumbore, Traversal::Robust) => sized!(MollerTrumbore, RobustSlabs),
             (Intersector::MollerTrumbore, Traversal::Fast) => sized!(MollerTrumbore, FastSlabs),
+            (Intersector::WatertightF64, Traversal::Robust) => sized!(WatertightF64, RobustSlabs),
+            (Intersector::WatertightF64, Traversal::Fast) => sized!(WatertightF64, FastSlabs),
         }
     }};
 }

@@ -77,6 +77,26 @@ pub(crate) struct BlockHits {
 }
 
 impl BlockHits {
+    /// Every lane that holds a triangle left to the scalar test: for tests
+    /// without a block kernel.
+    #[inline(always)]
+    pub(crate) fn scalar_only(block: &TriangleBlock) -> BlockHits {
+        let rescan = block
+            .ids
+            .iter()
+            .enumerate()
+            .filter(|(_, id)| **id != TriangleBlock::NO_TRIANGLE)
+            .fold(0, |m, (lane, _)| m | 1 << lane);
+        BlockHits {
+            exact: 0,
+            rescan,
+            t: Vec4::ZERO,
+            beta_scaled: Vec4::ZERO,
+            gamma_scaled: Vec4::ZERO,
+            scale: Vec4::ONE,
+        }
+    }
+
     /// The hit in lane `lane` of [`BlockHits::exact`]: the bits the scalar
     /// test computes for that lane's triangle.
     #[inline(always)]

@@ -84,13 +84,17 @@ fn copies() -> Case {
 }
 
 /// A closed mesh and the points strictly inside it that rays are aimed at.
-struct Solid {
-    mesh: ClosedMesh,
+#[derive(Clone, Debug)]
+pub struct Solid {
+    pub mesh: ClosedMesh,
     /// A point inside the unit-sized shape, from two to three uniform numbers.
-    inside: fn(&mut Rng) -> Vec3,
+    pub inside: fn(&mut Rng) -> Vec3,
 }
 
-fn solids() -> [(&'static str, Solid); 3] {
+/// The closed solids of the adversarial set, by name: an icosphere, a
+/// tessellated cube and a cylinder, each of unit size around the origin
+/// (place them with [`ClosedMesh::placed`]).
+pub fn solids() -> [(&'static str, Solid); 3] {
     fn in_ball(rng: &mut Rng) -> Vec3 {
         uniform_sphere(rng.next_f32(), rng.next_f32()) * 0.8 * rng.next_f32().cbrt()
     }

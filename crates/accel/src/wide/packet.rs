@@ -24,7 +24,7 @@ use crate::contract::{AcceptAll, Best, PreparedRay, QueryKind};
 use crate::simd::boxes::FAR_OF_NEAR;
 use crate::simd::{Isa, Kernel, dispatch};
 use crate::slab::ROBUST_FAR_SCALE;
-use crate::triangle::{MollerTrumbore, TriangleTest, Watertight};
+use crate::triangle::{MollerTrumbore, TriangleTest, Watertight, WatertightF64};
 use crate::{Hit, Intersector, NoCounter};
 
 /// Rays in a packet.
@@ -149,6 +149,9 @@ impl<const W: usize> WideBvh<W> {
             }
             Intersector::MollerTrumbore => {
                 dispatch(Batch::<W, Q, MollerTrumbore> { bvh: self, rays, answer, kinds: PhantomData })
+            }
+            Intersector::WatertightF64 => {
+                dispatch(Batch::<W, Q, WatertightF64> { bvh: self, rays, answer, kinds: PhantomData })
             }
         }
     }

@@ -14,7 +14,7 @@ use crate::simd::boxes::PlaneRay;
 use crate::simd::triangles::TriangleBlock;
 use crate::simd::{Isa, Kernel, dispatch, prefetch};
 use crate::slab::BoxRay;
-use crate::triangle::{MollerTrumbore, TriangleTest, Watertight};
+use crate::triangle::{MollerTrumbore, TriangleTest, Watertight, WatertightF64};
 use crate::{Counter, Hit, Intersector};
 
 /// Children waiting to be visited, with the distance at which the ray
@@ -81,6 +81,9 @@ impl<const W: usize> WideBvh<W> {
             }
             Intersector::MollerTrumbore => {
                 dispatch(SingleRay::<W, Q, C, MollerTrumbore, F> { bvh: self, ray, counter, filter, test: PhantomData })
+            }
+            Intersector::WatertightF64 => {
+                dispatch(SingleRay::<W, Q, C, WatertightF64, F> { bvh: self, ray, counter, filter, test: PhantomData })
             }
         }
     }

@@ -5,8 +5,6 @@
 //! from the linear scan's (zero for every structure of the contract: the
 //! structures cost time, not accuracy).
 
-use std::time::Instant;
-
 use rayon::prelude::*;
 use rtgi_accel::{Accel, AccelKind, BuildParams, Hit, TraversalCounters};
 use rtgi_math::Ray;
@@ -14,7 +12,7 @@ use rtgi_render::rays::{primary_rays, surface_rays};
 
 use crate::plot::{Corner, Curve, Plot};
 use crate::report::{Point, Report, Series, Table, format_ms, format_number};
-use crate::runner::build_timed;
+use crate::runner::{build_timed, time_rays};
 use crate::stats::Timing;
 use crate::{ExperimentError, Options, Steps, Subject};
 
@@ -51,18 +49,6 @@ fn configurations(triangles: usize, quick: bool) -> Vec<(String, AccelKind, Buil
         list.push((format!("sah bins {sah_bins}"), AccelKind::Sah, params));
     }
     list
-}
-
-/// Times `trace` over `rays` in chunks of 1024 on all threads, `repeats` times after a warm-up.
-fn time_rays(rays: &[Ray], repeats: usize, trace: impl Fn(&[Ray]) -> usize + Sync) -> Timing {
-    let run = || {
-        let start = Instant::now();
-        let hits: usize = rays.par_chunks(1024).map(&trace).sum();
-        std::hint::black_box(hits);
-        start.elapsed().as_secs_f64() * 1e3
-    };
-    run();
-    Timing::of(&(0..repeats.max(1)).map(|_| run()).collect::<Vec<_>>())
 }
 
 fn answers(accel: &dyn Accel, rays: &[Ray]) -> Vec<Option<Hit>> {

@@ -8,6 +8,8 @@ mod accel;
 mod depth;
 mod direct;
 mod effects;
+mod intersector;
+mod precision;
 mod scaling;
 mod spp;
 
@@ -26,10 +28,24 @@ pub enum Knob {
     Direct,
     /// Each decision of the effects planner reversed.
     Effects,
+    /// The ray/triangle tests: time, and failures on the hard cases of `rtgi verify`.
+    Intersector,
+    /// The triangle test in single against double precision: time, and
+    /// error against the exact answer on near-degenerate and far triangles.
+    Precision,
 }
 
 impl Knob {
-    pub const ALL: &'static [Knob] = &[Knob::Spp, Knob::Depth, Knob::Accel, Knob::Scaling, Knob::Direct, Knob::Effects];
+    pub const ALL: &'static [Knob] = &[
+        Knob::Spp,
+        Knob::Depth,
+        Knob::Accel,
+        Knob::Scaling,
+        Knob::Direct,
+        Knob::Effects,
+        Knob::Intersector,
+        Knob::Precision,
+    ];
 
     pub fn name(self) -> &'static str {
         match self {
@@ -39,6 +55,8 @@ impl Knob {
             Knob::Scaling => "scaling",
             Knob::Direct => "direct",
             Knob::Effects => "effects",
+            Knob::Intersector => "intersector",
+            Knob::Precision => "precision",
         }
     }
 
@@ -61,14 +79,22 @@ impl Knob {
             Knob::Effects => {
                 "what does each effect cost, and does leaving out one the scene does not call for cost accuracy?"
             }
+            Knob::Intersector => {
+                "what does each ray/triangle test cost, and how often do rays slip through shared edges or hit \
+                 the surface they leave?"
+            }
+            Knob::Precision => {
+                "how far are t and the barycentrics from the exact answer in single and double precision, on \
+                 near-degenerate and far-from-origin triangles, and what does double precision cost?"
+            }
         }
     }
 
-    /// Whether the knob renders the subject's scene (and so needs a
-    /// reference of it); `scaling` makes its own meshes and `direct`
-    /// renders scenes of its own, at the subject's size.
+    /// Whether the knob measures on the subject's scene (and so needs a
+    /// reference of it); `scaling` and `precision` make their own
+    /// triangles and `direct` renders scenes of its own, at the subject's size.
     pub fn uses_scene(self) -> bool {
-        !matches!(self, Knob::Scaling | Knob::Direct)
+        !matches!(self, Knob::Scaling | Knob::Direct | Knob::Precision)
     }
 }
 
@@ -88,6 +114,7 @@ pub(crate) fn run(
             Knob::Direct => {
                 "scenes/direct-small-light.toml, direct-large-light.toml and direct-glossy.toml (built in)".to_owned()
             }
+            Knob::Precision => "generated triangles".to_owned(),
             _ => "generated meshes".to_owned(),
         },
         machine: Machine::this(options.threads),
@@ -108,5 +135,7 @@ pub(crate) fn run(
         Knob::Scaling => scaling::run(options, report, progress),
         Knob::Direct => direct::run(subject, options, report, progress),
         Knob::Effects => effects::run(subject, options, report, progress),
+        Knob::Intersector => intersector::run(subject, options, report, progress),
+        Knob::Precision => precision::run(options, report, progress),
     }
 }
