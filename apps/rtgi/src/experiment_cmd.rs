@@ -63,15 +63,15 @@ pub(crate) fn run(args: &ExperimentArgs) -> Result<()> {
         cache: (!args.no_cache).then(|| args.cache.clone().unwrap_or_else(|| out_root.join(".references"))),
         reference_spp: args.reference_spp,
     };
-    // (knob, scene, folder) for every run.
-    let mut runs: Vec<(Knob, Option<PathBuf>, PathBuf)> = Vec::new();
+    // (knob, scene, its name in the report, folder) for every run.
+    let mut runs: Vec<(Knob, Option<PathBuf>, Option<String>, PathBuf)> = Vec::new();
     for &knob in &knobs {
         let single_folder = match (args.knob, &args.out) {
             (KnobChoice::One(_), Some(out)) => out.clone(),
             _ => out_root.join(knob.name()),
         };
         if !report_mode || !knob.uses_scene() {
-            runs.push((knob, args.scene.clone(), single_folder));
+            runs.push((knob, args.scene.clone(), None, single_folder));
             continue;
         }
         let scenes = report_scenes(knob);
@@ -86,12 +86,21 @@ pub(crate) fn run(args: &ExperimentArgs) -> Result<()> {
             }
             let stem = path.file_stem().map_or_else(|| "scene".into(), |s| s.to_string_lossy().to_lowercase());
             let folder = if scenes.len() > 1 { single_folder.join(stem) } else { single_folder.clone() };
-            runs.push((knob, Some(path), folder));
+            // Named as the shared scenes are documented, not by this machine's absolute path.
+            let name = if std::env::var_os("RTGI_SCENES").is_some() {
+                path.display().to_string()
+            } else {
+                format!("../shared/scenes/{scene}")
+            };
+            runs.push((knob, Some(path), Some(name), folder));
         }
     }
     let mut written: Vec<(PathBuf, Report)> = Vec::new();
-    for (knob, scene, folder) in runs {
-        let subject = pool.install(|| prepare(args, scene.as_deref()))?;
+    for (knob, scene, name, folder) in runs {
+        let mut subject = pool.install(|| prepare(args, scene.as_deref()))?;
+        if let Some(name) = name {
+            subject.name = name;
+        }
         eprintln!("experiment {knob} on {}: {}", subject.name, knob.question());
         let report = pool.install(|| rtgi_experiment::run(knob, &subject, &options, &|line| eprintln!("  {line}")))?;
         for finding in &report.findings {
