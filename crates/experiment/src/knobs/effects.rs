@@ -175,11 +175,15 @@ pub(super) fn run(
     if !free.is_empty() {
         let times: Vec<String> = free.iter().map(|(l, t, _)| format!("{l} {t:.2}×")).collect();
         let largest = free.iter().map(|(_, _, change)| change.abs()).fold(0.0, f64::max);
+        let change = if largest == 0.0 {
+            "the RMSE is the same to the last bit (the same paths are traced)".to_owned()
+        } else {
+            format!("the RMSE changes by at most {}", format_number(largest))
+        };
         report.findings.push(format!(
             "forcing on what the scene does not call for takes {} the plan's time and buys no accuracy: \
-             the RMSE changes by at most {} (the reference's noise is {})",
+             {change} (the reference's noise is {})",
             times.join(", "),
-            format_number(largest),
             format_number(noise)
         ));
     }

@@ -111,9 +111,7 @@ pub(crate) fn run(
         question: knob.question().to_owned(),
         scene: match knob {
             _ if knob.uses_scene() => subject.name.clone(),
-            Knob::Direct => {
-                "scenes/direct-small-light.toml, direct-large-light.toml and direct-glossy.toml (built in)".to_owned()
-            }
+            Knob::Direct => "scenes/direct-*.toml (built in: small light, large light, glossy)".to_owned(),
             Knob::Precision => "generated triangles".to_owned(),
             _ => "generated meshes".to_owned(),
         },
