@@ -101,7 +101,8 @@ pub(crate) fn run(args: &ExperimentArgs) -> Result<()> {
         if let Some(name) = name {
             subject.name = name;
         }
-        eprintln!("experiment {knob} on {}: {}", subject.name, knob.question());
+        let on = if knob.uses_scene() { format!(" on {}", subject.name) } else { String::new() };
+        eprintln!("experiment {knob}{on}: {}", knob.question());
         let report = pool.install(|| rtgi_experiment::run(knob, &subject, &options, &|line| eprintln!("  {line}")))?;
         for finding in &report.findings {
             println!("{knob}: {finding}");
