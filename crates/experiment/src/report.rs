@@ -130,6 +130,18 @@ pub fn format_timing(t: &Timing) -> String {
     format!("{} ({}–{})", format_ms(t.median_ms), format_ms(t.min_ms), format_ms(t.max_ms))
 }
 
+/// The table cells of a rendered measurement: time, RMSE with its range
+/// over the repeats, relative MSE, and mean radiance over the reference's.
+pub(crate) fn measurement_cells(point: &Point) -> [String; 4] {
+    let (time, error) = (point.time.expect("measured"), point.error.expect("measured"));
+    [
+        format_timing(&time),
+        format!("{} ({}–{})", format_number(error.rmse), format_number(error.rmse_min), format_number(error.rmse_max)),
+        format_number(error.relative_mse),
+        format!("{:.4}", error.mean / error.reference_mean.max(1e-30)),
+    ]
+}
+
 /// A number in 4 significant digits, in scientific notation when small or large.
 pub fn format_number(x: f64) -> String {
     if x == 0.0 || (1e-3..1e5).contains(&x.abs()) {

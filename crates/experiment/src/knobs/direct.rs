@@ -18,7 +18,7 @@ use rtgi_scene::description::Description;
 
 use crate::plot::{Corner, Curve, Plot};
 use crate::reference::reference;
-use crate::report::{Report, Series, Table, format_ms, format_number, format_timing};
+use crate::report::{Report, Series, Table, format_ms, format_number, measurement_cells};
 use crate::runner::measure;
 use crate::{ExperimentError, Options, Steps, Subject};
 
@@ -147,20 +147,9 @@ pub(super) fn run(
                     ..scene_subject.settings.clone()
                 };
                 let point = measure(&scene_subject, &settings, options, &reference);
-                let (time, error) = (point.time.expect("measured"), point.error.expect("measured"));
-                table.rows.push(vec![
-                    strategy.to_string(),
-                    spp.to_string(),
-                    format_timing(&time),
-                    format!(
-                        "{} ({}–{})",
-                        format_number(error.rmse),
-                        format_number(error.rmse_min),
-                        format_number(error.rmse_max)
-                    ),
-                    format_number(error.relative_mse),
-                    format!("{:.4}", error.mean / error.reference_mean.max(1e-30)),
-                ]);
+                let mut row = vec![strategy.to_string(), spp.to_string()];
+                row.extend(measurement_cells(&point));
+                table.rows.push(row);
                 series.points.push(point);
             }
             let xy: Vec<(f64, f64)> = series

@@ -13,7 +13,7 @@ use rtgi_render::{Integrator, PixelSampler, RenderSettings};
 
 use crate::plot::{Corner, Curve, Plot};
 use crate::reference::reference;
-use crate::report::{Report, Series, Table, format_number, format_timing};
+use crate::report::{Report, Series, Table, format_number, measurement_cells};
 use crate::runner::measure;
 use crate::stats::PowerLaw;
 use crate::{ExperimentError, Options, Steps, Subject};
@@ -59,20 +59,9 @@ pub(super) fn run(
                 steps.next(&format!("{integrand}: {sampler} at {spp} spp"));
                 let settings = RenderSettings { sampler, samples_per_pixel: spp, ..base.clone() };
                 let point = measure(subject, &settings, options, &reference);
-                let (time, error) = (point.time.expect("measured"), point.error.expect("measured"));
-                table.rows.push(vec![
-                    sampler.to_string(),
-                    spp.to_string(),
-                    format_timing(&time),
-                    format!(
-                        "{} ({}–{})",
-                        format_number(error.rmse),
-                        format_number(error.rmse_min),
-                        format_number(error.rmse_max)
-                    ),
-                    format_number(error.relative_mse),
-                    format!("{:.4}", error.mean / error.reference_mean.max(1e-30)),
-                ]);
+                let mut row = vec![sampler.to_string(), spp.to_string()];
+                row.extend(measurement_cells(&point));
+                table.rows.push(row);
                 series.points.push(point);
             }
             let rmse = |p: &crate::Point| p.error.expect("measured").rmse;
