@@ -20,12 +20,15 @@
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 
+mod accumulation;
+mod accumulation_file;
 pub mod bsdf;
 mod camera;
 mod distribution;
 mod effect_set;
 pub mod effects;
 mod framing;
+mod identity;
 mod integrator;
 pub mod lights;
 pub mod probes;
@@ -33,16 +36,20 @@ pub mod rays;
 mod sampler;
 mod shade;
 
+pub use accumulation::{Accumulation, FIXED_POINT_BITS, MergeError, PixelSum, SAMPLE_LIMIT};
+pub use accumulation_file::AccumulationFileError;
 pub use camera::CameraRays;
 pub use distribution::Distribution1D;
 pub use effect_set::EffectSet;
 pub use effects::{Effect, EffectOverrides, EffectPlan, PlannedEffect, Reversal};
 pub use framing::frame_scene;
+pub use identity::{Difference, RenderIdentity, scene_fingerprint};
 pub use integrator::{DirectStrategy, Integrator};
 pub use lights::{Environment, EnvironmentMap, LightSet};
 pub use sampler::{PixelSample, PixelSampler};
 pub use shade::{albedo, alpha_accepts, has_alpha, shade_primary, shading_normal};
 
+use std::ops::Range;
 use std::time::Instant;
 
 use rayon::prelude::*;
@@ -52,6 +59,7 @@ use rtgi_math::{Ray, Rng, Vec2, Vec3};
 use rtgi_scene::{Camera, Scene};
 use serde::Serialize;
 
+use crate::accumulation::{image_of_sums, to_fixed};
 use crate::effects::SPECIALISED;
 use crate::integrator::Transport;
 
@@ -125,12 +133,12 @@ impl RenderStats {
     }
 }
 
-/// The rectangles that make up an image, in row-major order.
-fn tiles(width: u32, height: u32) -> Vec<(u32, u32, u32, u32)> {
+/// The rectangles that make up rows `rows` of an image, in row-major order.
+fn tiles(width: u32, rows: Range<u32>) -> Vec<(u32, u32, u32, u32)> {
     let mut tiles = Vec::new();
-    for y0 in (0..height).step_by(TILE_SIZE as usize) {
+    for y0 in rows.clone().step_by(TILE_SIZE as usize) {
         for x0 in (0..width).step_by(TILE_SIZE as usize) {
-            tiles.push((x0, y0, (x0 + TILE_SIZE).min(width), (y0 + TILE_SIZE).min(height)));
+            tiles.push((x0, y0, (x0 + TILE_SIZE).min(width), (y0 + TILE_SIZE).min(rows.end)));
         }
     }
     tiles
@@ -142,6 +150,9 @@ fn tiles(width: u32, height: u32) -> Vec<(u32, u32, u32, u32)> {
 ///
 /// `progress` is called from the worker threads with the number of pixels
 /// finished since its last call; it must be cheap.
+///
+/// The image has the same bits as any progressive or split render of the
+/// same settings ([`render_pass`], [`Accumulation::merge`]).
 pub fn render<A: Accel + ?Sized>(
     scene: &Scene,
     accel: &A,
@@ -149,6 +160,86 @@ pub fn render<A: Accel + ?Sized>(
     settings: &RenderSettings,
     progress: &(dyn Fn(u64) + Sync),
 ) -> (HdrImage, RenderStats) {
+    let spp = settings.samples_per_pixel.max(1);
+    let per_pixel = |done: u64| progress(done / spp as u64);
+    let control = PassControl { progress: &per_pixel, cancelled: &|| false };
+    let (sums, stats) = render_sums(scene, accel, camera, settings, 0..settings.height, 0..spp, &control)
+        .expect("a render that cannot be cancelled finishes");
+    (image_of_sums(settings.width, settings.height, 0, &sums, spp), stats)
+}
+
+/// How a pass of [`render_pass`] reports its progress and is told to stop.
+#[derive(Clone, Copy)]
+pub struct PassControl<'a> {
+    /// Called from the worker threads with the pixel samples finished since
+    /// its last call (pixels × samples); it must be cheap.
+    pub progress: &'a (dyn Fn(u64) + Sync),
+    /// Polled from the worker threads between samples; once it returns
+    /// true the pass is abandoned.
+    pub cancelled: &'a (dyn Fn() -> bool + Sync),
+}
+
+impl std::fmt::Debug for PassControl<'_> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("PassControl").finish_non_exhaustive()
+    }
+}
+
+/// A pass stopped by [`PassControl::cancelled`]; the accumulation is as it was before it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, thiserror::Error)]
+#[error("the pass was cancelled")]
+pub struct Cancelled;
+
+/// Renders the next `count` samples of every pixel of `accumulation`'s
+/// rows and adds them to it: one pass of a progressive render, or a job of
+/// a split one. However a render is cut into passes, ranges of samples
+/// ([`Accumulation::new`] at a first sample other than 0) and bands of rows,
+/// the sums come out the same, bit for bit, as those of [`render`].
+///
+/// If `control` cancels the pass, `accumulation` is left untouched.
+///
+/// # Panics
+/// If `accumulation` is of another size, seed or sample count than
+/// `settings`, or `count` goes past the render's samples.
+pub fn render_pass<A: Accel + ?Sized>(
+    scene: &Scene,
+    accel: &A,
+    camera: &Camera,
+    settings: &RenderSettings,
+    accumulation: &mut Accumulation,
+    count: u32,
+    control: &PassControl<'_>,
+) -> Result<RenderStats, Cancelled> {
+    let identity = accumulation.identity();
+    assert!(
+        (identity.width, identity.height, identity.samples_per_pixel, identity.seed)
+            == (settings.width, settings.height, settings.samples_per_pixel.max(1), settings.seed),
+        "the accumulation is of another render"
+    );
+    let samples = accumulation.samples();
+    assert!(
+        samples.end + count <= identity.samples_per_pixel,
+        "samples past the render's {}",
+        identity.samples_per_pixel
+    );
+    let range = samples.end..samples.end + count;
+    let (sums, mut stats) = render_sums(scene, accel, camera, settings, accumulation.rows(), range, control)?;
+    accumulation.add_pass(sums, count);
+    stats.samples_per_pixel = count;
+    Ok(stats)
+}
+
+/// The fixed-point sums of samples `samples` of every pixel of rows
+/// `rows`, and what rendering them took.
+fn render_sums<A: Accel + ?Sized>(
+    scene: &Scene,
+    accel: &A,
+    camera: &Camera,
+    settings: &RenderSettings,
+    rows: Range<u32>,
+    samples: Range<u32>,
+    control: &PassControl<'_>,
+) -> Result<(Vec<PixelSum>, RenderStats), Cancelled> {
     let start = Instant::now();
     // The views of the closest hit follow the plan for alpha and textures too.
     let plan = EffectPlan::new(scene, settings);
@@ -157,8 +248,9 @@ pub fn render<A: Accel + ?Sized>(
     // unless alpha masks need the filtered query.
     let batch = |rays: &[Ray], hits: &mut [Option<Hit>]| accel.intersect_batch(rays, hits);
     let first_hits: Option<&FirstHits> = if alpha { None } else { Some(&batch) };
-    let (image, rays) = match settings.integrator {
-        Integrator::Primary => render_samples(camera, settings, progress, first_hits, |ray, first, rng, rays| {
+    let pass = Pass { camera, settings, rows: rows.clone(), samples: samples.clone(), control, first_hits };
+    let (sums, rays) = match settings.integrator {
+        Integrator::Primary => render_samples(&pass, |ray, first, rng, rays| {
             *rays += 1;
             let hit = match first {
                 Some(hit) => hit,
@@ -169,22 +261,34 @@ pub fn render<A: Accel + ?Sized>(
                 None => settings.background,
             }
         }),
-        Integrator::Direct | Integrator::Path => {
-            render_transport(scene, accel, camera, settings, &plan, first_hits, progress)
-        }
-        aov => render_samples(camera, settings, progress, None, |ray, _, rng, rays| {
+        Integrator::Direct | Integrator::Path => render_transport(scene, accel, &plan, &pass),
+        aov => render_samples(&Pass { first_hits: None, ..pass }, |ray, _, rng, rays| {
             *rays += 1;
             shade::aov(aov, scene, accel, (alpha, textures), &ray, rng)
         }),
-    };
+    }
+    .ok_or(Cancelled)?;
     let stats = RenderStats {
         width: settings.width,
-        height: settings.height,
-        samples_per_pixel: settings.samples_per_pixel.max(1),
+        height: rows.end - rows.start,
+        samples_per_pixel: samples.end - samples.start,
         rays,
         render_ms: start.elapsed().as_secs_f64() * 1e3,
     };
-    (image, stats)
+    Ok((sums, stats))
+}
+
+/// What one pass renders: which rows and samples, with which camera and
+/// settings, and how camera rays are traced.
+#[derive(Clone)]
+struct Pass<'a> {
+    camera: &'a Camera,
+    settings: &'a RenderSettings,
+    rows: Range<u32>,
+    samples: Range<u32>,
+    control: &'a PassControl<'a>,
+    /// With `Some`, camera rays are traced in blocks through it.
+    first_hits: Option<&'a FirstHits<'a>>,
 }
 
 /// Light transport, specialised to the plan's effects: one compiled
@@ -192,25 +296,17 @@ pub fn render<A: Accel + ?Sized>(
 fn render_transport<A: Accel + ?Sized>(
     scene: &Scene,
     accel: &A,
-    camera: &Camera,
-    settings: &RenderSettings,
     plan: &EffectPlan,
-    first_hits: Option<&FirstHits>,
-    progress: &(dyn Fn(u64) + Sync),
-) -> (HdrImage, u64) {
+    pass: &Pass<'_>,
+) -> Option<(Vec<PixelSum>, u64)> {
     let white_sky = Environment::Uniform(Vec3::ONE);
-    let environment = if plan.default_environment { Some(&white_sky) } else { settings.environment.as_ref() };
-    let transport = Transport::new(scene, accel, plan, environment, settings);
+    let environment = if plan.default_environment { Some(&white_sky) } else { pass.settings.environment.as_ref() };
+    let transport = Transport::new(scene, accel, plan, environment, pass.settings);
     fn run<const S: u16, A: Accel + ?Sized>(
         transport: &Transport<'_, A>,
-        camera: &Camera,
-        settings: &RenderSettings,
-        first_hits: Option<&FirstHits>,
-        progress: &(dyn Fn(u64) + Sync),
-    ) -> (HdrImage, u64) {
-        render_samples(camera, settings, progress, first_hits, |ray, first, rng, rays| {
-            transport.radiance::<S>(ray, first, rng, rays)
-        })
+        pass: &Pass<'_>,
+    ) -> Option<(Vec<PixelSum>, u64)> {
+        render_samples(pass, |ray, first, rng, rays| transport.radiance::<S>(ray, first, rng, rays))
     }
     // Decides the specialised effects one at a time, each both ways: the
     // leaves are the 2^n loops, one per subset, each compiled for its set's bits.
@@ -223,7 +319,7 @@ fn render_transport<A: Accel + ?Sized>(
             specialised!($set; [] [$($effect),*])
         }};
         ($set:ident; [$($chosen:expr),*] []) => {
-            run::<{ EffectSet::of(&[$($chosen),*]).bits() }, A>(&transport, camera, settings, first_hits, progress)
+            run::<{ EffectSet::of(&[$($chosen),*]).bits() }, A>(&transport, pass)
         };
         ($set:ident; [$($chosen:expr),*] [$next:expr $(, $rest:expr)*]) => {
             if $set.contains($next) {
@@ -240,27 +336,28 @@ fn render_transport<A: Accel + ?Sized>(
 /// Closest hits of a batch of camera rays ([`Accel::intersect_batch`]).
 type FirstHits<'a> = dyn Fn(&[Ray], &mut [Option<Hit>]) + Sync + 'a;
 
-/// Renders each pixel as the mean of `settings.samples_per_pixel` values
-/// of `sample(camera ray, its closest hit, generator, ray counter)`. Each
-/// sample has its own generator, seeded by (seed, pixel, sample); samples
-/// that come out infinite or NaN count as black rather than spoiling the
-/// pixel.
+/// Sums, for each pixel of the pass's rows, the values of the pass's
+/// samples `sample(camera ray, its closest hit, generator, ray counter)`,
+/// in fixed point ([`accumulation`]). Each sample has its own generator,
+/// seeded by (seed, pixel, sample index), and its position in the pixel
+/// depends on its index and the render's total samples only, so a sample
+/// has the same value in whatever pass or job it is taken. `None` if the
+/// pass was cancelled.
 ///
 /// With `first_hits`, the camera rays of each sample of a 4×4 block of
 /// pixels are traced together through it and `sample` is handed the hit
 /// (`Some`); without, `sample` traces its camera ray itself (`None`). The
 /// hits are the same bits either way, and so is the image.
 fn render_samples(
-    camera: &Camera,
-    settings: &RenderSettings,
-    progress: &(dyn Fn(u64) + Sync),
-    first_hits: Option<&FirstHits>,
+    pass: &Pass<'_>,
     sample: impl Fn(Ray, Option<Option<Hit>>, &mut Rng, &mut u64) -> Vec3 + Sync,
-) -> (HdrImage, u64) {
-    let (width, height) = (settings.width, settings.height);
-    let camera_rays = CameraRays::new(camera, width, height);
+) -> Option<(Vec<PixelSum>, u64)> {
+    let settings = pass.settings;
+    let width = settings.width;
+    let camera_rays = CameraRays::new(pass.camera, width, settings.height);
     let spp = settings.samples_per_pixel.max(1);
-    render_blocks(width, height, progress, |pixels, values| {
+    let first_hits = pass.first_hits;
+    render_blocks(width, pass.rows.clone(), pass.control, |pixels, values| {
         let pixel_index = |(x, y): (u32, u32)| y as u64 * width as u64 + x as u64;
         // One more generator per pixel, past every sample's: its shift of the pixel's pattern.
         let shifts: Vec<Vec2> = pixels
@@ -270,12 +367,14 @@ fn render_samples(
                 Vec2::new(shift.next_f32(), shift.next_f32())
             })
             .collect();
-        let mut sums = vec![Vec3::ZERO; pixels.len()];
         let mut traced = 0;
         let mut generators = Vec::with_capacity(pixels.len());
         let mut rays = Vec::with_capacity(pixels.len());
         let mut hits = vec![None; pixels.len()];
-        for index in 0..spp {
+        for index in pass.samples.clone() {
+            if (pass.control.cancelled)() {
+                return None;
+            }
             generators.clear();
             rays.clear();
             for (&(x, y), &pixel_shift) in pixels.iter().zip(&shifts) {
@@ -289,15 +388,11 @@ fn render_samples(
             }
             for (i, (ray, rng)) in rays.iter().zip(&mut generators).enumerate() {
                 let value = sample(*ray, first_hits.map(|_| hits[i]), rng, &mut traced);
-                if value.is_finite() {
-                    sums[i] += value;
-                }
+                accumulation::add(&mut values[i], &to_fixed(value));
             }
         }
-        for (value, sum) in values.iter_mut().zip(sums) {
-            *value = sum / spp as f32;
-        }
-        traced
+        (pass.control.progress)(pixels.len() as u64 * pass.samples.len() as u64);
+        Some(traced)
     })
 }
 
@@ -313,13 +408,19 @@ pub fn render_traversal_cost<A: Accel + ?Sized>(
     progress: &(dyn Fn(u64) + Sync),
 ) -> (HdrImage, TraversalCounters) {
     let rays = CameraRays::new(camera, width, height);
-    let (image, _) = render_pixels(width, height, progress, |x, y| {
-        let mut counters = TraversalCounters::default();
-        let hit = accel.intersect_counted(&rays.ray(x, y, Vec2::splat(0.5)), &mut counters);
-        let value =
-            Vec3::new(counters.nodes_visited as f32, counters.triangles_tested as f32, hit.is_some() as u32 as f32);
-        (value, 1)
-    });
+    let control = PassControl { progress, cancelled: &|| false };
+    let (values, _) = render_blocks(width, 0..height, &control, |pixels, values: &mut [Vec3]| {
+        for (&(x, y), value) in pixels.iter().zip(values) {
+            let mut counters = TraversalCounters::default();
+            let hit = accel.intersect_counted(&rays.ray(x, y, Vec2::splat(0.5)), &mut counters);
+            *value =
+                Vec3::new(counters.nodes_visited as f32, counters.triangles_tested as f32, hit.is_some() as u32 as f32);
+        }
+        progress(pixels.len() as u64);
+        Some(0)
+    })
+    .expect("never cancelled");
+    let image = HdrImage::from_pixels(width, height, values).expect("one value per pixel");
     let mut total = TraversalCounters { rays: width as u64 * height as u64, ..TraversalCounters::default() };
     for p in image.pixels() {
         total.nodes_visited += p.x as u64;
@@ -328,43 +429,29 @@ pub fn render_traversal_cost<A: Accel + ?Sized>(
     (image, total)
 }
 
-/// Computes every pixel with `pixel(x, y)`, which returns the value and
-/// the rays it traced, tile by tile in parallel, and reports finished pixels
-/// to `progress`. The value of a pixel depends only on its coordinates, so
-/// the image is the same for any number of threads. Returns the image and
-/// the total of the rays.
-fn render_pixels(
+/// Computes the values of every pixel of rows `rows`, tile by tile in
+/// parallel: each tile is cut into blocks of up to
+/// [`rays::TILE`]×[`rays::TILE`] pixels, and `block(pixels, values)` fills
+/// in the values of its pixels (which start as `T::default()`) and returns
+/// the rays traced, or `None` when `control` cancelled it. The value of a
+/// pixel depends only on its coordinates, so the result is the same for
+/// any number of threads. Returns the values row by row and the total of
+/// the rays, or `None` if cancelled.
+fn render_blocks<T: Clone + Default + Send>(
     width: u32,
-    height: u32,
-    progress: &(dyn Fn(u64) + Sync),
-    pixel: impl Fn(u32, u32) -> (Vec3, u64) + Sync,
-) -> (HdrImage, u64) {
-    render_blocks(width, height, progress, |pixels, values| {
-        let mut traced = 0;
-        for (&(x, y), value) in pixels.iter().zip(values) {
-            let (computed, rays) = pixel(x, y);
-            *value = computed;
-            traced += rays;
-        }
-        traced
-    })
-}
-
-/// [`render_pixels`] a block of pixels at a time: each tile is cut into
-/// blocks of up to [`rays::TILE`]×[`rays::TILE`] pixels, and `block(pixels,
-/// values)` fills in the values of its pixels and returns the rays traced.
-fn render_blocks(
-    width: u32,
-    height: u32,
-    progress: &(dyn Fn(u64) + Sync),
-    block: impl Fn(&[(u32, u32)], &mut [Vec3]) -> u64 + Sync,
-) -> (HdrImage, u64) {
+    rows: Range<u32>,
+    control: &PassControl<'_>,
+    block: impl Fn(&[(u32, u32)], &mut [T]) -> Option<u64> + Sync,
+) -> Option<(Vec<T>, u64)> {
     // Per tile: its pixels, their values, and the rays traced.
-    type Tile = (Vec<(u32, u32)>, Vec<Vec3>, u64);
+    type Tile<T> = (Vec<(u32, u32)>, Vec<T>, u64);
     let step = rays::TILE as usize;
-    let tile_pixels: Vec<Tile> = tiles(width, height)
+    let tile_values: Vec<Tile<T>> = tiles(width, rows.clone())
         .into_par_iter()
         .map(|(x0, y0, x1, y1)| {
+            if (control.cancelled)() {
+                return None;
+            }
             let (mut pixels, mut values, mut traced) = (Vec::new(), Vec::new(), 0);
             for by in (y0..y1).step_by(step) {
                 for bx in (x0..x1).step_by(step) {
@@ -373,23 +460,22 @@ fn render_blocks(
                         (by..(by + rays::TILE).min(y1))
                             .flat_map(|y| (bx..(bx + rays::TILE).min(x1)).map(move |x| (x, y))),
                     );
-                    values.resize(pixels.len(), Vec3::ZERO);
-                    traced += block(&pixels[start..], &mut values[start..]);
+                    values.resize(pixels.len(), T::default());
+                    traced += block(&pixels[start..], &mut values[start..])?;
                 }
             }
-            progress(pixels.len() as u64);
-            (pixels, values, traced)
+            Some((pixels, values, traced))
         })
-        .collect();
-    let mut image = HdrImage::new(width, height);
+        .collect::<Option<_>>()?;
+    let mut all = vec![T::default(); (rows.end - rows.start) as usize * width as usize];
     let mut rays = 0;
-    for (pixels, values, traced) in tile_pixels {
+    for (pixels, values, traced) in tile_values {
         rays += traced;
         for ((x, y), value) in pixels.into_iter().zip(values) {
-            image.set(x, y, value);
+            all[(y - rows.start) as usize * width as usize + x as usize] = value;
         }
     }
-    (image, rays)
+    Some((all, rays))
 }
 
 #[cfg(test)]
@@ -399,7 +485,7 @@ mod tests {
     #[test]
     fn tiles_cover_the_image_once() {
         let mut covered = vec![0u8; 37 * 21];
-        for (x0, y0, x1, y1) in tiles(37, 21) {
+        for (x0, y0, x1, y1) in tiles(37, 0..21) {
             for y in y0..y1 {
                 for x in x0..x1 {
                     covered[(y * 37 + x) as usize] += 1;

@@ -140,6 +140,11 @@ impl EnvironmentMap {
         Self { image, rows, columns }
     }
 
+    /// The equirectangular image.
+    pub fn image(&self) -> &HdrImage {
+        &self.image
+    }
+
     fn texel_of(&self, direction: Vec3) -> (u32, u32) {
         let uv = uv_of(direction);
         let x = ((uv.x * self.image.width() as f32) as u32).min(self.image.width() - 1);

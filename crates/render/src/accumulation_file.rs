@@ -1,0 +1,236 @@
+//! The file of an [`Accumulation`]: checkpoints of progressive renders and
+//! the parts of split renders.
+//!
+//! Layout: the line `rtgi accumulation 1\n`; a little-endian `u32` length
+//! and that many bytes of JSON (the [`RenderIdentity`], the rows and the
+//! samples); the three fixed-point channel sums of every pixel of the
+//! band, row by row, each as a zigzag LEB128 varint (most sums are far
+//! smaller than 128 bits); and a little-endian `u64` FNV-1a of those sum
+//! bytes, which catches a truncated or damaged file. Files are written to
+//! a temporary name beside the target and renamed into place, so an
+//! interrupted write never leaves half a checkpoint.
+
+use std::fs::File;
+use std::io::{BufReader, BufWriter, Read, Write};
+use std::ops::Range;
+use std::path::{Path, PathBuf};
+
+use serde::{Deserialize, Serialize};
+
+use crate::accumulation::{Accumulation, PixelSum};
+use crate::identity::RenderIdentity;
+
+const MAGIC: &[u8] = b"rtgi accumulation 1\n";
+
+/// Longest header accepted: a real one is well under a kilobyte.
+const MAX_HEADER: u32 = 1 << 20;
+
+/// Why an accumulation file cannot be read or written.
+#[derive(Debug, thiserror::Error)]
+pub enum AccumulationFileError {
+    #[error("{path}: {source}")]
+    Io { path: PathBuf, source: std::io::Error },
+    #[error("{path}: not an rtgi accumulation file: {message}")]
+    Invalid { path: PathBuf, message: String },
+}
+
+#[derive(Serialize, Deserialize)]
+struct Header {
+    identity: RenderIdentity,
+    rows: Range<u32>,
+    samples: Range<u32>,
+}
+
+impl Accumulation {
+    /// Writes the accumulation to `path`, atomically.
+    pub fn write(&self, path: &Path) -> Result<(), AccumulationFileError> {
+        let io = |source| AccumulationFileError::Io { path: path.to_owned(), source };
+        let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
+        let temporary = path.with_file_name(format!(".{name}.{}.partial", std::process::id()));
+        let result = (|| {
+            let mut out = BufWriter::new(File::create(&temporary)?);
+            let header = Header { identity: self.identity().clone(), rows: self.rows(), samples: self.samples() };
+            let header = serde_json::to_vec(&header).map_err(std::io::Error::other)?;
+            out.write_all(MAGIC)?;
+            out.write_all(&(header.len() as u32).to_le_bytes())?;
+            out.write_all(&header)?;
+            let mut checksum = Fnv::new();
+            let mut bytes = Vec::with_capacity(3 * 19);
+            for sum in self.sums() {
+                bytes.clear();
+                for &channel in sum {
+                    encode(channel, &mut bytes);
+                }
+                checksum.bytes(&bytes);
+                out.write_all(&bytes)?;
+            }
+            out.write_all(&checksum.0.to_le_bytes())?;
+            out.into_inner().map_err(|e| e.into_error())?.sync_all()?;
+            std::fs::rename(&temporary, path)
+        })();
+        if result.is_err() {
+            let _ = std::fs::remove_file(&temporary);
+        }
+        result.map_err(io)
+    }
+
+    /// Reads an accumulation written by [`Accumulation::write`].
+    pub fn read(path: &Path) -> Result<Accumulation, AccumulationFileError> {
+        let io = |source| AccumulationFileError::Io { path: path.to_owned(), source };
+        let invalid = |message: String| AccumulationFileError::Invalid { path: path.to_owned(), message };
+        let mut input = BufReader::new(File::open(path).map_err(io)?);
+        let mut magic = [0u8; MAGIC.len()];
+        read_exact(&mut input, &mut magic).map_err(|e| invalid(format!("{e} in its first line")))?;
+        if magic != MAGIC {
+            return Err(invalid("it does not start with 'rtgi accumulation 1'".into()));
+        }
+        let mut length = [0u8; 4];
+        read_exact(&mut input, &mut length).map_err(|e| invalid(format!("{e} in the header's length")))?;
+        let length = u32::from_le_bytes(length);
+        if length > MAX_HEADER {
+            return Err(invalid(format!("a header of {length} bytes (at most {MAX_HEADER})")));
+        }
+        let mut header = vec![0u8; length as usize];
+        read_exact(&mut input, &mut header).map_err(|e| invalid(format!("{e} in the header")))?;
+        let header: Header =
+            serde_json::from_slice(&header).map_err(|e| invalid(format!("its header is not valid: {e}")))?;
+        let Header { identity, rows, samples } = header;
+        if rows.start > rows.end || rows.end > identity.height {
+            return Err(invalid(format!("rows {rows:?} outside an image of height {}", identity.height)));
+        }
+        let pixels = (rows.end - rows.start) as u64 * identity.width as u64;
+        // Every pixel takes at least three bytes: a file shorter than that is
+        // refused before its sums are allocated.
+        if let Ok(metadata) = std::fs::metadata(path)
+            && metadata.len() < pixels.saturating_mul(3)
+        {
+            return Err(invalid(format!("{} bytes cannot hold {pixels} pixels", metadata.len())));
+        }
+        let mut sums: Vec<PixelSum> = Vec::new();
+        sums.try_reserve_exact(pixels as usize)
+            .map_err(|_| invalid(format!("{pixels} pixels do not fit in memory")))?;
+        let mut checksum = Fnv::new();
+        for pixel in 0..pixels {
+            let mut sum = [0i128; 3];
+            for channel in &mut sum {
+                *channel = decode(&mut input, &mut checksum)
+                    .map_err(|e| invalid(format!("pixel {pixel} of {pixels}: {e}")))?;
+            }
+            sums.push(sum);
+        }
+        let mut stored = [0u8; 8];
+        read_exact(&mut input, &mut stored).map_err(|e| invalid(format!("{e} in the checksum")))?;
+        if u64::from_le_bytes(stored) != checksum.0 {
+            return Err(invalid("the checksum does not match: the file is damaged".into()));
+        }
+        if input.read(&mut [0u8; 1]).map_err(io)? != 0 {
+            return Err(invalid("there are bytes after the checksum".into()));
+        }
+        Accumulation::from_parts(identity, rows, samples, sums).map_err(invalid)
+    }
+}
+
+/// `read_exact`, with an end of file said in words.
+fn read_exact(input: &mut impl Read, buffer: &mut [u8]) -> Result<(), String> {
+    input.read_exact(buffer).map_err(|e| match e.kind() {
+        std::io::ErrorKind::UnexpectedEof => "the file ends early".to_owned(),
+        _ => e.to_string(),
+    })
+}
+
+/// Appends `value` as a zigzag LEB128 varint.
+fn encode(value: i128, out: &mut Vec<u8>) {
+    let mut zigzag = ((value << 1) ^ (value >> 127)) as u128;
+    loop {
+        let byte = (zigzag & 0x7f) as u8;
+        zigzag >>= 7;
+        if zigzag == 0 {
+            out.push(byte);
+            return;
+        }
+        out.push(byte | 0x80);
+    }
+}
+
+/// Reads a zigzag LEB128 varint, adding its bytes to `checksum`.
+fn decode(input: &mut impl Read, checksum: &mut Fnv) -> Result<i128, String> {
+    let mut zigzag = 0u128;
+    for shift in (0..128).step_by(7) {
+        let mut byte = [0u8; 1];
+        read_exact(input, &mut byte)?;
+        checksum.bytes(&byte);
+        let bits = (byte[0] & 0x7f) as u128;
+        if shift == 126 && bits > 0b11 {
+            return Err("a sum longer than 128 bits".into());
+        }
+        zigzag |= bits << shift;
+        if byte[0] & 0x80 == 0 {
+            return Ok(((zigzag >> 1) as i128) ^ -((zigzag & 1) as i128));
+        }
+    }
+    Err("a sum longer than 128 bits".into())
+}
+
+/// FNV-1a, 64 bits, fed in pieces.
+struct Fnv(u64);
+
+impl Fnv {
+    fn new() -> Fnv {
+        Fnv(0xcbf2_9ce4_8422_2325)
+    }
+
+    fn bytes(&mut self, bytes: &[u8]) {
+        for &b in bytes {
+            self.0 = (self.0 ^ b as u64).wrapping_mul(0x0000_0100_0000_01b3);
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn scratch(name: &str) -> PathBuf {
+        let dir = std::env::temp_dir().join(format!("rtgi-accumulation-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        dir.join(name)
+    }
+
+    #[test]
+    fn varints_round_trip_the_extremes() {
+        for value in [0i128, 1, -1, 63, -64, 64, 1 << 100, -(1 << 100), i128::MAX, i128::MIN] {
+            let mut bytes = Vec::new();
+            encode(value, &mut bytes);
+            assert!(bytes.len() <= 19);
+            let decoded = decode(&mut bytes.as_slice(), &mut Fnv::new()).unwrap();
+            assert_eq!(decoded, value);
+        }
+        let too_long = [0xffu8; 19];
+        assert!(decode(&mut too_long.as_slice(), &mut Fnv::new()).is_err());
+    }
+
+    #[test]
+    fn files_round_trip_and_damage_is_found() {
+        let identity = RenderIdentity::for_tests(3, 5, 8);
+        let sums: Vec<PixelSum> = (0..6).map(|i| [i * 1_000_000_007, -i, (i << 90) + 3]).collect();
+        let accumulation = Accumulation::from_parts(identity, 2..4, 0..5, sums).unwrap();
+        let path = scratch("round-trip.accum");
+        accumulation.write(&path).unwrap();
+        assert_eq!(Accumulation::read(&path).unwrap(), accumulation);
+
+        let bytes = std::fs::read(&path).unwrap();
+        let damaged = scratch("damaged.accum");
+        let mut flipped = bytes.clone();
+        let last = flipped.len() - 9;
+        flipped[last] ^= 1;
+        std::fs::write(&damaged, &flipped).unwrap();
+        let error = Accumulation::read(&damaged).unwrap_err().to_string();
+        assert!(error.contains("damaged") || error.contains("pixel"), "{error}");
+        std::fs::write(&damaged, &bytes[..bytes.len() - 3]).unwrap();
+        let error = Accumulation::read(&damaged).unwrap_err().to_string();
+        assert!(error.contains("ends early"), "{error}");
+        std::fs::write(&damaged, b"P6 not this").unwrap();
+        let error = Accumulation::read(&damaged).unwrap_err().to_string();
+        assert!(error.contains("not an rtgi accumulation file"), "{error}");
+    }
+}
