@@ -41,6 +41,9 @@ pub(crate) enum Command {
     /// Check that every acceleration structure answers hard rays exactly as the linear scan does,
     /// bit for bit, and that rays aimed inside closed surfaces never leak
     Verify(VerifyArgs),
+    /// Put the parts of a split render (--samples, --tile) or a checkpoint together into one
+    /// image or accumulation, bit-identical to the render in one go
+    Merge(crate::merge_cmd::MergeArgs),
     /// What accuracy costs in time: vary one knob (spp, depth, accel, scaling, or all) and write
     /// a table (KNOB.md), every measurement (KNOB.json) and SVG plots
     Experiment(ExperimentArgs),
@@ -503,7 +506,8 @@ pub(crate) struct RenderArgs {
     /// Scene file (.obj, .gltf, .glb or .toml); the built-in Cornell box when omitted
     pub(crate) scene: Option<PathBuf>,
 
-    /// Output image; the format follows the extension (.png or .exr)
+    /// Output image; the format follows the extension (.png or .exr), or .accum for the
+    /// render's exact sums (a part of a split render, for 'rtgi merge')
     #[arg(short, long)]
     pub(crate) output: PathBuf,
 
@@ -551,6 +555,9 @@ pub(crate) struct RenderArgs {
     /// Radiance of camera rays that hit nothing and see no environment, as R,G,B
     #[arg(long, value_parser = parse_vec3, default_value = "0.05,0.05,0.06")]
     pub(crate) background: Vec3,
+
+    #[command(flatten)]
+    pub(crate) job: crate::render_job::JobArgs,
 }
 
 /// The size of an image in pixels.

@@ -132,3 +132,22 @@ pub(crate) fn apply_lighting(args: &LightingArgs, scene: &mut Scene, settings: &
     };
     Ok(())
 }
+
+/// Whether `a` and `b` name the same file, following links; a file that
+/// does not exist yet is compared by its folder and name.
+pub(crate) fn same_file(a: &Path, b: &Path) -> bool {
+    fn canonical(path: &Path) -> Option<std::path::PathBuf> {
+        if let Ok(path) = path.canonicalize() {
+            return Some(path);
+        }
+        let folder = match path.parent() {
+            Some(parent) if !parent.as_os_str().is_empty() => parent.canonicalize().ok()?,
+            _ => std::env::current_dir().ok()?,
+        };
+        Some(folder.join(path.file_name()?))
+    }
+    match (canonical(a), canonical(b)) {
+        (Some(a), Some(b)) => a == b,
+        _ => a == b,
+    }
+}

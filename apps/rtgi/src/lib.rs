@@ -11,7 +11,11 @@ mod default_scene;
 mod effects_cmd;
 mod experiment_cmd;
 mod info_cmd;
+mod interrupt;
+mod merge_cmd;
+mod progress;
 mod render_cmd;
+mod render_job;
 mod trace_cmd;
 mod verify_cmd;
 
@@ -36,10 +40,15 @@ pub fn main() -> ExitCode {
         cli::Command::BenchEffects(args) => effects_cmd::run(&args),
         cli::Command::Verify(args) => verify_cmd::run(&args),
         cli::Command::Experiment(args) => experiment_cmd::run(&args),
+        cli::Command::Merge(args) => merge_cmd::run(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
+            if let Some(render_job::StoppedBySignal(signal)) = e.downcast_ref() {
+                eprintln!("rtgi: {e}");
+                return ExitCode::from(interrupt::exit_status(*signal));
+            }
             eprintln!("error: {}", one_line(&e));
             ExitCode::FAILURE
         }

@@ -1,0 +1,79 @@
+//! `rtgi merge`: the parts of a split render, put together.
+
+use std::path::PathBuf;
+
+use anyhow::{Context, Result, bail};
+use clap::Args;
+use rtgi_image::{ToneMap, ToneOperator};
+use rtgi_render::Accumulation;
+
+use crate::render_cmd::{check_output, is_accumulation};
+
+/// `rtgi merge`: accumulations (.accum) of one render into its image.
+#[derive(Debug, Args)]
+pub(crate) struct MergeArgs {
+    /// The parts: .accum files written by 'rtgi render --samples/--tile -o PART.accum' or --checkpoint
+    #[arg(required = true)]
+    pub(crate) parts: Vec<PathBuf>,
+
+    /// The result: an image (.png, .exr), or an .accum file to merge further
+    #[arg(short, long)]
+    pub(crate) output: PathBuf,
+
+    /// Exposure in stops, for PNG output
+    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
+    pub(crate) exposure: f32,
+
+    /// Tone map for PNG output: clamp, reinhard, aces
+    #[arg(long, default_value = "clamp")]
+    pub(crate) tonemap: ToneOperator,
+}
+
+pub(crate) fn run(args: &MergeArgs) -> Result<()> {
+    check_output(&args.output)?;
+    for part in &args.parts {
+        if crate::common::same_file(part, &args.output) {
+            bail!("-o {}: is also one of the parts; write the result to a new file", args.output.display());
+        }
+    }
+    let parts = args.parts.iter().map(|path| Accumulation::read(path)).collect::<Result<Vec<_>, _>>()?;
+    let names: Vec<String> = args.parts.iter().map(|p| p.display().to_string()).collect();
+    let merged = Accumulation::merge(parts).map_err(|e| {
+        // The error numbers the parts; name them.
+        let mut message = e.to_string();
+        message = message.replace("than part 0", &format!("than {}", names[0]));
+        for (index, name) in names.iter().enumerate().rev() {
+            message = message.replace(&format!("part {index} "), &format!("{name} "));
+            message = message.replace(&format!("parts {index} "), &format!("{name} "));
+            message = message.replace(&format!("and {index} "), &format!("and {name} "));
+        }
+        anyhow::anyhow!("cannot merge: {message}")
+    })?;
+    let identity = merged.identity();
+    let complete = merged.is_complete();
+    if is_accumulation(&args.output) {
+        merged.write(&args.output)?;
+    } else {
+        if merged.rows() != (0..identity.height) {
+            bail!(
+                "cannot make an image: the parts hold rows {:?} of 0..{}; add the other bands (--tile), or \
+                 write an .accum to merge further",
+                merged.rows(),
+                identity.height
+            );
+        }
+        let tone_map = ToneMap { exposure: args.exposure, operator: args.tonemap };
+        merged.image().write(&args.output, &tone_map).context("cannot write the merged image")?;
+    }
+    println!("parts       {}", args.parts.len());
+    println!(
+        "render      {}x{}, {} spp in all, seed {}",
+        identity.width, identity.height, identity.samples_per_pixel, identity.seed
+    );
+    println!("merged      rows {:?}, samples {:?} of every pixel", merged.rows(), merged.samples());
+    if !complete {
+        println!("incomplete  {} of {} samples per pixel", merged.samples_done(), identity.samples_per_pixel);
+    }
+    println!("wrote       {}", args.output.display());
+    Ok(())
+}
