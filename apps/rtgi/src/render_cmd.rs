@@ -5,8 +5,11 @@ use anyhow::{Result, bail};
 use rtgi_image::{ToneMap, check_writable};
 use rtgi_render::{Accumulation, EffectPlan, Integrator, PixelSampler, RenderIdentity, RenderSettings, render};
 
+use crate::cli::EnvironmentArg;
 use crate::cli::RenderArgs;
-use crate::common::{LoadedScene, apply_lighting, check_output_folder, choose_camera, load_scene, thread_pool};
+use crate::common::{
+    LoadedScene, apply_lighting, check_output_folder, choose_camera, load_scene, same_file, thread_pool,
+};
 use crate::interrupt;
 use crate::progress::Progress;
 use crate::render_job::{Ending, Renderer, StoppedBySignal, run_passes};
@@ -52,6 +55,16 @@ pub(crate) fn run(args: &RenderArgs) -> Result<()> {
     if let Some(path) = &job.checkpoint {
         check_output_folder(path)?;
     }
+    let outputs: Vec<(&str, &Path)> = [("-o", args.output.as_path())]
+        .into_iter()
+        .chain(aov_outputs.iter().map(|(_, path)| ("--aov", path.as_path())))
+        .chain(job.checkpoint.as_deref().map(|path| ("--checkpoint", path)))
+        .collect();
+    let mut inputs: Vec<(&str, &Path)> = args.scene.as_deref().map(|path| ("the scene", path)).into_iter().collect();
+    if let Some(EnvironmentArg::File(path)) = &args.lighting.environment {
+        inputs.push(("--environment", path));
+    }
+    refuse_inputs_as_outputs(&outputs, &inputs)?;
     let resumed = job.resume.as_deref().map(Accumulation::read).transpose()?;
     check_memory(args.size.width, args.size.height)?;
 
@@ -198,6 +211,17 @@ pub(crate) fn run(args: &RenderArgs) -> Result<()> {
         Ending::TimeLimit if !wrote_output => bail!("no sample finished within the time limit"),
         _ => Ok(()),
     }
+}
+
+/// Refuses to write over a file the render reads: an output named like
+/// the scene, a texture or the environment map would destroy it.
+pub(crate) fn refuse_inputs_as_outputs(outputs: &[(&str, &Path)], inputs: &[(&str, &Path)]) -> Result<()> {
+    for (option, output) in outputs {
+        if let Some((what, _)) = inputs.iter().find(|(_, input)| same_file(output, input)) {
+            bail!("{option} {}: is {what}, which the render reads; write to another file", output.display());
+        }
+    }
+    Ok(())
 }
 
 /// Refuses an image too large for this machine's memory before anything is

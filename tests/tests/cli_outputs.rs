@@ -1,0 +1,81 @@
+//! Outputs that would destroy an input, or that cannot fit in memory, are
+//! refused before anything is rendered.
+
+use std::path::Path;
+
+use rtgi_tests::{Run, run_cli, scratch_dir};
+
+const RTGI: &str = env!("CARGO_BIN_EXE_rtgi-under-test");
+
+fn rtgi(args: &[&str]) -> Run {
+    run_cli(RTGI, args)
+}
+
+fn path_str(p: &Path) -> &str {
+    p.to_str().expect("scratch paths are UTF-8")
+}
+
+#[test]
+fn an_output_that_is_also_an_input_is_refused_and_left_alone() {
+    let dir = scratch_dir("output-is-input");
+    let sky = dir.join("sky.exr");
+    let mut image = rtgi_image::HdrImage::new(8, 4);
+    image.pixels_mut().fill(rtgi_math::Vec3::splat(0.5));
+    image.write(&sky, &rtgi_image::ToneMap::default()).unwrap();
+    let before = std::fs::read(&sky).unwrap();
+    let small = ["render", "--width", "16", "--height", "16", "--environment", path_str(&sky)];
+    // As the image, as an AOV and as the checkpoint, through another spelling of the same path.
+    let other_spelling = dir.join(".").join("sky.exr");
+    for extra in [
+        vec!["-o", path_str(&sky)],
+        vec!["-o", path_str(&other_spelling)],
+        vec!["-o", "x.png", "--checkpoint", path_str(&sky)],
+    ] {
+        let args: Vec<&str> = small.iter().copied().chain(extra).collect();
+        let run = rtgi(&args);
+        assert_eq!(run.code, Some(1), "{run:?}");
+        assert!(run.stderr.contains("is --environment, which the render reads"), "{run:?}");
+    }
+    let aov_source = dir.join("out.normal.exr");
+    std::fs::copy(&sky, &aov_source).unwrap();
+    let out = dir.join("out.png");
+    let run = rtgi(&[
+        "render",
+        "--width",
+        "16",
+        "--height",
+        "16",
+        "--environment",
+        path_str(&aov_source),
+        "--aov",
+        "normal",
+        "-o",
+        path_str(&out),
+    ]);
+    assert_eq!(run.code, Some(1), "{run:?}");
+    assert!(run.stderr.contains("--aov"), "{run:?}");
+    assert_eq!(std::fs::read(&sky).unwrap(), before);
+    assert!(!out.exists());
+}
+
+#[test]
+fn an_image_too_large_for_memory_is_refused_before_anything_is_allocated() {
+    let available = std::fs::read_to_string("/proc/meminfo").ok().and_then(|info| {
+        info.lines().find(|l| l.starts_with("MemAvailable:"))?.split_whitespace().nth(1)?.parse::<u64>().ok()
+    });
+    match available {
+        Some(kib) if kib * 1024 < 16384 * 16384 * 120 => {}
+        _ => {
+            eprintln!("skipped: this machine may have the memory for a 16384x16384 render");
+            return;
+        }
+    }
+    let dir = scratch_dir("too-large");
+    let out = dir.join("huge.png");
+    let start = std::time::Instant::now();
+    let run = rtgi(&["render", "--width", "16384", "--height", "16384", "-o", path_str(&out)]);
+    assert_eq!(run.code, Some(1), "{run:?}");
+    assert!(run.stderr.contains("GiB of memory") && run.stderr.contains("--tile"), "{run:?}");
+    assert!(start.elapsed() < std::time::Duration::from_secs(5), "{:?}", start.elapsed());
+    assert!(!out.exists());
+}
