@@ -239,11 +239,11 @@ pub(crate) struct LightingArgs {
 
     /// Clamp the light each path brings in after two or more bounces to this value: fewer
     /// fireflies (caustics), at the price of a bias [default: no clamp]
-    #[arg(long, value_parser = parse_positive)]
+    #[arg(long, value_parser = parse_positive, allow_negative_numbers = true)]
     pub(crate) clamp_indirect: Option<f32>,
 
     /// Light from far away: a radiance R,G,B or an equirectangular .exr image
-    #[arg(long, value_parser = parse_environment)]
+    #[arg(long, value_parser = parse_environment, allow_hyphen_values = true)]
     pub(crate) environment: Option<EnvironmentArg>,
 
     /// Add a light (repeatable): point:X,Y,Z:INTENSITY[:R,G,B],
@@ -264,11 +264,41 @@ pub(crate) enum EnvironmentArg {
     File(PathBuf),
 }
 
-fn parse_positive(text: &str) -> Result<f32, String> {
-    text.parse::<f32>()
+/// Parses a finite number that `accept` allows; the error names the
+/// allowed values, `allowed`, so that the user knows what to type instead.
+fn parse_number(text: &str, accept: impl Fn(f32) -> bool, allowed: &str) -> Result<f32, String> {
+    text.trim()
+        .parse::<f32>()
         .ok()
-        .filter(|v| v.is_finite() && *v > 0.0)
-        .ok_or_else(|| format!("expected a positive number (got '{text}')"))
+        .filter(|v| v.is_finite() && accept(*v))
+        .ok_or_else(|| format!("expected {allowed} (got '{text}')"))
+}
+
+fn parse_positive(text: &str) -> Result<f32, String> {
+    parse_number(text, |v| v > 0.0, "a finite number greater than 0")
+}
+
+/// Exposure in stops: 2^±64 already turns any radiance black or white.
+fn parse_exposure(text: &str) -> Result<f32, String> {
+    parse_number(text, |v| (-64.0..=64.0).contains(&v), "a number of stops from -64 to 64")
+}
+
+fn parse_fov(text: &str) -> Result<f32, String> {
+    parse_number(text, |v| v > 0.0 && v < 180.0, "an angle in degrees greater than 0 and less than 180")
+}
+
+/// Parses "r,g,b" into a colour: three finite numbers, none negative.
+pub(crate) fn parse_colour(text: &str) -> Result<Vec3, String> {
+    parse_vec3(text).ok().filter(|c| c.min_element() >= 0.0).ok_or_else(|| {
+        format!("expected three finite numbers of at least 0 separated by commas, like 0.05,0.05,0.06 (got '{text}')")
+    })
+}
+
+/// Parses "x,y,z" into a direction: three finite numbers, not all zero.
+pub(crate) fn parse_direction(text: &str) -> Result<Vec3, String> {
+    parse_vec3(text).ok().filter(|d| *d != Vec3::ZERO).ok_or_else(|| {
+        format!("expected three finite numbers, not all 0, separated by commas, like 0,1,0 (got '{text}')")
+    })
 }
 
 fn parse_environment(text: &str) -> Result<EnvironmentArg, String> {
@@ -299,7 +329,7 @@ pub(crate) fn parse_light(text: &str) -> Result<Light, String> {
     let colour = |rest: &[&str]| -> Result<Vec3, String> {
         match rest {
             [] => Ok(Vec3::ONE),
-            [c] => vector(c),
+            [c] => parse_colour(c).map_err(|e| format!("light '{text}': the colour: {e}")),
             _ => Err(format!("light '{text}': too many fields")),
         }
     };
@@ -378,7 +408,7 @@ pub(crate) struct HeatmapArgs {
     pub(crate) size: ImageSize,
 
     /// Count that maps to the top of the colour scale [default: the image's maximum]
-    #[arg(long)]
+    #[arg(long, value_parser = parse_positive, allow_negative_numbers = true)]
     pub(crate) scale: Option<f32>,
 
     /// Count triangle tests instead of nodes visited
@@ -541,7 +571,7 @@ pub(crate) struct RenderArgs {
     pub(crate) camera: CameraArgs,
 
     /// Exposure in stops, for PNG output
-    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
+    #[arg(long, default_value_t = 0.0, value_parser = parse_exposure, allow_negative_numbers = true)]
     pub(crate) exposure: f32,
 
     /// Tone map for PNG output: clamp, reinhard, aces
@@ -549,7 +579,7 @@ pub(crate) struct RenderArgs {
     pub(crate) tonemap: ToneOperator,
 
     /// Radiance of camera rays that hit nothing and see no environment, as R,G,B
-    #[arg(long, value_parser = parse_vec3, default_value = "0.05,0.05,0.06")]
+    #[arg(long, value_parser = parse_colour, default_value = "0.05,0.05,0.06", allow_hyphen_values = true)]
     pub(crate) background: Vec3,
 }
 
@@ -593,7 +623,7 @@ pub(crate) struct BuildArgs {
     pub(crate) sah_bins: u32,
 
     /// Cost of a BVH traversal step relative to a ray/triangle test, for the SAH [default: 1; 4 for the wide BVHs]
-    #[arg(long)]
+    #[arg(long, value_parser = parse_positive, allow_negative_numbers = true)]
     pub(crate) traversal_cost: Option<f32>,
 
     /// Ray/triangle test: watertight, moller-trumbore, watertight-f64 (the watertight test in double precision)
@@ -644,11 +674,11 @@ pub(crate) struct CameraArgs {
     pub(crate) look: Option<Vec3>,
 
     /// World up direction, as X,Y,Z
-    #[arg(long, value_parser = parse_vec3, allow_hyphen_values = true)]
+    #[arg(long, value_parser = parse_direction, allow_hyphen_values = true)]
     pub(crate) up: Option<Vec3>,
 
-    /// Vertical field of view in degrees
-    #[arg(long)]
+    /// Vertical field of view in degrees, greater than 0 and less than 180
+    #[arg(long, value_parser = parse_fov, allow_negative_numbers = true)]
     pub(crate) fov: Option<f32>,
 }
 

@@ -1,0 +1,90 @@
+//! The `rtgi` command given hostile input: option values out of range, a
+//! standard output whose reader goes away, ray files that are not ray
+//! files. It must never panic, and its errors must say what to do instead.
+
+use std::path::Path;
+
+use rtgi_tests::{Run, run_cli, scratch_dir};
+
+const RTGI: &str = env!("CARGO_BIN_EXE_rtgi-under-test");
+
+fn rtgi(args: &[&str]) -> Run {
+    run_cli(RTGI, args)
+}
+
+fn s(p: &Path) -> &str {
+    p.to_str().expect("scratch paths are UTF-8")
+}
+
+/// Each value is refused by the parser, as clap refuses (exit status 2),
+/// before the scene is read: the scene given does not exist, so any later
+/// refusal would name it instead. The one line names the option and the
+/// values it takes.
+#[test]
+fn out_of_range_option_values_are_refused_with_the_allowed_range() {
+    let dir = scratch_dir("hostile-options");
+    let png = dir.join("out.png");
+    let missing = "no-such-scene.obj";
+    let render = |extra: &[&str]| -> Vec<String> {
+        let mut args = vec!["render", missing, "-o", s(&png), "--width", "8", "--height", "8", "--spp", "1"];
+        args.extend_from_slice(extra);
+        args.into_iter().map(str::to_owned).collect()
+    };
+    let owned = |args: &[&str]| -> Vec<String> { args.iter().map(|a| (*a).to_owned()).collect() };
+    let heatmap = dir.join("heat.png");
+    let cases: Vec<(Vec<String>, &str, &str)> = vec![
+        (render(&["--exposure", "nan"]), "--exposure", "from -64 to 64"),
+        (render(&["--exposure", "inf"]), "--exposure", "from -64 to 64"),
+        (render(&["--exposure", "-1e9"]), "--exposure", "from -64 to 64"),
+        (render(&["--traversal-cost", "-5"]), "--traversal-cost", "greater than 0"),
+        (render(&["--traversal-cost", "nan"]), "--traversal-cost", "greater than 0"),
+        (render(&["--traversal-cost", "0"]), "--traversal-cost", "greater than 0"),
+        (render(&["--fov", "inf"]), "--fov", "less than 180"),
+        (render(&["--fov", "-10"]), "--fov", "greater than 0"),
+        (render(&["--fov", "180"]), "--fov", "less than 180"),
+        (render(&["--background", "nan,0,0"]), "--background", "finite"),
+        (render(&["--background", "-1,0,0"]), "--background", "at least 0"),
+        (render(&["--clamp-indirect", "-1"]), "--clamp-indirect", "greater than 0"),
+        (render(&["--clamp-indirect", "inf"]), "--clamp-indirect", "greater than 0"),
+        (render(&["--at", "nan,0,0"]), "--at", "finite"),
+        (render(&["--look", "0,inf,0"]), "--look", "finite"),
+        (render(&["--up", "0,0,0"]), "--up", "not all 0"),
+        (render(&["--environment", "-1,0,0"]), "--environment", "negative"),
+        (render(&["--light", "point:nan,0,0:1"]), "--light", "finite"),
+        (render(&["--light", "point:0,1,0:nan"]), "--light", "non-negative"),
+        (render(&["--light", "point:0,1,0:-3"]), "--light", "non-negative"),
+        (render(&["--light", "point:0,1,0:5:-1,0,0"]), "--light", "at least 0"),
+        (render(&["--light", "directional:0,0,0:1"]), "--light", "zero"),
+        (render(&["--light", "spot:0,1,0:0,-1,0:5:30:inf"]), "--light", "non-negative"),
+        (
+            owned(&["heatmap", missing, "-o", s(&heatmap), "--width", "8", "--height", "8", "--scale", "nan"]),
+            "--scale",
+            "greater than 0",
+        ),
+        (
+            owned(&["heatmap", missing, "-o", s(&heatmap), "--width", "8", "--height", "8", "--scale", "-2"]),
+            "--scale",
+            "greater than 0",
+        ),
+        (owned(&["bench", missing, "--traversal-cost", "inf"]), "--traversal-cost", "greater than 0"),
+        (owned(&["info", missing, "--clamp-indirect", "nan"]), "--clamp-indirect", "greater than 0"),
+        (owned(&["verify", missing, "--traversal-cost", "-1"]), "--traversal-cost", "greater than 0"),
+    ];
+    let mut failures = Vec::new();
+    for (args, option, allowed) in &cases {
+        let args: Vec<&str> = args.iter().map(String::as_str).collect();
+        let run = rtgi(&args);
+        let lines: Vec<&str> = run.stderr.lines().filter(|l| !l.trim().is_empty()).collect();
+        let ok = run.code == Some(2)
+            && lines.len() == 1
+            && lines[0].contains(option)
+            && lines[0].contains(allowed)
+            && !lines[0].contains(missing);
+        if !ok {
+            failures.push(format!("{args:?}: exit {:?}, stderr {:?}", run.code, run.stderr));
+        }
+    }
+    assert!(!png.exists() && !heatmap.exists());
+    assert!(failures.is_empty(), "{} of {} cases:\n{}", failures.len(), cases.len(), failures.join("\n"));
+}
+
