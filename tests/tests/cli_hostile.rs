@@ -2,9 +2,13 @@
 //! standard output whose reader goes away, ray files that are not ray
 //! files. It must never panic, and its errors must say what to do instead.
 
+use std::io::{BufRead, BufReader};
 use std::path::Path;
+use std::process::{Command, Stdio};
 
-use rtgi_tests::{Run, run_cli, scratch_dir};
+use rtgi_image::HdrImage;
+use rtgi_math::Vec3;
+use rtgi_tests::{Run, run_cli, scratch_dir, workspace_root};
 
 const RTGI: &str = env!("CARGO_BIN_EXE_rtgi-under-test");
 
@@ -88,3 +92,90 @@ fn out_of_range_option_values_are_refused_with_the_allowed_range() {
     assert!(failures.is_empty(), "{} of {} cases:\n{}", failures.len(), cases.len(), failures.join("\n"));
 }
 
+/// Runs `rtgi` with its standard output in a pipe whose read end is closed
+/// after `lines` lines (at once for 0), as `rtgi ... | head -1` does; the
+/// command must end with success, without a panic or an error. Returns what
+/// it wrote to standard error (progress, for the commands that show it).
+fn assert_quiet_when_the_pipe_closes(args: &[&str], lines: usize) -> String {
+    let mut child = Command::new(RTGI)
+        .args(args)
+        .current_dir(workspace_root())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("cannot start the rtgi binary");
+    let stdout = child.stdout.take().expect("stdout is piped");
+    let mut reader = BufReader::new(stdout);
+    for _ in 0..lines {
+        let mut line = String::new();
+        reader.read_line(&mut line).expect("cannot read the first lines");
+        assert!(!line.is_empty(), "{args:?}: fewer than {lines} lines");
+    }
+    drop(reader);
+    let output = child.wait_with_output().expect("cannot wait for rtgi");
+    let stderr = String::from_utf8_lossy(&output.stderr).into_owned();
+    let noise = ["panicked", "Broken pipe", "error"].iter().any(|n| stderr.contains(n));
+    assert!(output.status.success() && !noise, "{args:?}: {:?}, stderr {stderr:?}", output.status);
+    stderr
+}
+
+/// `rtgi bench` shows progress on standard error, and its table on
+/// standard output only at the end: the reader is long gone by then.
+#[test]
+fn bench_ends_quietly_when_its_reader_goes_away() {
+    let args = [
+        "bench",
+        "--accel",
+        "sah",
+        "--width",
+        "8",
+        "--height",
+        "8",
+        "--rays",
+        "64",
+        "--repeats",
+        "1",
+        "--leak-rays",
+        "64",
+        "--linear-rays",
+        "16",
+    ];
+    let stderr = assert_quiet_when_the_pipe_closes(&args, 0);
+    assert!(stderr.contains("measuring sah"), "{stderr}");
+}
+
+/// An OBJ scene with one material per triangle: `rtgi info` prints a line
+/// for each, far more than a pipe holds (64 KiB on Linux), so that the
+/// command is still writing when the reader goes away.
+fn scene_with_many_materials(dir: &Path, count: usize) -> std::path::PathBuf {
+    let (mut obj, mut mtl) = (String::from("mtllib many.mtl\n"), String::new());
+    for i in 0..count {
+        let x = i as f32;
+        obj += &format!("v {x} 0 0\nv {} 0 0\nv {x} 1 0\nusemtl material_{i}\nf -3 -2 -1\n", x + 1.0);
+        mtl += &format!("newmtl material_{i}\nKd 0.5 0.5 0.5\n");
+    }
+    std::fs::write(dir.join("many.mtl"), mtl).unwrap();
+    let path = dir.join("many.obj");
+    std::fs::write(&path, obj).unwrap();
+    path
+}
+
+#[test]
+fn info_ends_quietly_when_its_reader_goes_away() {
+    let dir = scratch_dir("hostile-pipe-info");
+    let scene = scene_with_many_materials(&dir, 4000);
+    assert_eq!(assert_quiet_when_the_pipe_closes(&["info", s(&scene)], 1), "");
+    assert_eq!(assert_quiet_when_the_pipe_closes(&["info", s(&scene), "--json"], 1), "");
+}
+
+#[test]
+fn compare_ends_quietly_when_its_reader_goes_away() {
+    let dir = scratch_dir("hostile-pipe-compare");
+    let (a, b) = (dir.join("a.exr"), dir.join("b.exr"));
+    let mut image = HdrImage::new(4, 3);
+    image.write(&a, &Default::default()).unwrap();
+    image.set(1, 1, Vec3::ONE);
+    image.write(&b, &Default::default()).unwrap();
+    assert_eq!(assert_quiet_when_the_pipe_closes(&["compare", s(&a), s(&b)], 0), "");
+    assert_eq!(assert_quiet_when_the_pipe_closes(&["compare", s(&a), s(&b), "--json"], 0), "");
+}

@@ -14,6 +14,7 @@ use rtgi_render::{PixelSampler, RenderSettings};
 
 use crate::cli::{ExperimentArgs, KnobChoice};
 use crate::common::{LoadedScene, apply_lighting, choose_camera, load_scene, thread_pool};
+use crate::output::outln;
 
 /// The shared scenes of the report, relative to the scenes folder.
 const CORNELL: &str = "cornell-box/CornellBox-Original.obj";
@@ -105,10 +106,10 @@ pub(crate) fn run(args: &ExperimentArgs) -> Result<()> {
         eprintln!("experiment {knob}{on}: {}", knob.question());
         let report = pool.install(|| rtgi_experiment::run(knob, &subject, &options, &|line| eprintln!("  {line}")))?;
         for finding in &report.findings {
-            println!("{knob}: {finding}");
+            outln!("{knob}: {finding}")?;
         }
         for path in report.write(&folder)? {
-            println!("wrote {}", path.display());
+            outln!("wrote {}", path.display())?;
         }
         written.push((folder, report));
     }
@@ -121,7 +122,7 @@ pub(crate) fn run(args: &ExperimentArgs) -> Result<()> {
             })
             .collect();
         let path = rtgi_experiment::write_index(&out_root, &entries, &options.command)?;
-        println!("wrote {}", path.display());
+        outln!("wrote {}", path.display())?;
     }
     Ok(())
 }

@@ -11,6 +11,7 @@ mod default_scene;
 mod effects_cmd;
 mod experiment_cmd;
 mod info_cmd;
+mod output;
 mod render_cmd;
 mod trace_cmd;
 mod verify_cmd;
@@ -37,8 +38,13 @@ pub fn main() -> ExitCode {
         cli::Command::Verify(args) => verify_cmd::run(&args),
         cli::Command::Experiment(args) => experiment_cmd::run(&args),
     };
+    // Whatever the command printed last may still sit in the buffer.
+    let result = result.and_then(|()| output::flush());
     match result {
         Ok(()) => ExitCode::SUCCESS,
+        // The reader of standard output has gone (`rtgi info | head -1`):
+        // it has all it wanted, so this is not a failure to report.
+        Err(e) if output::is_closed(&e) => ExitCode::SUCCESS,
         Err(e) => {
             eprintln!("error: {}", one_line(&e));
             ExitCode::FAILURE
