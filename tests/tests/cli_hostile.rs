@@ -2,15 +2,19 @@
 //! standard output whose reader goes away, ray files that are not ray
 //! files. It must never panic, and its errors must say what to do instead.
 
-use std::io::{BufRead, BufReader};
+use std::io::{BufRead, BufReader, Write};
 use std::path::Path;
 use std::process::{Command, Stdio};
 
+use rtgi_accel::{Accel, LinearScan};
 use rtgi_image::HdrImage;
-use rtgi_math::Vec3;
+use rtgi_math::{Ray, Rng, Vec3};
+use rtgi_render::rays::uniform_sphere;
+use rtgi_scene::Scene;
 use rtgi_tests::{Run, run_cli, scratch_dir, workspace_root};
 
 const RTGI: &str = env!("CARGO_BIN_EXE_rtgi-under-test");
+const BOX: &str = "scenes/cornell-box.toml";
 
 fn rtgi(args: &[&str]) -> Run {
     run_cli(RTGI, args)
@@ -178,4 +182,149 @@ fn compare_ends_quietly_when_its_reader_goes_away() {
     image.write(&b, &Default::default()).unwrap();
     assert_eq!(assert_quiet_when_the_pipe_closes(&["compare", s(&a), s(&b)], 0), "");
     assert_eq!(assert_quiet_when_the_pipe_closes(&["compare", s(&a), s(&b), "--json"], 0), "");
+}
+
+fn encode(rays: &[Ray]) -> Vec<u8> {
+    rays.iter()
+        .flat_map(|r| {
+            [r.origin.x, r.origin.y, r.origin.z, r.direction.x, r.direction.y, r.direction.z, r.t_min, r.t_max]
+                .map(f32::to_le_bytes)
+        })
+        .flatten()
+        .collect()
+}
+
+fn random_rays(count: usize) -> Vec<Ray> {
+    let mut rng = Rng::new(11, 0);
+    (0..count)
+        .map(|_| {
+            let origin = Vec3::new(rng.next_f32() * 550.0, rng.next_f32() * 540.0, rng.next_f32() * 550.0);
+            Ray::new(origin, uniform_sphere(rng.next_f32(), rng.next_f32()))
+        })
+        .collect()
+}
+
+/// Asserts that a failed run wrote one line containing every `expected`
+/// and left no hit file, finished or partial.
+fn assert_refused(run: &Run, expected: &[&str], out: &Path) {
+    assert!(run.code == Some(1), "exit {:?} (101 is a panic): {run:?}", run.code);
+    let lines: Vec<&str> = run.stderr.lines().filter(|l| !l.trim().is_empty()).collect();
+    assert_eq!(lines.len(), 1, "{:?}", run.stderr);
+    for e in expected {
+        assert!(lines[0].contains(e), "'{}' does not mention '{e}'", lines[0]);
+    }
+    assert!(!out.exists(), "{} was written", out.display());
+    let leftovers: Vec<_> = std::fs::read_dir(out.parent().unwrap())
+        .unwrap()
+        .filter_map(Result::ok)
+        .filter(|e| e.file_name().to_string_lossy().contains("partial"))
+        .collect();
+    assert!(leftovers.is_empty(), "left {leftovers:?}");
+}
+
+/// `/dev/zero` is an endless stream of rays with a zero direction: refused
+/// at its first record, not read until memory runs out.
+#[test]
+fn trace_refuses_dev_zero_at_its_first_ray() {
+    let dir = scratch_dir("hostile-zero");
+    let out = dir.join("hits.bin");
+    let run = rtgi(&["trace", BOX, "--rays", "/dev/zero", "--out", s(&out)]);
+    assert_refused(&run, &["/dev/zero", "ray 0 ", "direction is zero"], &out);
+}
+
+/// A record that is no ray is refused, naming its index, and nothing is
+/// written, not even the hits of the valid rays before it.
+#[test]
+fn trace_refuses_invalid_rays_naming_the_record() {
+    let dir = scratch_dir("hostile-records");
+    let good = random_rays(5);
+    let bad = [
+        (Ray::new(Vec3::new(f32::NAN, 1.0, 1.0), Vec3::Z), "origin"),
+        (Ray::new(Vec3::new(1.0, f32::INFINITY, 1.0), Vec3::Z), "origin"),
+        (Ray::new(Vec3::splat(100.0), Vec3::new(0.0, f32::NEG_INFINITY, 0.0)), "direction"),
+        (Ray::new(Vec3::splat(100.0), Vec3::ZERO), "direction is zero"),
+        (Ray::with_range(Vec3::splat(100.0), Vec3::Y, f32::NAN, 1.0), "range"),
+        (Ray::with_range(Vec3::splat(100.0), Vec3::Y, 0.0, f32::NAN), "range"),
+    ];
+    for (i, (ray, what)) in bad.into_iter().enumerate() {
+        let mut rays = good.clone();
+        rays.push(ray);
+        rays.extend(random_rays(3));
+        let path = dir.join(format!("bad{i}.bin"));
+        std::fs::write(&path, encode(&rays)).unwrap();
+        let out = dir.join("hits.bin");
+        let run = rtgi(&["trace", BOX, "--rays", s(&path), "--out", s(&out)]);
+        assert_refused(&run, &[&format!("bad{i}.bin"), "ray 5 ", what], &out);
+    }
+}
+
+/// A stream's size is known only at its end: a trailing part of a record
+/// is refused there, with the size and the record size.
+#[test]
+fn trace_refuses_a_stream_that_ends_inside_a_record() {
+    let dir = scratch_dir("hostile-stream");
+    let out = dir.join("hits.bin");
+    let mut bytes = encode(&random_rays(2));
+    bytes.extend_from_slice(&[0; 8]);
+    let mut child = Command::new(RTGI)
+        .args(["trace", BOX, "--rays", "/dev/stdin", "--out", s(&out)])
+        .current_dir(workspace_root())
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    child.stdin.take().unwrap().write_all(&bytes).unwrap();
+    let run: Run = child.wait_with_output().unwrap().into();
+    assert_refused(&run, &["72 bytes", "multiple of 32"], &out);
+}
+
+/// A file of more rays than one chunk is read, traced and written in
+/// parts; the hits are those of the linear scan, in order.
+#[test]
+fn trace_streams_a_file_of_many_chunks_exactly() {
+    let dir = scratch_dir("hostile-chunks");
+    let scene = Scene::load(&workspace_root().join(BOX)).unwrap();
+    let rays = random_rays(3 * 65536 + 123);
+    let path = dir.join("rays.bin");
+    std::fs::write(&path, encode(&rays)).unwrap();
+    let out = dir.join("hits.bin");
+    let run = rtgi(&["trace", BOX, "--rays", s(&path), "--out", s(&out), "--threads", "2"]);
+    assert!(run.success, "{run:?}");
+    assert!(run.stderr.contains(&format!("{} rays", rays.len())), "{}", run.stderr);
+    let bytes = std::fs::read(&out).unwrap();
+    assert_eq!(bytes.len(), rays.len() * 16);
+    let reference = LinearScan::new(&scene.triangle_positions(), rtgi_accel::Intersector::default());
+    for (i, (ray, hit)) in rays.iter().zip(bytes.chunks_exact(16)).enumerate() {
+        let word = |k: usize| [hit[k], hit[k + 1], hit[k + 2], hit[k + 3]];
+        let got = (f32::from_le_bytes(word(0)), u32::from_le_bytes(word(4)));
+        let expected = reference.intersect(ray).map_or((f32::INFINITY, u32::MAX), |h| (h.t, h.triangle));
+        assert_eq!(got, expected, "ray {i}");
+    }
+}
+
+/// Files that are not what a command expects: refused with one line that
+/// names them, never a panic.
+#[test]
+fn files_that_are_not_files_are_refused_cleanly() {
+    let dir = scratch_dir("hostile-files");
+    let empty = dir.join("empty.exr");
+    std::fs::write(&empty, b"").unwrap();
+    let out = dir.join("hits.bin");
+    let folder = s(&dir);
+    let cases: Vec<(Vec<&str>, &str)> = vec![
+        (vec!["compare", "/dev/null", s(&empty)], "/dev/null"),
+        (vec!["compare", s(&empty), s(&empty)], "empty.exr"),
+        (vec!["compare", folder, s(&empty)], folder),
+        (vec!["info", folder], folder),
+        (vec!["info", "/dev/null"], "/dev/null"),
+        (vec!["trace", BOX, "--rays", folder, "--out", s(&out)], folder),
+    ];
+    for (args, expected) in cases {
+        let run = rtgi(&args);
+        let lines: Vec<&str> = run.stderr.lines().filter(|l| !l.trim().is_empty()).collect();
+        assert!(run.code == Some(1), "{args:?}: exit {:?} (101 is a panic): {}", run.code, run.stderr);
+        assert!(lines.len() == 1 && lines[0].contains(expected), "{args:?}: {:?}", run.stderr);
+    }
+    assert!(!out.exists());
 }
