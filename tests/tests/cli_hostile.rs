@@ -328,3 +328,59 @@ fn files_that_are_not_files_are_refused_cleanly() {
     }
     assert!(!out.exists());
 }
+
+/// An uncompressed scan-line OpenEXR file that declares `side` × `side`
+/// pixels of RGB f32 but holds one line of them: its offset table points
+/// every line at that one (about 20 bytes per line of file for 12 × side
+/// bytes per line of image).
+fn exr_claiming(side: i32) -> Vec<u8> {
+    fn attribute(out: &mut Vec<u8>, name: &str, kind: &str, data: &[u8]) {
+        for text in [name, kind] {
+            out.extend_from_slice(text.as_bytes());
+            out.push(0);
+        }
+        out.extend_from_slice(&(data.len() as i32).to_le_bytes());
+        out.extend_from_slice(data);
+    }
+    let ints = |v: &[i32]| -> Vec<u8> { v.iter().flat_map(|i| i.to_le_bytes()).collect() };
+    let mut channels = Vec::new();
+    for name in ["B", "G", "R"] {
+        channels.extend_from_slice(name.as_bytes());
+        channels.extend_from_slice(&[0, 2, 0, 0, 0, 0, 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0]);
+    }
+    channels.push(0);
+    let mut file = ints(&[20000630, 2]);
+    attribute(&mut file, "channels", "chlist", &channels);
+    attribute(&mut file, "compression", "compression", &[0]);
+    attribute(&mut file, "dataWindow", "box2i", &ints(&[0, 0, side - 1, side - 1]));
+    attribute(&mut file, "displayWindow", "box2i", &ints(&[0, 0, side - 1, side - 1]));
+    attribute(&mut file, "lineOrder", "lineOrder", &[0]);
+    attribute(&mut file, "pixelAspectRatio", "float", &1f32.to_le_bytes());
+    attribute(&mut file, "screenWindowCenter", "v2f", &[0; 8]);
+    attribute(&mut file, "screenWindowWidth", "float", &1f32.to_le_bytes());
+    file.push(0);
+    let line_at = (file.len() + 8 * side as usize) as u64;
+    for _ in 0..side {
+        file.extend_from_slice(&line_at.to_le_bytes());
+    }
+    file.extend_from_slice(&ints(&[0, 12 * side]));
+    file.resize(file.len() + 12 * side as usize, 0);
+    file
+}
+
+/// A small file that declares an absurd size is refused by its header,
+/// not by a failed allocation of that size (30 GB here), which aborts.
+#[test]
+fn compare_refuses_images_of_absurd_size_before_allocating() {
+    let dir = scratch_dir("hostile-huge-exr");
+    let huge = dir.join("huge.exr");
+    std::fs::write(&huge, exr_claiming(50_000)).unwrap();
+    let small = dir.join("small.exr");
+    HdrImage::new(4, 4).write(&small, &Default::default()).unwrap();
+    for args in [["compare", s(&huge), s(&small)], ["compare", s(&small), s(&huge)]] {
+        let run = rtgi(&args);
+        assert!(run.code == Some(1), "{args:?}: exit {:?} (134 is an abort): {}", run.code, run.stderr);
+        assert_eq!(run.stderr.trim().lines().count(), 1, "{}", run.stderr);
+        assert!(run.stderr.contains("huge.exr") && run.stderr.contains("50000x50000"), "{}", run.stderr);
+    }
+}
