@@ -1,6 +1,8 @@
 //! `rtgi info`: what a scene contains, as text or JSON.
 
-use anyhow::{Result, bail};
+use std::path::Path;
+
+use anyhow::{Context, Result, bail};
 use rtgi_image::HdrImage;
 use rtgi_render::{EffectPlan, RenderSettings};
 use rtgi_scene::{AlphaMode, LightKind, SUPPORTED_GLTF_EXTENSIONS};
@@ -206,8 +208,8 @@ fn print_text(info: &Info) -> Result<()> {
 
 /// `rtgi compare`: prints the error of one EXR image against another.
 pub(crate) fn compare(args: &CompareArgs) -> Result<()> {
-    let image = HdrImage::read_exr(&args.image)?;
-    let reference = HdrImage::read_exr(&args.reference)?;
+    let image = read_exr(&args.image)?;
+    let reference = read_exr(&args.reference)?;
     let Some(d) = rtgi_image::compare(&image, &reference) else {
         bail!(
             "{}: {}x{} pixels, but the reference {} has {}x{}",
@@ -228,4 +230,15 @@ pub(crate) fn compare(args: &CompareArgs) -> Result<()> {
         outln!("mean          {:.6} (reference {:.6})", d.mean, d.reference_mean)?;
     }
     Ok(())
+}
+
+/// Reads an EXR image from a regular file. Anything else is refused first:
+/// a FIFO would block until some other program writes to it, and a
+/// directory or a device is no image.
+fn read_exr(path: &Path) -> Result<HdrImage> {
+    let metadata = std::fs::metadata(path).with_context(|| format!("{}: cannot read", path.display()))?;
+    if !metadata.is_file() {
+        bail!("{}: cannot read: not a file", path.display());
+    }
+    Ok(HdrImage::read_exr(path)?)
 }
