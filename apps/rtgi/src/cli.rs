@@ -502,7 +502,10 @@ fn parse_accel_list(text: &str) -> Result<AccelList, String> {
 /// miss), triangle (u32; 0xFFFFFFFF for a miss), beta (f32), gamma (f32).
 /// With --any-hit, triangle is 0 when the ray is occluded and 0xFFFFFFFF when
 /// not, and t, beta and gamma are 0. Triangles are numbered in file order
-/// (an OBJ polygon becomes a fan of triangles, in order).
+/// (an OBJ polygon becomes a fan of triangles, in order). The rays are read,
+/// traced and written in chunks, so a file of any size (or a stream) fits
+/// in memory; a ray with a NaN or infinite origin or direction, a zero
+/// direction or a NaN bound is refused, naming its index.
 #[derive(Debug, Args)]
 pub(crate) struct TraceArgs {
     /// Scene file (.obj, .gltf, .glb or .toml)
