@@ -146,6 +146,30 @@ fn bench_ends_quietly_when_its_reader_goes_away() {
     ];
     let stderr = assert_quiet_when_the_pipe_closes(&args, 0);
     assert!(stderr.contains("measuring sah"), "{stderr}");
+    // The JSON file asked for is written all the same.
+    let json = scratch_dir("hostile-pipe-bench").join("bench.json");
+    let with_json = [&args[..], &["--json", s(&json)]].concat();
+    assert_quiet_when_the_pipe_closes(&with_json, 0);
+    let report: serde_json::Value = serde_json::from_slice(&std::fs::read(&json).unwrap()).unwrap();
+    assert!(report["variants"].as_array().is_some_and(|v| v.len() == 1), "{report}");
+}
+
+/// A reader that stops early must not turn a failed verification into a
+/// success: the failure is still reported, on standard error, with a
+/// failing status.
+#[test]
+fn verify_still_fails_when_its_reader_goes_away() {
+    let mut child = Command::new(RTGI)
+        .args(["verify", "--rays", "20000", "--accel", "sah", "--traversal", "fast"])
+        .current_dir(workspace_root())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    drop(child.stdout.take());
+    let run: Run = child.wait_with_output().unwrap().into();
+    assert_eq!(run.code, Some(1), "{run:?}");
+    assert!(run.stderr.contains("do not all answer exactly") && !run.stderr.contains("panicked"), "{}", run.stderr);
 }
 
 /// An OBJ scene with one material per triangle: `rtgi info` prints a line

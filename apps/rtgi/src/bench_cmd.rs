@@ -150,13 +150,14 @@ pub(crate) fn run(args: &BenchArgs) -> Result<()> {
         variants,
         accuracy,
     };
-    print_table(&report, args.linear_rays)?;
-    print_accuracy(&report.accuracy)?;
+    // The JSON asked for is written even when the reader of the table has
+    // gone (`| head`).
+    let printed = print_table(&report, args.linear_rays).and_then(|()| print_accuracy(&report.accuracy));
     if let Some(json) = &args.json {
         crate::common::write_atomically(json, serde_json::to_string_pretty(&report)?.as_bytes())?;
         eprintln!("wrote {}", json.display());
     }
-    Ok(())
+    printed
 }
 
 #[allow(clippy::too_many_arguments)]

@@ -55,7 +55,10 @@ pub(crate) fn run(args: &BenchEffectsArgs) -> Result<()> {
     };
     apply_lighting(&args.lighting, &mut scene, &mut settings)?;
     let plan = EffectPlan::new(&scene, &settings);
-    out!("{plan}")?;
+    // The measurements and the JSON asked for go on when the reader of
+    // standard output has gone (`| head`): the first failed write is kept
+    // and returned at the end, and nothing more is printed after it.
+    let mut printed = out!("{plan}");
 
     let pool = thread_pool(args.threads)?;
     let accel = pool.install(|| args.accel.build(&scene))?;
@@ -84,23 +87,27 @@ pub(crate) fn run(args: &BenchEffectsArgs) -> Result<()> {
         rows.push(Row { label, median_ms: ms, relative_time: ms / planned_ms, difference: compare(&image, &planned) });
     }
 
-    outln!(
-        "{name}: {}x{} at {} spp, {} threads, median of {}",
-        settings.width,
-        settings.height,
-        settings.samples_per_pixel,
-        pool.current_num_threads(),
-        args.repeats
-    )?;
-    outln!("{:<16} {:>10} {:>9} {:>12} {:>12}", "render", "ms", "x plan", "rmse", "max diff")?;
-    for row in &rows {
-        let (rmse, max) = row
-            .difference
-            .map_or(("-".into(), "-".into()), |d| (format!("{:.3e}", d.rmse), format!("{:.3e}", d.max_abs)));
-        outln!("{:<16} {:>10.1} {:>9.2} {:>12} {:>12}", row.label, row.median_ms, row.relative_time, rmse, max)?;
-    }
-    outln!("+effect: an effect the plan omits, forced on (its difference must be 0: specialising only saves time)")?;
-    outln!("-effect: an effect the plan simulates, forced off (what it costs, and what the image loses without it)")?;
+    printed = printed.and_then(|()| {
+        outln!(
+            "{name}: {}x{} at {} spp, {} threads, median of {}",
+            settings.width,
+            settings.height,
+            settings.samples_per_pixel,
+            pool.current_num_threads(),
+            args.repeats
+        )?;
+        outln!("{:<16} {:>10} {:>9} {:>12} {:>12}", "render", "ms", "x plan", "rmse", "max diff")?;
+        for row in &rows {
+            let (rmse, max) = row
+                .difference
+                .map_or(("-".into(), "-".into()), |d| (format!("{:.3e}", d.rmse), format!("{:.3e}", d.max_abs)));
+            outln!("{:<16} {:>10.1} {:>9.2} {:>12} {:>12}", row.label, row.median_ms, row.relative_time, rmse, max)?;
+        }
+        outln!(
+            "+effect: an effect the plan omits, forced on (its difference must be 0: specialising only saves time)"
+        )?;
+        outln!("-effect: an effect the plan simulates, forced off (what it costs, and what the image loses without it)")
+    });
 
     if let Some(json) = &args.json {
         let report = Report {
@@ -115,5 +122,5 @@ pub(crate) fn run(args: &BenchEffectsArgs) -> Result<()> {
         };
         crate::common::write_atomically(json, serde_json::to_string_pretty(&report)?.as_bytes())?;
     }
-    Ok(())
+    printed
 }

@@ -97,6 +97,10 @@ pub(crate) fn run(args: &ExperimentArgs) -> Result<()> {
         }
     }
     let mut written: Vec<(PathBuf, Report)> = Vec::new();
+    // Every experiment asked for runs and writes its files even when the
+    // reader of standard output has gone (`| head`): the first failed write
+    // is kept and returned at the end, and nothing more is printed after it.
+    let mut printed = Ok(());
     for (knob, scene, name, folder) in runs {
         let mut subject = pool.install(|| prepare(args, scene.as_deref()))?;
         if let Some(name) = name {
@@ -105,12 +109,16 @@ pub(crate) fn run(args: &ExperimentArgs) -> Result<()> {
         let on = if knob.uses_scene() { format!(" on {}", subject.name) } else { String::new() };
         eprintln!("experiment {knob}{on}: {}", knob.question());
         let report = pool.install(|| rtgi_experiment::run(knob, &subject, &options, &|line| eprintln!("  {line}")))?;
-        for finding in &report.findings {
-            outln!("{knob}: {finding}")?;
-        }
-        for path in report.write(&folder)? {
-            outln!("wrote {}", path.display())?;
-        }
+        let paths = report.write(&folder)?;
+        printed = printed.and_then(|()| {
+            for finding in &report.findings {
+                outln!("{knob}: {finding}")?;
+            }
+            for path in &paths {
+                outln!("wrote {}", path.display())?;
+            }
+            Ok(())
+        });
         written.push((folder, report));
     }
     if args.knob == KnobChoice::All {
@@ -122,9 +130,9 @@ pub(crate) fn run(args: &ExperimentArgs) -> Result<()> {
             })
             .collect();
         let path = rtgi_experiment::write_index(&out_root, &entries, &options.command)?;
-        outln!("wrote {}", path.display())?;
+        printed = printed.and_then(|()| outln!("wrote {}", path.display()));
     }
-    Ok(())
+    printed
 }
 
 /// Loads the scene (the built-in Cornell box when `None`), applies the

@@ -111,7 +111,9 @@ pub(crate) fn run(args: &VerifyArgs) -> Result<()> {
         );
     }
     let report = Report { scene: scene_name, seed: args.seed, kinds: kinds.into_values().collect(), structures };
-    print_report(&report)?;
+    // A reader that stops early (`| head`) must change neither the JSON
+    // written nor the exit status that says whether verification failed.
+    let printed = print_report(&report);
     if let Some(json) = &args.json {
         write_atomically(json, serde_json::to_string_pretty(&report)?.as_bytes())?;
     }
@@ -122,7 +124,7 @@ pub(crate) fn run(args: &VerifyArgs) -> Result<()> {
     if failed {
         bail!("the structures do not all answer exactly as the linear scan, or rays leaked (see the table)");
     }
-    Ok(())
+    printed
 }
 
 /// The structures to check, each with its build parameters; the peers
