@@ -10,9 +10,24 @@
 //! command-line tools do; any other write error ("no space left on device")
 //! is reported like every other error.
 //!
-//! ```ignore
-//! use crate::output::outln;
+//! ```text
+//! use crate::output::{out, outln};
+//!
 //! outln!("triangles   {}", scene.triangles.len())?;
+//! out!("{plan}")?;
+//! ```
+//!
+//! A command that must go on after its reader has gone, because it still
+//! writes files or decides its exit status (`bench --json`, `verify`), keeps
+//! the first failed write and returns it last; `and_then` prints nothing
+//! more once one write has failed:
+//!
+//! ```text
+//! let mut printed = out!("{plan}");
+//! // ... work ...
+//! printed = printed.and_then(|()| outln!("rendered in {ms} ms"));
+//! write_atomically(json, &bytes)?;
+//! printed
 //! ```
 
 use std::fmt;
