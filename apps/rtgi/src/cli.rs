@@ -728,6 +728,29 @@ mod tests {
     }
 
     #[test]
+    fn numbers_outside_their_range_are_refused_with_the_range() {
+        assert_eq!(parse_exposure("-2.5"), Ok(-2.5));
+        assert_eq!(parse_fov(" 45 "), Ok(45.0));
+        assert_eq!(parse_positive("1e-3"), Ok(1e-3));
+        for (result, range) in [
+            (parse_exposure("nan"), "from -64 to 64"),
+            (parse_exposure("65"), "from -64 to 64"),
+            (parse_fov("0"), "greater than 0"),
+            (parse_fov("inf"), "less than 180"),
+            (parse_positive("-1"), "greater than 0"),
+            (parse_positive("0"), "greater than 0"),
+            (parse_positive("abc"), "greater than 0"),
+        ] {
+            assert!(result.as_ref().is_err_and(|e| e.contains(range)), "{result:?}");
+        }
+        assert_eq!(parse_colour("0,0.5,2"), Ok(Vec3::new(0.0, 0.5, 2.0)));
+        assert!(parse_colour("-0.1,0,0").is_err() && parse_colour("nan,0,0").is_err());
+        assert_eq!(parse_direction("0,-1,0"), Ok(Vec3::NEG_Y));
+        assert!(parse_direction("0,0,0").is_err() && parse_direction("0,inf,0").is_err());
+        assert!(parse_light("point:0,1,0:5:1,-1,1").is_err_and(|e| e.contains("at least 0")));
+    }
+
+    #[test]
     fn command_line_is_well_formed() {
         use clap::CommandFactory;
         Cli::command().debug_assert();
