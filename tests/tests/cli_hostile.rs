@@ -417,3 +417,34 @@ fn compare_refuses_images_of_absurd_size_before_allocating() {
         assert!(run.stderr.contains("huge.exr") && run.stderr.contains("50000x50000"), "{}", run.stderr);
     }
 }
+
+/// Hits written to a FIFO go down the FIFO, as they are produced; the
+/// FIFO stays a FIFO. (Writing through a temporary file renamed over the
+/// output would replace it with a plain file, and as root would do the
+/// same to `/dev/null`.)
+#[cfg(unix)]
+#[test]
+fn trace_writes_into_a_fifo_without_replacing_it() {
+    use std::os::unix::fs::FileTypeExt;
+    let dir = scratch_dir("hostile-fifo-out");
+    let fifo = dir.join("hits.fifo");
+    if !Command::new("mkfifo").arg(&fifo).status().is_ok_and(|status| status.success()) {
+        eprintln!("mkfifo failed: skipping");
+        return;
+    }
+    let rays = random_rays(3000);
+    let path = dir.join("rays.bin");
+    std::fs::write(&path, encode(&rays)).unwrap();
+    // The reader opens the FIFO before the command does, and reads to its end.
+    let (sender, receiver) = std::sync::mpsc::channel();
+    let reader_path = fifo.clone();
+    std::thread::spawn(move || {
+        let _ = sender.send(std::fs::read(&reader_path).map(|b| b.len()).map_err(|e| e.to_string()));
+    });
+    let run = rtgi(&["trace", BOX, "--rays", s(&path), "--out", s(&fifo)]);
+    assert!(run.success, "{run:?}");
+    assert!(std::fs::metadata(&fifo).unwrap().file_type().is_fifo(), "the FIFO was replaced");
+    // A reader still waiting means the command never opened the FIFO.
+    let read = receiver.recv_timeout(std::time::Duration::from_secs(10)).expect("nothing was written to the FIFO");
+    assert_eq!(read, Ok(rays.len() * 16));
+}

@@ -199,17 +199,28 @@ fn encode_hit(t: f32, triangle: u32, beta: f32, gamma: f32) -> [u8; HIT_BYTES] {
 /// beside it that replaces it only when complete ([`PartialFile::commit`]):
 /// a failure never leaves a partial file or destroys an earlier one. The
 /// temporary file is named as `common::write_atomically` names its own.
+///
+/// A path that exists and is neither a regular file nor a folder (a FIFO,
+/// `/dev/null`, `/dev/stdout`) is written directly: renaming a file over it
+/// would replace the device or the pipe with a plain file (and for root,
+/// `/dev/null` is in a writable folder).
 struct PartialFile {
     path: PathBuf,
-    temporary: PathBuf,
+    /// The temporary file, renamed to `path` on commit; `None` when
+    /// writing to `path` directly.
+    temporary: Option<PathBuf>,
     file: Option<BufWriter<File>>,
 }
 
 impl PartialFile {
     fn create(path: &Path) -> Result<Self> {
-        let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
-        let temporary = path.with_file_name(format!(".{name}.{}.partial", std::process::id()));
-        let file = File::create(&temporary).with_context(|| format!("{}: cannot write", path.display()))?;
+        let special = std::fs::metadata(path).is_ok_and(|m| !m.is_file() && !m.is_dir());
+        let temporary = (!special).then(|| {
+            let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
+            path.with_file_name(format!(".{name}.{}.partial", std::process::id()))
+        });
+        let file = File::create(temporary.as_deref().unwrap_or(path))
+            .with_context(|| format!("{}: cannot write", path.display()))?;
         Ok(PartialFile { path: path.to_owned(), temporary, file: Some(BufWriter::new(file)) })
     }
 
@@ -221,17 +232,20 @@ impl PartialFile {
     /// Puts the complete file in place of `path`.
     fn commit(mut self) -> Result<()> {
         let file = self.file.take().expect("committed once");
-        file.into_inner()
-            .map_err(|e| e.into_error())
-            .and_then(|f| f.sync_all())
-            .and_then(|()| std::fs::rename(&self.temporary, &self.path))
-            .with_context(|| format!("{}: cannot write", self.path.display()))
+        let file = file.into_inner().map_err(|e| e.into_error());
+        match &self.temporary {
+            Some(temporary) => file.and_then(|f| f.sync_all()).and_then(|()| std::fs::rename(temporary, &self.path)),
+            None => file.map(drop),
+        }
+        .with_context(|| format!("{}: cannot write", self.path.display()))
     }
 }
 
 impl Drop for PartialFile {
     /// Removes the temporary file unless it was committed (renamed away).
     fn drop(&mut self) {
-        let _ = std::fs::remove_file(&self.temporary);
+        if let Some(temporary) = &self.temporary {
+            let _ = std::fs::remove_file(temporary);
+        }
     }
 }
