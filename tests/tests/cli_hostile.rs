@@ -345,6 +345,9 @@ fn files_that_are_not_files_are_refused_cleanly() {
         (vec!["info", folder], folder),
         (vec!["info", "/dev/null"], "/dev/null"),
         (vec!["trace", BOX, "--rays", folder, "--out", s(&out)], folder),
+        // Refused before measuring, not after.
+        (vec!["experiment", "spp", "--quick", "--out", s(&empty)], "--out"),
+        (vec!["experiment", "spp", "--quick", "--out", folder, "--cache", "/dev/null"], "--cache /dev/null"),
     ];
     let cases = if made {
         // Refused at once, not read (which would wait for a writer forever).

@@ -8,7 +8,7 @@
 
 use std::path::{Path, PathBuf};
 
-use anyhow::Result;
+use anyhow::{Result, bail};
 use rtgi_experiment::{IndexEntry, Knob, Options, Report, Subject};
 use rtgi_render::{PixelSampler, RenderSettings};
 
@@ -54,6 +54,13 @@ pub(crate) fn run(args: &ExperimentArgs) -> Result<()> {
     };
     let report_mode = args.knob == KnobChoice::All && args.scene.is_none() && !args.quick;
     let out_root = args.out.clone().unwrap_or_else(|| PathBuf::from("experiments"));
+    // Folders that cannot be folders are refused now, not after the
+    // minutes or hours of measuring whose results would go there.
+    for (option, folder) in [("--out", Some(&out_root)), ("--cache", args.cache.as_ref())] {
+        if let Some(folder) = folder.filter(|f| f.exists() && !f.is_dir()) {
+            bail!("{option} {}: exists and is not a folder", folder.display());
+        }
+    }
     let pool = thread_pool(args.threads)?;
     let options = Options {
         repeats: args.repeats as usize,
