@@ -20,8 +20,9 @@ fn s(p: &Path) -> &str {
     p.to_str().expect("scratch paths are UTF-8")
 }
 
-/// Camera rays, random rays from inside the box, and rays that must miss
-/// without trouble (NaN, zero direction, empty range).
+/// Camera rays, random rays from inside the box, and a ray that must miss
+/// without trouble (an empty range). Rays with a NaN or a zero direction are
+/// refused by `rtgi trace` (`cli_hostile.rs`), so they are not here.
 fn test_rays(scene: &Scene) -> Vec<Ray> {
     let mut rays = primary_rays(&scene.cameras[0], 24, 24);
     let mut rng = Rng::new(5, 0);
@@ -30,8 +31,6 @@ fn test_rays(scene: &Scene) -> Vec<Ray> {
         let t_max = if rng.next_f32() < 0.5 { f32::INFINITY } else { rng.next_f32() * 300.0 };
         rays.push(Ray::with_range(origin, uniform_sphere(rng.next_f32(), rng.next_f32()), 0.0, t_max));
     }
-    rays.push(Ray::new(Vec3::new(f32::NAN, 1.0, 1.0), Vec3::Z));
-    rays.push(Ray::new(Vec3::splat(100.0), Vec3::ZERO));
     rays.push(Ray::with_range(Vec3::splat(100.0), Vec3::Y, 5.0, 1.0));
     rays
 }
@@ -96,11 +95,11 @@ fn trace_writes_the_hits_of_every_variant_identically() {
         }
     }
     // Camera rays into the box hit something (the corners of the view pass
-    // outside the open box); the invalid rays at the end miss.
+    // outside the open box); the ray with an empty range at the end misses.
     let hits = decode_hits(&std::fs::read(dir.join("sah-false.bin")).unwrap());
     let central = (4..20).flat_map(|y| (4..20).map(move |x| y * 24 + x));
     assert!(central.into_iter().all(|i| hits[i].1 != u32::MAX));
-    assert!(hits[hits.len() - 3..].iter().all(|h| h.1 == u32::MAX));
+    assert_eq!(hits[hits.len() - 1].1, u32::MAX);
 }
 
 #[test]

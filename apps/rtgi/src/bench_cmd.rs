@@ -13,6 +13,7 @@ use serde::Serialize;
 
 use crate::cli::BenchArgs;
 use crate::common::{LoadedScene, check_output_folder, choose_camera, load_scene, thread_pool};
+use crate::output::outln;
 
 /// Everything one run of `rtgi bench` measured.
 #[derive(Debug, Serialize)]
@@ -149,13 +150,14 @@ pub(crate) fn run(args: &BenchArgs) -> Result<()> {
         variants,
         accuracy,
     };
-    print_table(&report, args.linear_rays);
-    print_accuracy(&report.accuracy);
+    // The JSON asked for is written even when the reader of the table has
+    // gone (`| head`).
+    let printed = print_table(&report, args.linear_rays).and_then(|()| print_accuracy(&report.accuracy));
     if let Some(json) = &args.json {
         crate::common::write_atomically(json, serde_json::to_string_pretty(&report)?.as_bytes())?;
         eprintln!("wrote {}", json.display());
     }
-    Ok(())
+    printed
 }
 
 #[allow(clippy::too_many_arguments)]
@@ -260,12 +262,17 @@ fn count(accel: &dyn Accel, rays: &[Ray], pool: &rayon::ThreadPool) -> (Traversa
     })
 }
 
-fn print_table(report: &BenchReport, linear_rays: u32) {
-    println!(
+fn print_table(report: &BenchReport, linear_rays: u32) -> Result<()> {
+    outln!(
         "{} ({} triangles), {} threads; primary: {} rays, incoherent: {} rays; median of {}",
-        report.scene, report.triangles, report.threads, report.primary_rays, report.incoherent_rays, report.repeats
-    );
-    println!(
+        report.scene,
+        report.triangles,
+        report.threads,
+        report.primary_rays,
+        report.incoherent_rays,
+        report.repeats
+    )?;
+    outln!(
         "{:<15} {:>8} {:>8} {:>7} {:>8} {:>5} {:>8} | {:>15} {:>15} {:>13} {:>11} | {:>15} {:>13} {:>11}",
         "",
         "build ms",
@@ -281,8 +288,8 @@ fn print_table(report: &BenchReport, linear_rays: u32) {
         "incoh. Mrays/s",
         "nodes, tris",
         "x linear"
-    );
-    println!(
+    )?;
+    outln!(
         "{:<15} {:>8} {:>8} {:>7} {:>8} {:>5} {:>8} | {:>15} {:>15} {:>13} {:>11} | {:>15} {:>13} {:>11}",
         "variant",
         "1 thr",
@@ -298,7 +305,7 @@ fn print_table(report: &BenchReport, linear_rays: u32) {
         format!("1 / {} thr", report.threads),
         "per ray",
         "(all thr)"
-    );
+    )?;
     let speedup = |s: Option<f64>| s.map_or("-".to_owned(), |s| format!("{s:.0}x"));
     for v in &report.variants {
         let batch = |b: &BatchReport| {
@@ -319,7 +326,7 @@ fn print_table(report: &BenchReport, linear_rays: u32) {
             significant(v.primary.batch_mrays_all_threads)
         );
         let (i, inn, is) = batch(&v.incoherent);
-        println!(
+        outln!(
             "{:<15} {:>8.1} {:>8.1} {:>7.1} {:>8} {:>5} {:>8.2} | {:>15} {:>15} {:>13} {:>11} | {:>15} {:>13} {:>11}",
             v.variant,
             v.build_ms_1_thread,
@@ -335,21 +342,22 @@ fn print_table(report: &BenchReport, linear_rays: u32) {
             i,
             inn,
             is
-        );
+        )?;
     }
-    println!(
+    outln!(
         "batch: the batch API on chunks of 1024 consecutive rays (primary rays come in 4x4 pixel tiles); \
          the wide BVHs trace coherent rays as packets of 16, the others one ray at a time"
-    );
+    )?;
     if report.variants.iter().any(|v| v.variant == "linear") {
-        println!("linear: timed on an evenly spaced subset of at most {linear_rays} rays of each batch");
+        outln!("linear: timed on an evenly spaced subset of at most {linear_rays} rays of each batch")?;
     }
     if report.variants.iter().any(|v| v.peer) {
-        println!(
+        outln!(
             "embree: Intel Embree 3, a peer (its own BVH, build quality medium; not held to the exactness contract); \
              it reports no nodes or triangle tests, and its SAH cost, nodes and depth are not ours to measure"
-        );
+        )?;
     }
+    Ok(())
 }
 
 /// A positive number with three significant digits (at least two decimals),
@@ -403,20 +411,27 @@ fn measure_accuracy(
     reports
 }
 
-fn print_accuracy(reports: &[AccuracyReport]) {
-    let Some(first) = reports.first() else { return };
-    println!();
-    println!(
+fn print_accuracy(reports: &[AccuracyReport]) -> Result<()> {
+    let Some(first) = reports.first() else { return Ok(()) };
+    outln!()?;
+    outln!(
         "What accuracy costs ({}): throughput on all threads beside failures on {} rays exactly through shared edges and {} rays from inside a closed mesh",
-        first.variant, first.shared_edge_rays, first.closed_mesh_rays
-    );
-    println!(
+        first.variant,
+        first.shared_edge_rays,
+        first.closed_mesh_rays
+    )?;
+    outln!(
         "{:<16} {:<10} {:>15} {:>15} {:>20} {:>20}",
-        "intersector", "traversal", "primary Mrays/s", "incoh. Mrays/s", "shared-edge misses", "closed-mesh escapes"
-    );
+        "intersector",
+        "traversal",
+        "primary Mrays/s",
+        "incoh. Mrays/s",
+        "shared-edge misses",
+        "closed-mesh escapes"
+    )?;
     let rate = |n: usize, of: usize| format!("{n} ({:.4}%)", 100.0 * n as f64 / of.max(1) as f64);
     for r in reports {
-        println!(
+        outln!(
             "{:<16} {:<10} {:>15.2} {:>15.2} {:>20} {:>20}",
             r.intersector,
             r.traversal,
@@ -424,6 +439,7 @@ fn print_accuracy(reports: &[AccuracyReport]) {
             r.incoherent_mrays_all_threads,
             rate(r.shared_edge_misses, r.shared_edge_rays),
             rate(r.closed_mesh_escapes, r.closed_mesh_rays)
-        );
+        )?;
     }
+    Ok(())
 }

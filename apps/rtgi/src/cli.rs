@@ -242,11 +242,11 @@ pub(crate) struct LightingArgs {
 
     /// Clamp the light each path brings in after two or more bounces to this value: fewer
     /// fireflies (caustics), at the price of a bias [default: no clamp]
-    #[arg(long, value_parser = parse_positive)]
+    #[arg(long, value_parser = parse_positive, allow_negative_numbers = true)]
     pub(crate) clamp_indirect: Option<f32>,
 
     /// Light from far away: a radiance R,G,B or an equirectangular .exr image
-    #[arg(long, value_parser = parse_environment)]
+    #[arg(long, value_parser = parse_environment, allow_hyphen_values = true)]
     pub(crate) environment: Option<EnvironmentArg>,
 
     /// Add a light (repeatable): point:X,Y,Z:INTENSITY[:R,G,B],
@@ -267,11 +267,41 @@ pub(crate) enum EnvironmentArg {
     File(PathBuf),
 }
 
-fn parse_positive(text: &str) -> Result<f32, String> {
-    text.parse::<f32>()
+/// Parses a finite number that `accept` allows; the error names the
+/// allowed values, `allowed`, so that the user knows what to type instead.
+fn parse_number(text: &str, accept: impl Fn(f32) -> bool, allowed: &str) -> Result<f32, String> {
+    text.trim()
+        .parse::<f32>()
         .ok()
-        .filter(|v| v.is_finite() && *v > 0.0)
-        .ok_or_else(|| format!("expected a positive number (got '{text}')"))
+        .filter(|v| v.is_finite() && accept(*v))
+        .ok_or_else(|| format!("expected {allowed} (got '{text}')"))
+}
+
+fn parse_positive(text: &str) -> Result<f32, String> {
+    parse_number(text, |v| v > 0.0, "a finite number greater than 0")
+}
+
+/// Exposure in stops: 2^±64 already turns any radiance black or white.
+fn parse_exposure(text: &str) -> Result<f32, String> {
+    parse_number(text, |v| (-64.0..=64.0).contains(&v), "a number of stops from -64 to 64")
+}
+
+fn parse_fov(text: &str) -> Result<f32, String> {
+    parse_number(text, |v| v > 0.0 && v < 180.0, "an angle in degrees greater than 0 and less than 180")
+}
+
+/// Parses "r,g,b" into a colour: three finite numbers, none negative.
+pub(crate) fn parse_colour(text: &str) -> Result<Vec3, String> {
+    parse_vec3(text).ok().filter(|c| c.min_element() >= 0.0).ok_or_else(|| {
+        format!("expected three finite numbers of at least 0 separated by commas, like 0.05,0.05,0.06 (got '{text}')")
+    })
+}
+
+/// Parses "x,y,z" into a direction: three finite numbers, not all zero.
+pub(crate) fn parse_direction(text: &str) -> Result<Vec3, String> {
+    parse_vec3(text).ok().filter(|d| *d != Vec3::ZERO).ok_or_else(|| {
+        format!("expected three finite numbers, not all 0, separated by commas, like 0,1,0 (got '{text}')")
+    })
 }
 
 fn parse_environment(text: &str) -> Result<EnvironmentArg, String> {
@@ -302,7 +332,7 @@ pub(crate) fn parse_light(text: &str) -> Result<Light, String> {
     let colour = |rest: &[&str]| -> Result<Vec3, String> {
         match rest {
             [] => Ok(Vec3::ONE),
-            [c] => vector(c),
+            [c] => parse_colour(c).map_err(|e| format!("light '{text}': the colour: {e}")),
             _ => Err(format!("light '{text}': too many fields")),
         }
     };
@@ -381,7 +411,7 @@ pub(crate) struct HeatmapArgs {
     pub(crate) size: ImageSize,
 
     /// Count that maps to the top of the colour scale [default: the image's maximum]
-    #[arg(long)]
+    #[arg(long, value_parser = parse_positive, allow_negative_numbers = true)]
     pub(crate) scale: Option<f32>,
 
     /// Count triangle tests instead of nodes visited
@@ -475,7 +505,10 @@ fn parse_accel_list(text: &str) -> Result<AccelList, String> {
 /// miss), triangle (u32; 0xFFFFFFFF for a miss), beta (f32), gamma (f32).
 /// With --any-hit, triangle is 0 when the ray is occluded and 0xFFFFFFFF when
 /// not, and t, beta and gamma are 0. Triangles are numbered in file order
-/// (an OBJ polygon becomes a fan of triangles, in order).
+/// (an OBJ polygon becomes a fan of triangles, in order). The rays are read,
+/// traced and written in chunks, so a file of any size (or a stream) fits
+/// in memory; a ray with a NaN or infinite origin or direction, a zero
+/// direction or a NaN bound is refused, naming its index.
 #[derive(Debug, Args)]
 pub(crate) struct TraceArgs {
     /// Scene file (.obj, .gltf, .glb or .toml)
@@ -545,7 +578,7 @@ pub(crate) struct RenderArgs {
     pub(crate) camera: CameraArgs,
 
     /// Exposure in stops, for PNG output
-    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
+    #[arg(long, default_value_t = 0.0, value_parser = parse_exposure, allow_negative_numbers = true)]
     pub(crate) exposure: f32,
 
     /// Tone map for PNG output: clamp, reinhard, aces
@@ -553,7 +586,7 @@ pub(crate) struct RenderArgs {
     pub(crate) tonemap: ToneOperator,
 
     /// Radiance of camera rays that hit nothing and see no environment, as R,G,B
-    #[arg(long, value_parser = parse_vec3, default_value = "0.05,0.05,0.06")]
+    #[arg(long, value_parser = parse_colour, default_value = "0.05,0.05,0.06", allow_hyphen_values = true)]
     pub(crate) background: Vec3,
 
     #[command(flatten)]
@@ -600,7 +633,7 @@ pub(crate) struct BuildArgs {
     pub(crate) sah_bins: u32,
 
     /// Cost of a BVH traversal step relative to a ray/triangle test, for the SAH [default: 1; 4 for the wide BVHs]
-    #[arg(long)]
+    #[arg(long, value_parser = parse_positive, allow_negative_numbers = true)]
     pub(crate) traversal_cost: Option<f32>,
 
     /// Ray/triangle test: watertight, moller-trumbore, watertight-f64 (the watertight test in double precision)
@@ -651,11 +684,11 @@ pub(crate) struct CameraArgs {
     pub(crate) look: Option<Vec3>,
 
     /// World up direction, as X,Y,Z
-    #[arg(long, value_parser = parse_vec3, allow_hyphen_values = true)]
+    #[arg(long, value_parser = parse_direction, allow_hyphen_values = true)]
     pub(crate) up: Option<Vec3>,
 
-    /// Vertical field of view in degrees
-    #[arg(long)]
+    /// Vertical field of view in degrees, greater than 0 and less than 180
+    #[arg(long, value_parser = parse_fov, allow_negative_numbers = true)]
     pub(crate) fov: Option<f32>,
 }
 
@@ -699,6 +732,29 @@ mod tests {
         for bad in ["1,2", "1,2,3,4", "a,b,c", "1,2,nan", "1,inf,2", ""] {
             assert!(parse_vec3(bad).is_err(), "{bad}");
         }
+    }
+
+    #[test]
+    fn numbers_outside_their_range_are_refused_with_the_range() {
+        assert_eq!(parse_exposure("-2.5"), Ok(-2.5));
+        assert_eq!(parse_fov(" 45 "), Ok(45.0));
+        assert_eq!(parse_positive("1e-3"), Ok(1e-3));
+        for (result, range) in [
+            (parse_exposure("nan"), "from -64 to 64"),
+            (parse_exposure("65"), "from -64 to 64"),
+            (parse_fov("0"), "greater than 0"),
+            (parse_fov("inf"), "less than 180"),
+            (parse_positive("-1"), "greater than 0"),
+            (parse_positive("0"), "greater than 0"),
+            (parse_positive("abc"), "greater than 0"),
+        ] {
+            assert!(result.as_ref().is_err_and(|e| e.contains(range)), "{result:?}");
+        }
+        assert_eq!(parse_colour("0,0.5,2"), Ok(Vec3::new(0.0, 0.5, 2.0)));
+        assert!(parse_colour("-0.1,0,0").is_err() && parse_colour("nan,0,0").is_err());
+        assert_eq!(parse_direction("0,-1,0"), Ok(Vec3::NEG_Y));
+        assert!(parse_direction("0,0,0").is_err() && parse_direction("0,inf,0").is_err());
+        assert!(parse_light("point:0,1,0:5:1,-1,1").is_err_and(|e| e.contains("at least 0")));
     }
 
     #[test]

@@ -9,6 +9,7 @@ use rtgi_render::render_traversal_cost;
 
 use crate::cli::{BvhBoxesArgs, HeatmapArgs};
 use crate::common::{LoadedScene, check_output_folder, choose_camera, load_scene, thread_pool, write_atomically};
+use crate::output::outln;
 
 /// Writes the boxes of the chosen levels as OBJ: eight corners and six
 /// quads a box, one group per level, so that viewers can show or hide
@@ -59,7 +60,7 @@ pub(crate) fn boxes(args: &BvhBoxesArgs) -> Result<()> {
         }
     }
     write_atomically(&args.output, obj.as_bytes())?;
-    println!("wrote {} boxes of levels {:?} to {}", boxes.len(), args.levels, args.output.display());
+    outln!("wrote {} boxes of levels {:?} to {}", boxes.len(), args.levels, args.output.display())?;
     Ok(())
 }
 
@@ -95,14 +96,14 @@ pub(crate) fn heatmap(args: &HeatmapArgs) -> Result<()> {
     image.write(&args.output, &ToneMap::default())?;
     let rays = total.rays.max(1) as f64;
     let what = if args.triangles { "triangle tests" } else { "nodes visited" };
-    println!("scene       {name}");
-    println!("accel       {}", accel.build_stats().variant);
-    println!(
+    outln!("scene       {name}")?;
+    outln!("accel       {}", accel.build_stats().variant)?;
+    outln!(
         "per ray     {:.1} nodes visited, {:.1} triangle tests (mean); max {maximum} {what}",
         total.nodes_visited as f64 / rays,
         total.triangles_tested as f64 / rays
-    );
-    println!("colour      0 (dark) to {scale} {what} (pale yellow)");
-    println!("wrote       {}", args.output.display());
+    )?;
+    outln!("colour      0 (dark) to {scale} {what} (pale yellow)")?;
+    outln!("wrote       {}", args.output.display())?;
     Ok(())
 }

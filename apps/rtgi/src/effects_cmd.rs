@@ -16,6 +16,7 @@ use serde::Serialize;
 
 use crate::cli::BenchEffectsArgs;
 use crate::common::{LoadedScene, apply_lighting, check_output_folder, choose_camera, load_scene, thread_pool};
+use crate::output::{out, outln};
 
 #[derive(Debug, Serialize)]
 struct Row {
@@ -54,7 +55,10 @@ pub(crate) fn run(args: &BenchEffectsArgs) -> Result<()> {
     };
     apply_lighting(&args.lighting, &mut scene, &mut settings)?;
     let plan = EffectPlan::new(&scene, &settings);
-    print!("{plan}");
+    // The measurements and the JSON asked for go on when the reader of
+    // standard output has gone (`| head`): the first failed write is kept
+    // and returned at the end, and nothing more is printed after it.
+    let mut printed = out!("{plan}");
 
     let pool = thread_pool(args.threads)?;
     let accel = pool.install(|| args.accel.build(&scene))?;
@@ -83,23 +87,27 @@ pub(crate) fn run(args: &BenchEffectsArgs) -> Result<()> {
         rows.push(Row { label, median_ms: ms, relative_time: ms / planned_ms, difference: compare(&image, &planned) });
     }
 
-    println!(
-        "{name}: {}x{} at {} spp, {} threads, median of {}",
-        settings.width,
-        settings.height,
-        settings.samples_per_pixel,
-        pool.current_num_threads(),
-        args.repeats
-    );
-    println!("{:<16} {:>10} {:>9} {:>12} {:>12}", "render", "ms", "x plan", "rmse", "max diff");
-    for row in &rows {
-        let (rmse, max) = row
-            .difference
-            .map_or(("-".into(), "-".into()), |d| (format!("{:.3e}", d.rmse), format!("{:.3e}", d.max_abs)));
-        println!("{:<16} {:>10.1} {:>9.2} {:>12} {:>12}", row.label, row.median_ms, row.relative_time, rmse, max);
-    }
-    println!("+effect: an effect the plan omits, forced on (its difference must be 0: specialising only saves time)");
-    println!("-effect: an effect the plan simulates, forced off (what it costs, and what the image loses without it)");
+    printed = printed.and_then(|()| {
+        outln!(
+            "{name}: {}x{} at {} spp, {} threads, median of {}",
+            settings.width,
+            settings.height,
+            settings.samples_per_pixel,
+            pool.current_num_threads(),
+            args.repeats
+        )?;
+        outln!("{:<16} {:>10} {:>9} {:>12} {:>12}", "render", "ms", "x plan", "rmse", "max diff")?;
+        for row in &rows {
+            let (rmse, max) = row
+                .difference
+                .map_or(("-".into(), "-".into()), |d| (format!("{:.3e}", d.rmse), format!("{:.3e}", d.max_abs)));
+            outln!("{:<16} {:>10.1} {:>9.2} {:>12} {:>12}", row.label, row.median_ms, row.relative_time, rmse, max)?;
+        }
+        outln!(
+            "+effect: an effect the plan omits, forced on (its difference must be 0: specialising only saves time)"
+        )?;
+        outln!("-effect: an effect the plan simulates, forced off (what it costs, and what the image loses without it)")
+    });
 
     if let Some(json) = &args.json {
         let report = Report {
@@ -114,5 +122,5 @@ pub(crate) fn run(args: &BenchEffectsArgs) -> Result<()> {
         };
         crate::common::write_atomically(json, serde_json::to_string_pretty(&report)?.as_bytes())?;
     }
-    Ok(())
+    printed
 }

@@ -8,12 +8,13 @@
 
 use std::path::{Path, PathBuf};
 
-use anyhow::Result;
+use anyhow::{Result, bail};
 use rtgi_experiment::{IndexEntry, Knob, Options, Report, Subject};
 use rtgi_render::{PixelSampler, RenderSettings};
 
 use crate::cli::{ExperimentArgs, KnobChoice};
 use crate::common::{LoadedScene, apply_lighting, choose_camera, load_scene, thread_pool};
+use crate::output::outln;
 
 /// The shared scenes of the report, relative to the scenes folder.
 const CORNELL: &str = "cornell-box/CornellBox-Original.obj";
@@ -53,6 +54,13 @@ pub(crate) fn run(args: &ExperimentArgs) -> Result<()> {
     };
     let report_mode = args.knob == KnobChoice::All && args.scene.is_none() && !args.quick;
     let out_root = args.out.clone().unwrap_or_else(|| PathBuf::from("experiments"));
+    // Folders that cannot be folders are refused now, not after the
+    // minutes or hours of measuring whose results would go there.
+    for (option, folder) in [("--out", Some(&out_root)), ("--cache", args.cache.as_ref())] {
+        if let Some(folder) = folder.filter(|f| f.exists() && !f.is_dir()) {
+            bail!("{option} {}: exists and is not a folder", folder.display());
+        }
+    }
     let pool = thread_pool(args.threads)?;
     let options = Options {
         repeats: args.repeats as usize,
@@ -96,6 +104,10 @@ pub(crate) fn run(args: &ExperimentArgs) -> Result<()> {
         }
     }
     let mut written: Vec<(PathBuf, Report)> = Vec::new();
+    // Every experiment asked for runs and writes its files even when the
+    // reader of standard output has gone (`| head`): the first failed write
+    // is kept and returned at the end, and nothing more is printed after it.
+    let mut printed = Ok(());
     for (knob, scene, name, folder) in runs {
         let mut subject = pool.install(|| prepare(args, scene.as_deref()))?;
         if let Some(name) = name {
@@ -104,12 +116,16 @@ pub(crate) fn run(args: &ExperimentArgs) -> Result<()> {
         let on = if knob.uses_scene() { format!(" on {}", subject.name) } else { String::new() };
         eprintln!("experiment {knob}{on}: {}", knob.question());
         let report = pool.install(|| rtgi_experiment::run(knob, &subject, &options, &|line| eprintln!("  {line}")))?;
-        for finding in &report.findings {
-            println!("{knob}: {finding}");
-        }
-        for path in report.write(&folder)? {
-            println!("wrote {}", path.display());
-        }
+        let paths = report.write(&folder)?;
+        printed = printed.and_then(|()| {
+            for finding in &report.findings {
+                outln!("{knob}: {finding}")?;
+            }
+            for path in &paths {
+                outln!("wrote {}", path.display())?;
+            }
+            Ok(())
+        });
         written.push((folder, report));
     }
     if args.knob == KnobChoice::All {
@@ -121,9 +137,9 @@ pub(crate) fn run(args: &ExperimentArgs) -> Result<()> {
             })
             .collect();
         let path = rtgi_experiment::write_index(&out_root, &entries, &options.command)?;
-        println!("wrote {}", path.display());
+        printed = printed.and_then(|()| outln!("wrote {}", path.display()));
     }
-    Ok(())
+    printed
 }
 
 /// Loads the scene (the built-in Cornell box when `None`), applies the

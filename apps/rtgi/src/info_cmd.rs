@@ -1,6 +1,8 @@
 //! `rtgi info`: what a scene contains, as text or JSON.
 
-use anyhow::{Result, bail};
+use std::path::Path;
+
+use anyhow::{Context, Result, bail};
 use rtgi_image::HdrImage;
 use rtgi_render::{EffectPlan, RenderSettings};
 use rtgi_scene::{AlphaMode, LightKind, SUPPORTED_GLTF_EXTENSIONS};
@@ -8,6 +10,7 @@ use serde::Serialize;
 
 use crate::cli::{CompareArgs, InfoArgs};
 use crate::common::{LoadedScene, apply_lighting, load_scene};
+use crate::output::{out, outln};
 
 #[derive(Debug, Serialize)]
 struct Info {
@@ -147,24 +150,24 @@ pub(crate) fn run(args: &InfoArgs) -> Result<()> {
         plan,
     };
     if args.json {
-        println!("{}", serde_json::to_string_pretty(&info)?);
+        outln!("{}", serde_json::to_string_pretty(&info)?)?;
     } else {
-        print_text(&info);
+        print_text(&info)?;
     }
     Ok(())
 }
 
-fn print_text(info: &Info) {
+fn print_text(info: &Info) -> Result<()> {
     let v = |a: [f32; 3]| format!("({}, {}, {})", a[0], a[1], a[2]);
-    println!("scene       {}", info.scene);
-    println!("triangles   {}", info.triangles);
-    println!("vertices    {}", info.vertices);
+    outln!("scene       {}", info.scene)?;
+    outln!("triangles   {}", info.triangles)?;
+    outln!("vertices    {}", info.vertices)?;
     if let Some([min, max]) = info.bounds {
-        println!("bounds      {} to {}", v(min), v(max));
+        outln!("bounds      {} to {}", v(min), v(max))?;
     }
-    println!("materials   {}", info.materials.len());
+    outln!("materials   {}", info.materials.len())?;
     for m in &info.materials {
-        println!(
+        outln!(
             "  {:<24} {:>8} triangles, base colour {}{}, metallic {}, roughness {:.3}, emission {}, {}",
             m.name,
             m.triangles,
@@ -174,39 +177,39 @@ fn print_text(info: &Info) {
             m.roughness,
             v(m.emission),
             m.alpha
-        );
+        )?;
     }
-    println!("textures    {}", info.textures.len());
+    outln!("textures    {}", info.textures.len())?;
     for t in &info.textures {
-        println!("  {} ({}x{})", t.name, t.width, t.height);
+        outln!("  {} ({}x{})", t.name, t.width, t.height)?;
     }
-    println!("lights      {}", info.lights.len());
+    outln!("lights      {}", info.lights.len())?;
     for l in &info.lights {
-        println!("  {:<24} {} at {}, colour {}, intensity {}", l.name, l.kind, v(l.position), v(l.color), l.intensity);
+        outln!("  {:<24} {} at {}, colour {}, intensity {}", l.name, l.kind, v(l.position), v(l.color), l.intensity)?;
     }
-    println!("cameras     {}", info.cameras.len());
+    outln!("cameras     {}", info.cameras.len())?;
     for c in &info.cameras {
-        println!(
+        outln!(
             "  at {} looking {}, up {}, vertical field of view {:.2}°",
             v(c.position),
             v(c.direction),
             v(c.up),
             c.vertical_fov_degrees
-        );
+        )?;
     }
     if !info.extensions_used.is_empty() {
-        println!("extensions  {}", info.extensions_used.join(", "));
+        outln!("extensions  {}", info.extensions_used.join(", "))?;
     }
     for e in &info.extensions_unsupported {
-        println!("warning: extension {e} is not supported and is ignored");
+        outln!("warning: extension {e} is not supported and is ignored")?;
     }
-    print!("{}", info.plan);
+    out!("{}", info.plan)
 }
 
 /// `rtgi compare`: prints the error of one EXR image against another.
 pub(crate) fn compare(args: &CompareArgs) -> Result<()> {
-    let image = HdrImage::read_exr(&args.image)?;
-    let reference = HdrImage::read_exr(&args.reference)?;
+    let image = read_exr(&args.image)?;
+    let reference = read_exr(&args.reference)?;
     let Some(d) = rtgi_image::compare(&image, &reference) else {
         bail!(
             "{}: {}x{} pixels, but the reference {} has {}x{}",
@@ -219,12 +222,23 @@ pub(crate) fn compare(args: &CompareArgs) -> Result<()> {
         );
     };
     if args.json {
-        println!("{}", serde_json::to_string_pretty(&d)?);
+        outln!("{}", serde_json::to_string_pretty(&d)?)?;
     } else {
-        println!("rmse          {:.6}", d.rmse);
-        println!("relative mse  {:.6}", d.relative_mse);
-        println!("max abs       {:.6} at pixel ({}, {})", d.max_abs, d.max_at.0, d.max_at.1);
-        println!("mean          {:.6} (reference {:.6})", d.mean, d.reference_mean);
+        outln!("rmse          {:.6}", d.rmse)?;
+        outln!("relative mse  {:.6}", d.relative_mse)?;
+        outln!("max abs       {:.6} at pixel ({}, {})", d.max_abs, d.max_at.0, d.max_at.1)?;
+        outln!("mean          {:.6} (reference {:.6})", d.mean, d.reference_mean)?;
     }
     Ok(())
+}
+
+/// Reads an EXR image from a regular file. Anything else is refused first:
+/// a FIFO would block until some other program writes to it, and a
+/// directory or a device is no image.
+fn read_exr(path: &Path) -> Result<HdrImage> {
+    let metadata = std::fs::metadata(path).with_context(|| format!("{}: cannot read", path.display()))?;
+    if !metadata.is_file() {
+        bail!("{}: cannot read: not a file", path.display());
+    }
+    Ok(HdrImage::read_exr(path)?)
 }

@@ -13,6 +13,7 @@ mod experiment_cmd;
 mod info_cmd;
 mod interrupt;
 mod merge_cmd;
+mod output;
 mod progress;
 mod render_cmd;
 mod render_job;
@@ -42,8 +43,13 @@ pub fn main() -> ExitCode {
         cli::Command::Experiment(args) => experiment_cmd::run(&args),
         cli::Command::Merge(args) => merge_cmd::run(&args),
     };
+    // Whatever the command printed last may still sit in the buffer.
+    let result = result.and_then(|()| output::flush());
     match result {
         Ok(()) => ExitCode::SUCCESS,
+        // The reader of standard output has gone (`rtgi info | head -1`):
+        // it has all it wanted, so this is not a failure to report.
+        Err(e) if output::is_closed(&e) => ExitCode::SUCCESS,
         Err(e) => {
             if let Some(render_job::StoppedBySignal(signal)) = e.downcast_ref() {
                 eprintln!("rtgi: {e}");

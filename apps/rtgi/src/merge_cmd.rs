@@ -7,6 +7,7 @@ use clap::Args;
 use rtgi_image::{ToneMap, ToneOperator};
 use rtgi_render::Accumulation;
 
+use crate::output::outln;
 use crate::render_cmd::{check_output, is_accumulation};
 
 /// `rtgi merge`: accumulations (.accum) of one render into its image.
@@ -65,15 +66,18 @@ pub(crate) fn run(args: &MergeArgs) -> Result<()> {
         let tone_map = ToneMap { exposure: args.exposure, operator: args.tonemap };
         merged.image().write(&args.output, &tone_map).context("cannot write the merged image")?;
     }
-    println!("parts       {}", args.parts.len());
-    println!(
+    outln!("parts       {}", args.parts.len())?;
+    outln!(
         "render      {}x{}, {} spp in all, seed {}",
-        identity.width, identity.height, identity.samples_per_pixel, identity.seed
-    );
-    println!("merged      rows {:?}, samples {:?} of every pixel", merged.rows(), merged.samples());
+        identity.width,
+        identity.height,
+        identity.samples_per_pixel,
+        identity.seed
+    )?;
+    outln!("merged      rows {:?}, samples {:?} of every pixel", merged.rows(), merged.samples())?;
     if !complete {
-        println!("incomplete  {} of {} samples per pixel", merged.samples_done(), identity.samples_per_pixel);
+        outln!("incomplete  {} of {} samples per pixel", merged.samples_done(), identity.samples_per_pixel)?;
     }
-    println!("wrote       {}", args.output.display());
+    outln!("wrote       {}", args.output.display())?;
     Ok(())
 }

@@ -11,6 +11,7 @@ use crate::common::{
     LoadedScene, apply_lighting, check_output_folder, choose_camera, load_scene, same_file, thread_pool,
 };
 use crate::interrupt;
+use crate::output::{out, outln};
 use crate::progress::Progress;
 use crate::render_job::{Ending, Renderer, StoppedBySignal, run_passes};
 
@@ -82,7 +83,15 @@ pub(crate) fn run(args: &RenderArgs) -> Result<()> {
     };
     apply_lighting(&args.lighting, &mut scene, &mut settings)?;
     let (rows, samples) = job.share(settings.height, spp)?;
-    print!("{}", EffectPlan::new(&scene, &settings));
+    // What is printed goes on standard output; a reader that goes away
+    // (`| head`) does not stop the render, and the first failed write is
+    // returned once the outputs are written.
+    let mut printed = out!("{}", EffectPlan::new(&scene, &settings));
+    macro_rules! say {
+        ($($arg:tt)*) => {
+            printed = printed.and_then(|()| outln!($($arg)*))
+        };
+    }
 
     let pool = thread_pool(args.threads)?;
 
@@ -116,12 +125,7 @@ pub(crate) fn run(args: &RenderArgs) -> Result<()> {
                     resumed.samples()
                 );
             }
-            println!(
-                "resuming   {} at {} of {} samples per pixel",
-                resume.display(),
-                resumed.samples().end,
-                samples.end
-            );
+            say!("resuming   {} at {} of {} samples per pixel", resume.display(), resumed.samples().end, samples.end);
             resumed
         }
     };
@@ -141,12 +145,7 @@ pub(crate) fn run(args: &RenderArgs) -> Result<()> {
         && (ending != Ending::Complete || job.checkpoint.is_some())
     {
         accumulation.write(path)?;
-        println!(
-            "checkpoint  {} ({} of {} samples per pixel)",
-            path.display(),
-            accumulation.samples().end,
-            samples.end
-        );
+        say!("checkpoint  {} ({} of {} samples per pixel)", path.display(), accumulation.samples().end, samples.end);
     }
     let tone_map = ToneMap { exposure: args.exposure, operator: args.tonemap };
     let wrote_output = if is_accumulation(&args.output) {
@@ -167,11 +166,11 @@ pub(crate) fn run(args: &RenderArgs) -> Result<()> {
     }
 
     let build = accel.build_stats();
-    println!("scene       {scene_name}");
-    println!("triangles   {}", scene.triangles.len());
-    println!("load        {load_ms:.1} ms");
-    println!("build       {:.1} ms ({})", build.build_ms, build.variant);
-    println!(
+    say!("scene       {scene_name}");
+    say!("triangles   {}", scene.triangles.len());
+    say!("load        {load_ms:.1} ms");
+    say!("build       {:.1} ms ({})", build.build_ms, build.variant);
+    say!(
         "render      {:.1} ms, {}x{} at {} spp, {} threads, {} pass(es)",
         totals.render_seconds * 1e3,
         settings.width,
@@ -181,35 +180,35 @@ pub(crate) fn run(args: &RenderArgs) -> Result<()> {
         totals.passes
     );
     if job.is_part() {
-        println!("part        rows {rows:?}, samples {samples:?} of every pixel");
+        say!("part        rows {rows:?}, samples {samples:?} of every pixel");
     }
     let rays_per_second = totals.rays as f64 / totals.render_seconds.max(1e-9);
-    println!("rays        {} ({:.3} Mrays/s)", totals.rays, rays_per_second * 1e-6);
+    say!("rays        {} ({:.3} Mrays/s)", totals.rays, rays_per_second * 1e-6);
     let stopped_by = match ending {
         Ending::Complete => None,
         Ending::TimeLimit => Some(format!("the time limit ({} s)", job.time_limit.unwrap_or_default())),
         Ending::Signal(signal) => Some(interrupt::name(signal).to_owned()),
     };
     if let Some(reason) = &stopped_by {
-        println!("stopped     by {reason} with {} of {} samples per pixel", accumulation.samples().end, samples.end);
+        say!("stopped     by {reason} with {} of {} samples per pixel", accumulation.samples().end, samples.end);
     }
     if wrote_output {
         let partial = if done < samples.len() as u32 { format!(" ({done} samples per pixel)") } else { String::new() };
-        println!("wrote       {}{partial}", args.output.display());
+        say!("wrote       {}{partial}", args.output.display());
     } else {
-        println!("wrote       nothing: no sample finished");
+        say!("wrote       nothing: no sample finished");
     }
     if ending == Ending::Complete {
         for (_, path) in &aov_outputs {
-            println!("wrote       {}", path.display());
+            say!("wrote       {}", path.display());
         }
     } else if !aov_outputs.is_empty() {
-        println!("skipped     the AOVs (they are written when the render completes)");
+        say!("skipped     the AOVs (they are written when the render completes)");
     }
     match ending {
         Ending::Signal(signal) => Err(StoppedBySignal(signal).into()),
         Ending::TimeLimit if !wrote_output => bail!("no sample finished within the time limit"),
-        _ => Ok(()),
+        _ => printed,
     }
 }
 

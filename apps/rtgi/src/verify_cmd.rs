@@ -11,6 +11,7 @@ use serde::Serialize;
 
 use crate::cli::VerifyArgs;
 use crate::common::{check_output_folder, load_scene, thread_pool, write_atomically};
+use crate::output::outln;
 
 /// One row of the table: a ray kind, summed over scenes and structures.
 #[derive(Debug, Default, Serialize)]
@@ -110,7 +111,9 @@ pub(crate) fn run(args: &VerifyArgs) -> Result<()> {
         );
     }
     let report = Report { scene: scene_name, seed: args.seed, kinds: kinds.into_values().collect(), structures };
-    print_report(&report);
+    // A reader that stops early (`| head`) must change neither the JSON
+    // written nor the exit status that says whether verification failed.
+    let printed = print_report(&report);
     if let Some(json) = &args.json {
         write_atomically(json, serde_json::to_string_pretty(&report)?.as_bytes())?;
     }
@@ -121,7 +124,7 @@ pub(crate) fn run(args: &VerifyArgs) -> Result<()> {
     if failed {
         bail!("the structures do not all answer exactly as the linear scan, or rays leaked (see the table)");
     }
-    Ok(())
+    printed
 }
 
 /// The structures to check, each with its build parameters; the peers
@@ -218,73 +221,108 @@ fn check_case(
     Ok(())
 }
 
-fn print_report(report: &Report) {
-    println!("rtgi verify: {} (seed {})", report.scene, report.seed);
-    println!();
-    println!(
+fn print_report(report: &Report) -> Result<()> {
+    outln!("rtgi verify: {} (seed {})", report.scene, report.seed)?;
+    outln!()?;
+    outln!(
         "{:<15} {:>10} {:>12} {:>14} {:>14} {:>8} {:>10}",
-        "ray kind", "rays", "linear rays", "closest diff.", "any-hit diff.", "leaks", "self-hits"
-    );
+        "ray kind",
+        "rays",
+        "linear rays",
+        "closest diff.",
+        "any-hit diff.",
+        "leaks",
+        "self-hits"
+    )?;
     for row in &report.kinds {
         let t = &row.tally;
-        println!(
+        outln!(
             "{:<15} {:>10} {:>12} {:>14} {:>14} {:>8} {:>10}",
-            row.kind, row.rays, row.linear_rays, t.closest_disagreements, t.any_disagreements, t.leaks, t.self_hits
-        );
+            row.kind,
+            row.rays,
+            row.linear_rays,
+            t.closest_disagreements,
+            t.any_disagreements,
+            t.leaks,
+            t.self_hits
+        )?;
     }
     if report.kinds.iter().any(|row| row.peers.is_some()) {
-        println!();
-        println!("peers by ray kind (peer: differences are not failures)");
-        println!(
+        outln!()?;
+        outln!("peers by ray kind (peer: differences are not failures)")?;
+        outln!(
             "{:<15} {:>10} {:>12} {:>14} {:>14} {:>8} {:>10}",
-            "ray kind", "rays", "linear rays", "closest diff.", "any-hit diff.", "leaks", "self-hits"
-        );
+            "ray kind",
+            "rays",
+            "linear rays",
+            "closest diff.",
+            "any-hit diff.",
+            "leaks",
+            "self-hits"
+        )?;
         for row in &report.kinds {
             let t = row.peers.clone().unwrap_or_default();
-            println!(
+            outln!(
                 "{:<15} {:>10} {:>12} {:>14} {:>14} {:>8} {:>10}",
-                row.kind, row.rays, row.linear_rays, t.closest_disagreements, t.any_disagreements, t.leaks, t.self_hits
-            );
+                row.kind,
+                row.rays,
+                row.linear_rays,
+                t.closest_disagreements,
+                t.any_disagreements,
+                t.leaks,
+                t.self_hits
+            )?;
         }
     }
-    println!();
-    println!(
+    outln!()?;
+    outln!(
         "{:<44} {:>10} {:>14} {:>14} {:>8} {:>10}",
-        "structure", "rays", "closest diff.", "any-hit diff.", "leaks", "self-hits"
-    );
+        "structure",
+        "rays",
+        "closest diff.",
+        "any-hit diff.",
+        "leaks",
+        "self-hits"
+    )?;
     for s in &report.structures {
         let t = &s.tally;
         let leaks = if s.watertight || t.leaks == 0 { t.leaks.to_string() } else { format!("({})", t.leaks) };
-        println!(
+        outln!(
             "{:<44} {:>10} {:>14} {:>14} {:>8} {:>10}",
-            s.structure, t.rays, t.closest_disagreements, t.any_disagreements, leaks, t.self_hits
-        );
+            s.structure,
+            t.rays,
+            t.closest_disagreements,
+            t.any_disagreements,
+            leaks,
+            t.self_hits
+        )?;
     }
-    println!();
-    println!(
+    outln!()?;
+    outln!(
         "Disagreements are differences in any bit of the closest hit (triangle, t, beta, gamma) or in the any-hit \
          answer, against the linear scan (on big scenes the linear scan answers the first rays of each kind; the \
          rest are compared with the first structure). Leaks are rays aimed inside a closed surface that hit nothing \
          by the point aimed at; leaks in parentheses are those of a test that does not claim watertightness \
          (moller-trumbore). Self-hits are rays leaving a triangle that hit it again."
-    );
+    )?;
     if report.structures.iter().any(|s| s.peer) {
-        println!(
+        outln!(
             "Structures marked (peer) are other people's backends (Embree), not held to the exactness contract: \
              they break ties between triangles at equal t in their own order and round differently on grazing rays. \
              peer: differences are not failures, and do not change the exit status."
-        );
+        )?;
     }
     for s in &report.structures {
         let t = &s.tally;
         if s.peer && !t.is_clean() {
             for example in &t.examples {
-                println!("  {} (a difference, not a failure): {example}", s.structure);
+                outln!("  {} (a difference, not a failure): {example}", s.structure)?;
             }
         } else if t.closest_disagreements + t.any_disagreements + t.self_hits > 0 || (s.watertight && t.leaks > 0) {
             for example in &t.examples {
-                println!("  {}: {example}", s.structure);
+                outln!("  {}: {example}", s.structure)?;
             }
         }
     }
+    Ok(())
 }

@@ -24,7 +24,7 @@ mod write;
 
 pub use compare::{Difference, compare};
 pub use tonemap::{ToneMap, ToneOperator, heat_colour, linear_to_srgb, srgb_to_linear};
-pub use write::{ImageError, OutputFormat, check_writable};
+pub use write::{ImageError, MAX_READ_PIXELS, OutputFormat, check_writable};
 
 use rtgi_math::Vec3;
 

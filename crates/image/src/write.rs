@@ -87,9 +87,26 @@ impl HdrImage {
     }
 
     /// Reads an OpenEXR file's RGB channels (alpha ignored) as linear floats.
+    ///
+    /// Layers of more than [`MAX_READ_PIXELS`] pixels are refused before
+    /// any pixel memory is allocated: a header of a few bytes can declare
+    /// any size, and a 1 MB file claiming 50,000 × 50,000 pixels would
+    /// otherwise ask for 30 GB.
     pub fn read_exr(path: &Path) -> Result<HdrImage, ImageError> {
         use exr::prelude::*;
         let read_error = |e: exr::error::Error| ImageError::Read { path: path.to_owned(), message: e.to_string() };
+        let meta = exr::meta::MetaData::read_from_file(path, false).map_err(read_error)?;
+        for header in &meta.headers {
+            let (width, height) = (header.layer_size.width(), header.layer_size.height());
+            if width.checked_mul(height).is_none_or(|pixels| pixels > MAX_READ_PIXELS) {
+                return Err(ImageError::Read {
+                    path: path.to_owned(),
+                    message: format!(
+                        "{width}x{height} pixels is more than the {MAX_READ_PIXELS} pixels rtgi reads (32768x16384)"
+                    ),
+                });
+            }
+        }
         let image = read_first_rgba_layer_from_file(
             path,
             |resolution, _| HdrImage::new(resolution.width() as u32, resolution.height() as u32),
@@ -101,6 +118,10 @@ impl HdrImage {
         Ok(image.layer_data.channel_data.pixels)
     }
 }
+
+/// Most pixels [`HdrImage::read_exr`] reads from one layer: 32768 × 16384
+/// (an environment map at the largest size in common use), 6 GiB of f32 RGB.
+pub const MAX_READ_PIXELS: usize = 1 << 29;
 
 /// A name beside `path` that no other writer uses at the same time.
 fn temporary_path(path: &Path) -> PathBuf {
