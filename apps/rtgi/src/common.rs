@@ -1,6 +1,5 @@
 //! Steps that several commands share.
 
-use std::io::Write;
 use std::path::Path;
 use std::time::Instant;
 
@@ -51,17 +50,11 @@ fn beside(path: &Path, suffix: &str) -> std::path::PathBuf {
     path.with_file_name(format!(".{name}.{}.{suffix}", std::process::id()))
 }
 
-/// Writes `bytes` to `path` through a temporary file beside it, so that a
-/// failure never leaves a partial file or destroys an earlier one.
+/// Writes `bytes` to `path` atomically ([`rtgi_image::write_atomically`]):
+/// a failure never leaves a partial file or destroys an earlier one, and a
+/// FIFO or device is written in place.
 pub(crate) fn write_atomically(path: &Path, bytes: &[u8]) -> Result<()> {
-    let temporary = beside(path, "partial");
-    let result = std::fs::File::create(&temporary)
-        .and_then(|mut f| f.write_all(bytes).and_then(|()| f.sync_all()))
-        .and_then(|()| std::fs::rename(&temporary, path));
-    if result.is_err() {
-        let _ = std::fs::remove_file(&temporary);
-    }
-    result.with_context(|| format!("{}: cannot write", path.display()))
+    rtgi_image::write_atomically(path, bytes).with_context(|| format!("{}: cannot write", path.display()))
 }
 
 /// Checks that `path` can be created, before long work whose result goes there.

@@ -18,10 +18,12 @@
 //! # Ok::<(), rtgi_image::ImageError>(())
 //! ```
 
+mod atomic;
 mod compare;
 mod tonemap;
 mod write;
 
+pub use atomic::{write_atomically, write_atomically_with};
 pub use compare::{Difference, compare};
 pub use tonemap::{ToneMap, ToneOperator, heat_colour, linear_to_srgb, srgb_to_linear};
 pub use write::{ImageError, MAX_READ_PIXELS, OutputFormat, check_writable};

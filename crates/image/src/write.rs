@@ -1,7 +1,8 @@
 use std::fs::{self, File};
-use std::io::{BufWriter, Write};
+use std::io::Write;
 use std::path::{Path, PathBuf};
 
+use crate::atomic::{temporary_path, write_atomically};
 use crate::{HdrImage, ToneMap};
 
 /// What can go wrong writing an image; every variant names the file.
@@ -43,47 +44,37 @@ impl HdrImage {
     /// data goes to a temporary file beside `path`, which is renamed over
     /// `path` only once complete.
     pub fn write(&self, path: &Path, tone_map: &ToneMap) -> Result<(), ImageError> {
-        let format = OutputFormat::from_path(path)?;
-        let temporary = temporary_path(path);
-        let result = match format {
-            OutputFormat::Png => self.write_png(&temporary, tone_map),
-            OutputFormat::Exr => self.write_exr(&temporary),
-        }
-        .map_err(|e| relabel(e, path));
-        let result = result.and_then(|()| {
-            fs::rename(&temporary, path).map_err(|source| ImageError::Io { path: path.to_owned(), source })
-        });
-        if result.is_err() {
-            let _ = fs::remove_file(&temporary);
-        }
-        result
+        let bytes = match OutputFormat::from_path(path)? {
+            OutputFormat::Png => self.encode_png(path, tone_map)?,
+            OutputFormat::Exr => self.encode_exr(path)?,
+        };
+        write_atomically(path, &bytes).map_err(|source| ImageError::Io { path: path.to_owned(), source })
     }
 
-    fn write_png(&self, path: &Path, tone_map: &ToneMap) -> Result<(), ImageError> {
+    fn encode_png(&self, path: &Path, tone_map: &ToneMap) -> Result<Vec<u8>, ImageError> {
         use image::ImageEncoder;
         let bytes = self.to_srgb8(tone_map);
-        let file = File::create(path).map_err(|source| ImageError::Io { path: path.to_owned(), source })?;
-        let mut writer = BufWriter::new(file);
-        image::codecs::png::PngEncoder::new(&mut writer)
+        let mut encoded = Vec::new();
+        image::codecs::png::PngEncoder::new(&mut encoded)
             .write_image(&bytes, self.width, self.height, image::ExtendedColorType::Rgb8)
             .map_err(|e| ImageError::Encode { path: path.to_owned(), message: e.to_string() })?;
-        writer
-            .into_inner()
-            .map_err(|e| e.into_error())
-            .and_then(|f| f.sync_all())
-            .map_err(|source| ImageError::Io { path: path.to_owned(), source })
+        Ok(encoded)
     }
 
-    fn write_exr(&self, path: &Path) -> Result<(), ImageError> {
+    fn encode_exr(&self, path: &Path) -> Result<Vec<u8>, ImageError> {
+        use exr::prelude::*;
         let width = self.width as usize;
-        exr::prelude::write_rgb_file(path, width, self.height as usize, |x, y| {
-            let p = self.pixels[y * width + x];
+        let channels = SpecificChannels::rgb(|position: Vec2<usize>| {
+            let p = self.pixels[position.y() * width + position.x()];
             (p.x, p.y, p.z)
-        })
-        .map_err(|e| match e {
+        });
+        let image = Image::from_channels((width, self.height as usize), channels);
+        let mut encoded = std::io::Cursor::new(Vec::new());
+        image.write().to_buffered(&mut encoded).map_err(|e| match e {
             exr::error::Error::Io(source) => ImageError::Io { path: path.to_owned(), source },
             other => ImageError::Encode { path: path.to_owned(), message: other.to_string() },
-        })
+        })?;
+        Ok(encoded.into_inner())
     }
 
     /// Reads an OpenEXR file's RGB channels (alpha ignored) as linear floats.
@@ -122,22 +113,6 @@ impl HdrImage {
 /// Most pixels [`HdrImage::read_exr`] reads from one layer: 32768 × 16384
 /// (an environment map at the largest size in common use), 6 GiB of f32 RGB.
 pub const MAX_READ_PIXELS: usize = 1 << 29;
-
-/// A name beside `path` that no other writer uses at the same time.
-fn temporary_path(path: &Path) -> PathBuf {
-    let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
-    path.with_file_name(format!(".{name}.{}.partial", std::process::id()))
-}
-
-/// Errors from the temporary file are reported under the name the user gave.
-fn relabel(error: ImageError, path: &Path) -> ImageError {
-    let path = path.to_owned();
-    match error {
-        ImageError::Io { source, .. } => ImageError::Io { path, source },
-        ImageError::Encode { message, .. } => ImageError::Encode { path, message },
-        other => other,
-    }
-}
 
 /// Checks before a long render that `path` names a supported format in a
 /// writable folder, by creating and removing a temporary file there.

@@ -6,12 +6,12 @@
 //! samples); the three fixed-point channel sums of every pixel of the
 //! band, row by row, each as a zigzag LEB128 varint (most sums are far
 //! smaller than 128 bits); and a little-endian `u64` FNV-1a of those sum
-//! bytes, which catches a truncated or damaged file. Files are written to
-//! a temporary name beside the target and renamed into place, so an
-//! interrupted write never leaves half a checkpoint.
+//! bytes, which catches a truncated or damaged file. Files are written
+//! atomically ([`rtgi_image::write_atomically_with`]), so an interrupted
+//! write never leaves half a checkpoint.
 
 use std::fs::File;
-use std::io::{BufReader, BufWriter, Read, Write};
+use std::io::{BufReader, Read};
 use std::ops::Range;
 use std::path::{Path, PathBuf};
 
@@ -44,13 +44,9 @@ struct Header {
 impl Accumulation {
     /// Writes the accumulation to `path`, atomically.
     pub fn write(&self, path: &Path) -> Result<(), AccumulationFileError> {
-        let io = |source| AccumulationFileError::Io { path: path.to_owned(), source };
-        let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
-        let temporary = path.with_file_name(format!(".{name}.{}.partial", std::process::id()));
-        let result = (|| {
-            let mut out = BufWriter::new(File::create(&temporary)?);
-            let header = Header { identity: self.identity().clone(), rows: self.rows(), samples: self.samples() };
-            let header = serde_json::to_vec(&header).map_err(std::io::Error::other)?;
+        let header = Header { identity: self.identity().clone(), rows: self.rows(), samples: self.samples() };
+        let header = serde_json::to_vec(&header).expect("the header is plain data");
+        rtgi_image::write_atomically_with(path, |out| {
             out.write_all(MAGIC)?;
             out.write_all(&(header.len() as u32).to_le_bytes())?;
             out.write_all(&header)?;
@@ -64,14 +60,9 @@ impl Accumulation {
                 checksum.bytes(&bytes);
                 out.write_all(&bytes)?;
             }
-            out.write_all(&checksum.0.to_le_bytes())?;
-            out.into_inner().map_err(|e| e.into_error())?.sync_all()?;
-            std::fs::rename(&temporary, path)
-        })();
-        if result.is_err() {
-            let _ = std::fs::remove_file(&temporary);
-        }
-        result.map_err(io)
+            out.write_all(&checksum.0.to_le_bytes())
+        })
+        .map_err(|source| AccumulationFileError::Io { path: path.to_owned(), source })
     }
 
     /// Reads an accumulation written by [`Accumulation::write`].
