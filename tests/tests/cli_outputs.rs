@@ -34,7 +34,7 @@ fn an_output_that_is_also_an_input_is_refused_and_left_alone() {
         let args: Vec<&str> = small.iter().copied().chain(extra).collect();
         let run = rtgi(&args);
         assert_eq!(run.code, Some(1), "{run:?}");
-        assert!(run.stderr.contains("is --environment, which the render reads"), "{run:?}");
+        assert!(run.stderr.contains("is --environment, which the command reads"), "{run:?}");
     }
     let aov_source = dir.join("out.normal.exr");
     std::fs::copy(&sky, &aov_source).unwrap();
@@ -78,4 +78,17 @@ fn an_image_too_large_for_memory_is_refused_before_anything_is_allocated() {
     assert!(run.stderr.contains("GiB of memory") && run.stderr.contains("--tile"), "{run:?}");
     assert!(start.elapsed() < std::time::Duration::from_secs(5), "{:?}", start.elapsed());
     assert!(!out.exists());
+}
+
+#[test]
+fn trace_refuses_to_write_its_hits_over_its_rays() {
+    let dir = scratch_dir("trace-over-rays");
+    let rays = dir.join("rays.bin");
+    let ray: Vec<u8> =
+        [0.0f32, 0.0, 5.0, 0.0, 0.0, -1.0, 0.0, f32::INFINITY].iter().flat_map(|v| v.to_le_bytes()).collect();
+    std::fs::write(&rays, &ray).unwrap();
+    let run = rtgi(&["trace", "scenes/cornell-box.toml", "--rays", path_str(&rays), "--out", path_str(&rays)]);
+    assert_eq!(run.code, Some(1), "{run:?}");
+    assert!(run.stderr.contains("is --rays, which the command reads"), "{run:?}");
+    assert_eq!(std::fs::read(&rays).unwrap(), ray);
 }

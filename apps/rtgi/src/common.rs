@@ -144,3 +144,14 @@ pub(crate) fn same_file(a: &Path, b: &Path) -> bool {
         _ => a == b,
     }
 }
+
+/// Refuses to write over a file the command reads: an output named like
+/// the scene, a texture, the environment map or the rays file would destroy it.
+pub(crate) fn refuse_inputs_as_outputs(outputs: &[(&str, &Path)], inputs: &[(&str, &Path)]) -> Result<()> {
+    for (option, output) in outputs {
+        if let Some((what, _)) = inputs.iter().find(|(_, input)| same_file(output, input)) {
+            bail!("{option} {}: is {what}, which the command reads; write to another file", output.display());
+        }
+    }
+    Ok(())
+}

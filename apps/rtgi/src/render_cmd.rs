@@ -8,7 +8,7 @@ use rtgi_render::{Accumulation, EffectPlan, Integrator, PixelSampler, RenderIden
 use crate::cli::EnvironmentArg;
 use crate::cli::RenderArgs;
 use crate::common::{
-    LoadedScene, apply_lighting, check_output_folder, choose_camera, load_scene, same_file, thread_pool,
+    LoadedScene, apply_lighting, check_output_folder, choose_camera, load_scene, refuse_inputs_as_outputs, thread_pool,
 };
 use crate::interrupt;
 use crate::output::{out, outln};
@@ -210,17 +210,6 @@ pub(crate) fn run(args: &RenderArgs) -> Result<()> {
         Ending::TimeLimit if !wrote_output => bail!("no sample finished within the time limit"),
         _ => printed,
     }
-}
-
-/// Refuses to write over a file the render reads: an output named like
-/// the scene, a texture or the environment map would destroy it.
-pub(crate) fn refuse_inputs_as_outputs(outputs: &[(&str, &Path)], inputs: &[(&str, &Path)]) -> Result<()> {
-    for (option, output) in outputs {
-        if let Some((what, _)) = inputs.iter().find(|(_, input)| same_file(output, input)) {
-            bail!("{option} {}: is {what}, which the render reads; write to another file", output.display());
-        }
-    }
-    Ok(())
 }
 
 /// Refuses an image too large for this machine's memory before anything is

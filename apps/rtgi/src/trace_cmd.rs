@@ -9,7 +9,7 @@ use rtgi_accel::Accel;
 use rtgi_math::{Ray, Vec3};
 
 use crate::cli::TraceArgs;
-use crate::common::{LoadedScene, check_output_folder, load_scene, thread_pool};
+use crate::common::{LoadedScene, check_output_folder, load_scene, refuse_inputs_as_outputs, thread_pool};
 
 /// Bytes of one ray in a ray file: 8 little-endian f32.
 pub(crate) const RAY_BYTES: usize = 32;
@@ -27,6 +27,7 @@ const BATCH_RAYS: usize = 1024;
 const CHUNK_RAYS: usize = 64 * BATCH_RAYS;
 
 pub(crate) fn run(args: &TraceArgs) -> Result<()> {
+    refuse_inputs_as_outputs(&[("--out", &args.out)], &[("--rays", &args.rays), ("the scene", &args.scene)])?;
     check_output_folder(&args.out)?;
     // The first chunk is read before the scene, so that a file that is no
     // ray file at all (`/dev/zero`, a picture) is refused at once.
