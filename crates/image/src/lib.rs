@@ -20,11 +20,13 @@
 
 mod atomic;
 mod compare;
+mod exposure;
 mod tonemap;
 mod write;
 
 pub use atomic::{write_atomically, write_atomically_with};
 pub use compare::{Difference, compare};
+pub use exposure::{Legibility, auto_exposure, legibility};
 pub use tonemap::{ToneMap, ToneOperator, heat_colour, linear_to_srgb, srgb_to_linear};
 pub use write::{ImageError, MAX_READ_PIXELS, OutputFormat, check_writable};
 

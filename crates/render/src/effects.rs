@@ -200,6 +200,41 @@ fn is_textured(m: &Material) -> bool {
         || m.transmission_texture.is_some()
 }
 
+/// Emitters whose power is below this fraction of what the default sky
+/// would bring to the scene do not count as lighting it.
+pub const WEAK_EMITTERS: f32 = 0.01;
+
+/// The power (luminance, in the scene's units × area) that the scene's
+/// untextured emissive triangles give off from their front faces.
+fn emitted_power(scene: &Scene) -> f32 {
+    let luminance = |c: rtgi_math::Vec3| c.dot(rtgi_math::Vec3::new(0.2126, 0.7152, 0.0722));
+    scene
+        .triangles
+        .iter()
+        .filter_map(|t| {
+            let material = scene.materials.get(t.material as usize)?;
+            if !material.is_emissive() || material.emission_texture.is_some() {
+                return None;
+            }
+            let [a, b, c] = t.vertices.map(|v| scene.vertices[v as usize].position);
+            let area = 0.5 * (b - a).cross(c - a).length();
+            Some(std::f32::consts::PI * area * luminance(material.emission)).filter(|p| p.is_finite())
+        })
+        .sum()
+}
+
+/// The power a sky of radiance 1 would bring onto the scene's bounding
+/// box: π times its surface area (each face facing open sky receives an
+/// irradiance of π).
+fn default_sky_power(scene: &Scene) -> f32 {
+    let bounds = scene.bounds();
+    if bounds.is_empty() {
+        return 0.0;
+    }
+    let e = bounds.extent();
+    std::f32::consts::PI * 2.0 * (e.x * e.y + e.y * e.z + e.z * e.x)
+}
+
 impl EffectPlan {
     /// Plans a render of `scene` with `settings`.
     pub fn new(scene: &Scene, settings: &RenderSettings) -> Self {
@@ -257,16 +292,31 @@ impl EffectPlan {
         // Emission through a texture is how glTF models glowing details (a
         // helmet's displays), not how they light a scene; such scenes are
         // meant to be seen under an environment.
-        let lit_by_emitters = emitters.iter().any(|m| m.emission_texture.is_none());
+        // Emitters too weak to light the view (a few glowing blocks in a
+        // world) keep the default sky and sun, as if there were none.
+        let emitted = emitted_power(scene);
+        let sky_power = default_sky_power(scene);
+        let weak_emitters = emitted > 0.0 && emitted < WEAK_EMITTERS * sky_power;
+        let lit_by_emitters = emitters.iter().any(|m| m.emission_texture.is_none()) && !weak_emitters;
         let default_environment = lighting && !environment_given && lights == 0 && !lit_by_emitters;
         let environment = if !lighting {
             decide(Effect::Environment, false, not_lit())
         } else if environment_given {
             decide(Effect::Environment, true, "an environment is set".into())
         } else if default_environment {
-            let what = if emissive_triangles > 0 { "lights or untextured emitters" } else { "lights or emitters" };
+            let why = if weak_emitters {
+                format!(
+                    "the scene's emitters give {:.2}% of the light a sky would, too little to light it",
+                    100.0 * emitted / sky_power
+                )
+            } else if emissive_triangles > 0 {
+                "the scene has no lights or untextured emitters".to_owned()
+            } else {
+                "the scene has no lights or emitters".to_owned()
+            };
             let reason = format!(
-                "the scene has no {what}, so a uniform white sky (radiance 1) lights it; --environment chooses another"
+                "{why}, so a default sky (blue overhead, grey ground) and a sun from the upper front right light \
+                 it; --environment or --light chooses others"
             );
             decide(Effect::Environment, true, reason)
         } else {
@@ -284,7 +334,7 @@ impl EffectPlan {
                 sources.push(count(emissive_triangles, "emissive triangle"));
             }
             if environment {
-                sources.push("the environment".into());
+                sources.push(if default_environment { "the default sun and sky" } else { "the environment" }.into());
             }
             if sources.is_empty() {
                 decide(Effect::DirectLight, false, "nothing emits light".into())

@@ -164,6 +164,9 @@ fn power_heuristic(a: f32, b: f32) -> f32 {
     if a2.is_infinite() { 1.0 } else { a2 / (a2 + b2).max(f32::MIN_POSITIVE) }
 }
 
+static DEFAULT_SUN: std::sync::LazyLock<rtgi_scene::Light> =
+    std::sync::LazyLock::new(crate::default_lighting::default_sun);
+
 fn luminance(c: Vec3) -> f32 {
     c.dot(Vec3::new(0.2126, 0.7152, 0.0722))
 }
@@ -180,7 +183,13 @@ impl<'a, A: Accel + ?Sized> Transport<'a, A> {
         Self {
             scene,
             accel,
-            lights: LightSet::new(scene, plan.has(Effect::Emission), environment),
+            // The default sun comes with the default sky.
+            lights: LightSet::new(
+                scene,
+                if plan.default_environment { std::slice::from_ref(&*DEFAULT_SUN) } else { &[] },
+                plan.has(Effect::Emission),
+                environment,
+            ),
             environment,
             background: settings.background,
             max_depth: plan.max_depth,

@@ -24,6 +24,7 @@ mod accumulation;
 mod accumulation_file;
 pub mod bsdf;
 mod camera;
+mod default_lighting;
 mod distribution;
 mod effect_set;
 pub mod effects;
@@ -39,10 +40,11 @@ mod shade;
 pub use accumulation::{Accumulation, FIXED_POINT_BITS, MergeError, PixelSum, SAMPLE_LIMIT};
 pub use accumulation_file::AccumulationFileError;
 pub use camera::CameraRays;
+pub use default_lighting::{ENCLOSED, default_sky, default_sun, room_light, sky_visibility};
 pub use distribution::Distribution1D;
 pub use effect_set::EffectSet;
 pub use effects::{Effect, EffectOverrides, EffectPlan, PlannedEffect, Reversal};
-pub use framing::frame_scene;
+pub use framing::{camera_blocked, frame_scene, three_quarter_view};
 pub use identity::{Difference, RenderIdentity, scene_fingerprint};
 pub use integrator::{DirectStrategy, Integrator};
 pub use lights::{Environment, EnvironmentMap, LightSet};
@@ -299,8 +301,7 @@ fn render_transport<A: Accel + ?Sized>(
     plan: &EffectPlan,
     pass: &Pass<'_>,
 ) -> Option<(Vec<PixelSum>, u64)> {
-    let white_sky = Environment::Uniform(Vec3::ONE);
-    let environment = if plan.default_environment { Some(&white_sky) } else { pass.settings.environment.as_ref() };
+    let environment = if plan.default_environment { Some(default_sky()) } else { pass.settings.environment.as_ref() };
     let transport = Transport::new(scene, accel, plan, environment, pass.settings);
     fn run<const S: u16, A: Accel + ?Sized>(
         transport: &Transport<'_, A>,

@@ -11,7 +11,7 @@ use std::path::Path;
 
 use rtgi_image::{HdrImage, ImageError};
 use rtgi_math::{Ray, SurfacePoint, TriangleShape, Vec2, Vec3};
-use rtgi_scene::{LightKind, Scene, SurfaceModel, TextureId};
+use rtgi_scene::{Light, LightKind, Scene, SurfaceModel, TextureId};
 
 use crate::distribution::Distribution1D;
 
@@ -254,14 +254,14 @@ pub struct LightSet {
 }
 
 impl LightSet {
-    /// Collects the scene's punctual lights, its emissive triangles (when
-    /// `emission` is on) and the environment (when given).
-    pub fn new(scene: &Scene, emission: bool, environment: Option<&Environment>) -> Self {
+    /// Collects the scene's punctual lights and `extra` ones, its emissive
+    /// triangles (when `emission` is on) and the environment (when given).
+    pub fn new(scene: &Scene, extra: &[Light], emission: bool, environment: Option<&Environment>) -> Self {
         let bounds = scene.bounds();
         let radius = if bounds.is_empty() { 1.0 } else { 0.5 * bounds.extent().length().max(1e-6) };
         let mut sources = Vec::new();
         let mut powers = Vec::new();
-        for light in &scene.lights {
+        for light in scene.lights.iter().chain(extra) {
             let intensity = light.color * light.intensity;
             let point = |cone| Source::Point { position: light.position, intensity, range: light.range, cone };
             let (source, power) = match light.kind {
@@ -328,7 +328,13 @@ impl LightSet {
         }
         let mut environment_index = None;
         if let Some(environment) = environment {
-            let power = PI * 4.0 * PI * radius * radius * luminance(environment.mean_radiance());
+            // What the environment brings through the disc a directional
+            // light is weighed by (π r² times an irradiance of π times its
+            // mean radiance), so that a sun and a sky of equal irradiance are
+            // chosen equally often. (Its power through the bounding sphere,
+            // four times more, drowned a sun in sky samples and speckled
+            // every sunlit surface.)
+            let power = PI * radius * radius * PI * luminance(environment.mean_radiance());
             if power > 0.0 {
                 environment_index = Some(sources.len());
                 sources.push(Source::Environment);

@@ -1,0 +1,144 @@
+//! The light a scene gets when it brings none of its own: a sky with a
+//! visible gradient and a sun, so that the first render of a model shows
+//! its shape. A uniform white sky, the earlier default, lights every side
+//! the same and washes a white model out against its background.
+
+use std::sync::LazyLock;
+
+use rtgi_accel::Accel;
+use rtgi_image::HdrImage;
+use rtgi_math::{Ray, Vec3};
+use rtgi_scene::{Light, LightKind, Scene};
+
+use crate::{Environment, EnvironmentMap};
+
+/// Texels of the sky's equirectangular image (its gradient is smooth).
+const SKY_WIDTH: u32 = 64;
+const SKY_HEIGHT: u32 = 32;
+
+/// Radiance straight up, at the horizon, and of the ground below it.
+const ZENITH: Vec3 = Vec3::new(0.32, 0.48, 0.85);
+const HORIZON: Vec3 = Vec3::new(0.95, 0.95, 0.98);
+const GROUND: Vec3 = Vec3::new(0.30, 0.28, 0.26);
+
+/// The sun: from 55 degrees above the horizon, 35 degrees to the right of
+/// +Z (where automatic views look from), so that it lights the sides the
+/// camera sees and casts shadows down and away; irradiance in the units of
+/// the scene's other lights (its colour a warm white).
+const SUN_ELEVATION_DEGREES: f32 = 55.0;
+const SUN_AZIMUTH_DEGREES: f32 = 35.0;
+const SUN_IRRADIANCE: f32 = 2.0;
+const SUN_COLOUR: Vec3 = Vec3::new(1.0, 0.95, 0.86);
+
+static SKY: LazyLock<Environment> = LazyLock::new(|| {
+    let mut image = HdrImage::new(SKY_WIDTH, SKY_HEIGHT);
+    for y in 0..SKY_HEIGHT {
+        // The elevation of the row's centre: +90 degrees in the top row.
+        let elevation = std::f32::consts::FRAC_PI_2 * (1.0 - 2.0 * (y as f32 + 0.5) / SKY_HEIGHT as f32);
+        let radiance = sky_radiance(elevation.sin());
+        for x in 0..SKY_WIDTH {
+            image.set(x, y, radiance);
+        }
+    }
+    Environment::Map(EnvironmentMap::new(image))
+});
+
+/// The sky's radiance at a direction whose up component is `up` (sine of the elevation).
+fn sky_radiance(up: f32) -> Vec3 {
+    if up >= 0.0 {
+        HORIZON.lerp(ZENITH, up.sqrt())
+    } else {
+        // A short blend below the horizon, then the ground.
+        HORIZON.lerp(GROUND, (-up * 8.0).min(1.0))
+    }
+}
+
+/// The default sky: blue overhead, white at the horizon, grey ground.
+pub fn default_sky() -> &'static Environment {
+    &SKY
+}
+
+/// The default sun, a directional light.
+pub fn default_sun() -> Light {
+    let (elevation, azimuth) = (SUN_ELEVATION_DEGREES.to_radians(), SUN_AZIMUTH_DEGREES.to_radians());
+    let towards_sun = Vec3::new(azimuth.sin() * elevation.cos(), elevation.sin(), azimuth.cos() * elevation.cos());
+    Light {
+        name: "default sun".into(),
+        kind: LightKind::Directional,
+        position: Vec3::ZERO,
+        direction: -towards_sun,
+        color: SUN_COLOUR,
+        intensity: SUN_IRRADIANCE,
+        range: None,
+    }
+}
+
+/// Directions probed by [`sky_visibility`].
+const VISIBILITY_PROBES: u32 = 256;
+
+/// The fraction of directions from `position` in which a ray leaves the
+/// scene: about 0.5 on open ground, 0 inside a closed room, where a sky
+/// lights nothing. The directions are a Fibonacci spiral over the sphere.
+pub fn sky_visibility<A: Accel + ?Sized>(accel: &A, position: Vec3) -> f32 {
+    let golden = std::f32::consts::PI * (3.0 - 5f32.sqrt());
+    let escaped = (0..VISIBILITY_PROBES)
+        .filter(|&i| {
+            let z = 1.0 - 2.0 * (i as f32 + 0.5) / VISIBILITY_PROBES as f32;
+            let r = (1.0 - z * z).max(0.0).sqrt();
+            let phi = golden * i as f32;
+            let direction = Vec3::new(r * phi.cos(), z, r * phi.sin());
+            accel.intersect(&Ray::new(position, direction)).is_none()
+        })
+        .count();
+    escaped as f32 / VISIBILITY_PROBES as f32
+}
+
+/// Below this [`sky_visibility`] a camera is taken to be enclosed.
+pub const ENCLOSED: f32 = 0.02;
+
+/// A light for a camera enclosed by an unlit scene (a room with no lamps):
+/// a point light above the camera, three tenths of the way to the ceiling
+/// (or, with none above, one tenth of the scene's size up): close enough
+/// that what the camera sees is lit directly, not only by bounces, bright enough
+/// to give an irradiance of about π at the camera's height.
+pub fn room_light<A: Accel + ?Sized>(scene: &Scene, accel: &A, camera: Vec3) -> Light {
+    let size = scene.bounds().extent().length().max(1e-6);
+    let up = Ray::new(camera, Vec3::Y);
+    let height = accel.intersect(&up).map_or(0.1 * size, |hit| 0.3 * hit.t);
+    Light {
+        name: "default room light".into(),
+        kind: LightKind::Point,
+        position: camera + Vec3::Y * height,
+        direction: Vec3::NEG_Y,
+        color: SUN_COLOUR,
+        intensity: std::f32::consts::PI * height * height,
+        range: None,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_sky_darkens_upwards_and_the_ground_is_darker_still() {
+        let luminance = |c: Vec3| c.dot(Vec3::new(0.2126, 0.7152, 0.0722));
+        let (zenith, horizon, ground) = (sky_radiance(1.0), sky_radiance(0.0), sky_radiance(-1.0));
+        assert!(luminance(zenith) < 0.7 * luminance(horizon));
+        assert!(luminance(ground) < luminance(zenith));
+        assert!(zenith.z > zenith.x, "the zenith is blue");
+        let Environment::Map(map) = default_sky() else { panic!("the sky is a map") };
+        let top = map.image().get(0, 0);
+        let bottom = map.image().get(0, SKY_HEIGHT - 1);
+        assert!(
+            luminance(top) < luminance(map.image().get(0, SKY_HEIGHT / 2 - 1)) && luminance(bottom) < luminance(top)
+        );
+    }
+
+    #[test]
+    fn the_sun_shines_down_from_the_front() {
+        let sun = default_sun();
+        assert!(sun.direction.y < -0.7 && sun.direction.z < 0.0);
+        assert!((sun.direction.length() - 1.0).abs() < 1e-6);
+    }
+}
