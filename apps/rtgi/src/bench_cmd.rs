@@ -94,7 +94,7 @@ pub(crate) fn run(args: &BenchArgs) -> Result<()> {
     }
     let LoadedScene { scene, name, .. } = load_scene(args.scene.as_deref())?;
     let triangles = scene.triangle_positions();
-    let pool = thread_pool(args.threads)?;
+    let pool = args.threads.pool()?;
     let single = thread_pool(Some(1))?;
     let repeats = args.repeats as usize;
     if args.accuracy_accel.is_peer() {

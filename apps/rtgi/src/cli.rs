@@ -44,6 +44,8 @@ pub(crate) enum Command {
     /// Put the parts of a split render (--samples, --tile) or a checkpoint together into one
     /// image or accumulation, bit-identical to the render in one go
     Merge(crate::merge_cmd::MergeArgs),
+    /// A contact sheet of scenes, each rendered as 'rtgi render SCENE' renders it with no options
+    Gallery(crate::gallery_cmd::GalleryArgs),
     /// What accuracy costs in time: vary one knob (spp, depth, accel, scaling, or all) and write
     /// a table (KNOB.md), every measurement (KNOB.json) and SVG plots
     Experiment(ExperimentArgs),
@@ -100,9 +102,8 @@ pub(crate) struct ExperimentArgs {
     #[command(flatten)]
     pub(crate) camera: CameraArgs,
 
-    /// Worker threads [default: one per core]
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1024))]
-    pub(crate) threads: Option<u32>,
+    #[command(flatten)]
+    pub(crate) threads: ThreadArgs,
 }
 
 /// One knob, or all of them.
@@ -152,9 +153,8 @@ pub(crate) struct VerifyArgs {
     #[arg(long, default_value_t = 1)]
     pub(crate) seed: u64,
 
-    /// Worker threads [default: one per core]
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1024))]
-    pub(crate) threads: Option<u32>,
+    #[command(flatten)]
+    pub(crate) threads: ThreadArgs,
 
     /// Also write the table as JSON to this file
     #[arg(long)]
@@ -178,9 +178,8 @@ pub(crate) struct BenchEffectsArgs {
     #[arg(long, default_value_t = 3, value_parser = clap::value_parser!(u32).range(1..=1000))]
     pub(crate) repeats: u32,
 
-    /// Worker threads [default: one per core]
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1024))]
-    pub(crate) threads: Option<u32>,
+    #[command(flatten)]
+    pub(crate) threads: ThreadArgs,
 
     #[command(flatten)]
     pub(crate) lighting: LightingArgs,
@@ -424,9 +423,8 @@ pub(crate) struct HeatmapArgs {
     #[command(flatten)]
     pub(crate) camera: CameraArgs,
 
-    /// Worker threads [default: one per core]
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1024))]
-    pub(crate) threads: Option<u32>,
+    #[command(flatten)]
+    pub(crate) threads: ThreadArgs,
 }
 
 /// `rtgi bench`: what each acceleration structure costs and gives, side by side.
@@ -466,9 +464,8 @@ pub(crate) struct BenchArgs {
     #[arg(long, default_value_t = 2048, value_parser = clap::value_parser!(u32).range(1..=100_000_000))]
     pub(crate) linear_rays: u32,
 
-    /// Worker threads of the multi-threaded measurements [default: one per core]
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1024))]
-    pub(crate) threads: Option<u32>,
+    #[command(flatten)]
+    pub(crate) threads: ThreadArgs,
 
     /// Also write the results as JSON to this file
     #[arg(long)]
@@ -529,9 +526,8 @@ pub(crate) struct TraceArgs {
     #[command(flatten)]
     pub(crate) accel: AccelArgs,
 
-    /// Worker threads [default: one per core]
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1024))]
-    pub(crate) threads: Option<u32>,
+    #[command(flatten)]
+    pub(crate) threads: ThreadArgs,
 }
 
 #[derive(Debug, Args)]
@@ -540,12 +536,17 @@ pub(crate) struct RenderArgs {
     pub(crate) scene: Option<PathBuf>,
 
     /// Output image; the format follows the extension (.png or .exr), or .accum for the
-    /// render's exact sums (a part of a split render, for 'rtgi merge')
+    /// render's exact sums (a part of a split render, for 'rtgi merge') [default: the scene's
+    /// name with .png, in the current folder]
     #[arg(short, long)]
-    pub(crate) output: PathBuf,
+    pub(crate) output: Option<PathBuf>,
 
     #[command(flatten)]
     pub(crate) size: ImageSize,
+
+    /// A quick look: a quarter of the width and height, and at most 4 samples per pixel
+    #[arg(long)]
+    pub(crate) quick: bool,
 
     /// Samples per pixel [default: 16 for the direct and path integrators, 1 otherwise]
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1_048_576))]
@@ -556,7 +557,7 @@ pub(crate) struct RenderArgs {
 
     /// Also write arbitrary output variables beside the output, as OUTPUT.NAME.exr: a list
     /// of albedo, normal, depth, position, cost
-    #[arg(long, value_delimiter = ',')]
+    #[arg(long, value_delimiter = ',', value_parser = parse_aov)]
     pub(crate) aov: Vec<Integrator>,
 
     /// Where samples go in a pixel: center, uniform, stratified, low-discrepancy [default: center for 1 spp, stratified otherwise]
@@ -567,9 +568,8 @@ pub(crate) struct RenderArgs {
     #[arg(long, default_value_t = 0)]
     pub(crate) seed: u64,
 
-    /// Worker threads [default: one per core]
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1024))]
-    pub(crate) threads: Option<u32>,
+    #[command(flatten)]
+    pub(crate) threads: ThreadArgs,
 
     #[command(flatten)]
     pub(crate) accel: AccelArgs,
@@ -577,13 +577,8 @@ pub(crate) struct RenderArgs {
     #[command(flatten)]
     pub(crate) camera: CameraArgs,
 
-    /// Exposure in stops, for PNG output
-    #[arg(long, default_value_t = 0.0, value_parser = parse_exposure, allow_negative_numbers = true)]
-    pub(crate) exposure: f32,
-
-    /// Tone map for PNG output: clamp, reinhard, aces
-    #[arg(long, default_value = "clamp")]
-    pub(crate) tonemap: ToneOperator,
+    #[command(flatten)]
+    pub(crate) tone: ToneArgs,
 
     /// Radiance of camera rays that hit nothing and see no environment, as R,G,B
     #[arg(long, value_parser = parse_colour, default_value = "0.05,0.05,0.06", allow_hyphen_values = true)]
@@ -591,6 +586,68 @@ pub(crate) struct RenderArgs {
 
     #[command(flatten)]
     pub(crate) job: crate::render_job::JobArgs,
+}
+
+impl RenderArgs {
+    /// Where the image goes: `-o`, else the scene's name with `.png` in the
+    /// current folder (`cornell-box.png` for the built-in scene).
+    pub(crate) fn output(&self) -> PathBuf {
+        match (&self.output, &self.scene) {
+            (Some(output), _) => output.clone(),
+            (None, Some(scene)) => {
+                let stem = scene.file_stem().map_or("render".into(), |s| s.to_string_lossy().into_owned());
+                PathBuf::from(format!("{stem}.png"))
+            }
+            (None, None) => PathBuf::from("cornell-box.png"),
+        }
+    }
+
+    /// Image width, height and samples per pixel, after `--quick`.
+    pub(crate) fn resolution(&self) -> (u32, u32, u32) {
+        let spp = self.spp.unwrap_or(if self.lighting.integrator.simulates_light() { 16 } else { 1 });
+        if self.quick {
+            ((self.size.width / 4).max(16), (self.size.height / 4).max(16), spp.min(4))
+        } else {
+            (self.size.width, self.size.height, spp)
+        }
+    }
+}
+
+fn parse_aov(text: &str) -> Result<Integrator, String> {
+    let aovs: Vec<&str> = Integrator::ALL.iter().filter(|i| i.is_aov()).map(|i| i.name()).collect();
+    text.parse::<Integrator>()
+        .ok()
+        .filter(|i| i.is_aov())
+        .ok_or_else(|| format!("'{text}' is not an output variable (expected one of {})", aovs.join(", ")))
+}
+
+/// How an image becomes 8-bit PNG (EXR keeps linear floats): shared by `render` and `merge`.
+#[derive(Debug, Args)]
+pub(crate) struct ToneArgs {
+    /// Exposure in stops, for PNG output [default: automatic for the direct and path integrators
+    /// (the image's log-average luminance brought to middle grey, highlights kept), 0 otherwise]
+    #[arg(long, value_parser = parse_exposure, allow_negative_numbers = true)]
+    pub(crate) exposure: Option<f32>,
+
+    /// Tone map for PNG output: aces (filmic), reinhard, clamp [default: aces for the direct and
+    /// path integrators, clamp otherwise]
+    #[arg(long)]
+    pub(crate) tonemap: Option<ToneOperator>,
+}
+
+/// Worker threads: shared by every command that runs in parallel.
+#[derive(Debug, Args)]
+pub(crate) struct ThreadArgs {
+    /// Worker threads [default: one per core]
+    #[arg(short = 't', long = "threads", value_parser = clap::value_parser!(u32).range(1..=1024))]
+    pub(crate) count: Option<u32>,
+}
+
+impl ThreadArgs {
+    /// A pool of that many worker threads.
+    pub(crate) fn pool(&self) -> anyhow::Result<rayon::ThreadPool> {
+        crate::common::thread_pool(self.count)
+    }
 }
 
 /// The size of an image in pixels.

@@ -5,7 +5,7 @@ use std::time::Instant;
 
 use anyhow::{Context, Result, bail};
 use rtgi_accel::Accel;
-use rtgi_render::{Environment, RenderSettings, frame_scene};
+use rtgi_render::{Environment, RenderSettings, camera_blocked, frame_scene};
 use rtgi_scene::{Camera, Scene};
 
 use crate::cli::{CameraArgs, EnvironmentArg, LightingArgs};
@@ -85,6 +85,7 @@ pub(crate) fn choose_camera(scene: &Scene, accel: &dyn Accel, options: &CameraAr
         Some(degrees) => degrees.to_radians(),
         None => chosen.map_or(DEFAULT_FOV_DEGREES.to_radians(), |c| c.vertical_fov),
     };
+    let automatic = chosen.is_none() && options.at.is_none();
     let mut camera = match chosen {
         Some(camera) => *camera,
         None => frame_scene(scene, accel, fov, aspect),
@@ -104,6 +105,15 @@ pub(crate) fn choose_camera(scene: &Scene, accel: &dyn Accel, options: &CameraAr
     }
     if !camera.is_valid() {
         bail!("the camera is degenerate: it must look somewhere other than its own position, and not along --up");
+    }
+    // The automatic framing avoids such views itself; a camera from the file
+    // or the options is kept, but said to be buried.
+    if !automatic && let Some(fraction) = camera_blocked(scene, accel, &camera, aspect) {
+        eprintln!(
+            "warning: the camera seems to be inside geometry: {:.0}% of the rays through its view hit the back of a \
+             surface or start against one; move it with --at (and --look)",
+            100.0 * fraction
+        );
     }
     Ok(camera)
 }

@@ -8,7 +8,7 @@ use rtgi_image::{HdrImage, OutputFormat, ToneMap, check_writable, heat_colour};
 use rtgi_render::render_traversal_cost;
 
 use crate::cli::{BvhBoxesArgs, HeatmapArgs};
-use crate::common::{LoadedScene, check_output_folder, choose_camera, load_scene, thread_pool, write_atomically};
+use crate::common::{LoadedScene, check_output_folder, choose_camera, load_scene, write_atomically};
 use crate::output::outln;
 
 /// Writes the boxes of the chosen levels as OBJ: eight corners and six
@@ -77,7 +77,7 @@ pub(crate) fn heatmap(args: &HeatmapArgs) -> Result<()> {
         );
     }
     let LoadedScene { scene, name, .. } = load_scene(args.scene.as_deref())?;
-    let pool = thread_pool(args.threads)?;
+    let pool = args.threads.pool()?;
     let accel = pool.install(|| args.accel.build(&scene))?;
     let camera = choose_camera(&scene, accel.as_ref(), &args.camera, args.size.aspect())?;
     let (counts, total) =

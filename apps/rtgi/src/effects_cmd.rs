@@ -15,7 +15,7 @@ use rtgi_render::{EffectPlan, RenderSettings, render};
 use serde::Serialize;
 
 use crate::cli::BenchEffectsArgs;
-use crate::common::{LoadedScene, apply_lighting, check_output_folder, choose_camera, load_scene, thread_pool};
+use crate::common::{LoadedScene, apply_lighting, check_output_folder, choose_camera, load_scene};
 use crate::output::{out, outln};
 
 #[derive(Debug, Serialize)]
@@ -60,7 +60,7 @@ pub(crate) fn run(args: &BenchEffectsArgs) -> Result<()> {
     // and returned at the end, and nothing more is printed after it.
     let mut printed = out!("{plan}");
 
-    let pool = thread_pool(args.threads)?;
+    let pool = args.threads.pool()?;
     let accel = pool.install(|| args.accel.build(&scene))?;
     let camera = choose_camera(&scene, accel.as_ref(), &args.camera, args.size.aspect())?;
     let measure = |settings: &RenderSettings| -> (f64, HdrImage) {

@@ -13,7 +13,7 @@ use rtgi_experiment::{IndexEntry, Knob, Options, Report, Subject};
 use rtgi_render::{PixelSampler, RenderSettings};
 
 use crate::cli::{ExperimentArgs, KnobChoice};
-use crate::common::{LoadedScene, apply_lighting, choose_camera, load_scene, thread_pool};
+use crate::common::{LoadedScene, apply_lighting, choose_camera, load_scene};
 use crate::output::outln;
 
 /// The shared scenes of the report, relative to the scenes folder.
@@ -61,7 +61,7 @@ pub(crate) fn run(args: &ExperimentArgs) -> Result<()> {
             bail!("{option} {}: exists and is not a folder", folder.display());
         }
     }
-    let pool = thread_pool(args.threads)?;
+    let pool = args.threads.pool()?;
     let options = Options {
         repeats: args.repeats as usize,
         quick: args.quick,

@@ -10,6 +10,7 @@ mod debug_cmd;
 mod default_scene;
 mod effects_cmd;
 mod experiment_cmd;
+mod gallery_cmd;
 mod info_cmd;
 mod interrupt;
 mod merge_cmd;
@@ -42,6 +43,7 @@ pub fn main() -> ExitCode {
         cli::Command::Verify(args) => verify_cmd::run(&args),
         cli::Command::Experiment(args) => experiment_cmd::run(&args),
         cli::Command::Merge(args) => merge_cmd::run(&args),
+        cli::Command::Gallery(args) => gallery_cmd::run(&args),
     };
     // Whatever the command printed last may still sit in the buffer.
     let result = result.and_then(|()| output::flush());

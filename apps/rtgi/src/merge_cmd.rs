@@ -4,11 +4,11 @@ use std::path::PathBuf;
 
 use anyhow::{Context, Result, bail};
 use clap::Args;
-use rtgi_image::{ToneMap, ToneOperator};
 use rtgi_render::Accumulation;
 
+use crate::cli::ToneArgs;
 use crate::output::outln;
-use crate::render_cmd::{check_output, is_accumulation};
+use crate::render_cmd::{check_output, is_accumulation, tone_map};
 
 /// `rtgi merge`: accumulations (.accum) of one render into its image.
 #[derive(Debug, Args)]
@@ -21,13 +21,8 @@ pub(crate) struct MergeArgs {
     #[arg(short, long)]
     pub(crate) output: PathBuf,
 
-    /// Exposure in stops, for PNG output
-    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
-    pub(crate) exposure: f32,
-
-    /// Tone map for PNG output: clamp, reinhard, aces
-    #[arg(long, default_value = "clamp")]
-    pub(crate) tonemap: ToneOperator,
+    #[command(flatten)]
+    pub(crate) tone: ToneArgs,
 }
 
 pub(crate) fn run(args: &MergeArgs) -> Result<()> {
@@ -63,8 +58,12 @@ pub(crate) fn run(args: &MergeArgs) -> Result<()> {
                 identity.height
             );
         }
-        let tone_map = ToneMap { exposure: args.exposure, operator: args.tonemap };
-        merged.image().write(&args.output, &tone_map).context("cannot write the merged image")?;
+        let image = merged.image();
+        let simulates_light = identity.settings.get("integrator").is_some_and(|name| {
+            name.parse::<rtgi_render::Integrator>().is_ok_and(|integrator| integrator.simulates_light())
+        });
+        let tone_map = tone_map(&args.tone, simulates_light, &image);
+        image.write(&args.output, &tone_map).context("cannot write the merged image")?;
     }
     outln!("parts       {}", args.parts.len())?;
     outln!(

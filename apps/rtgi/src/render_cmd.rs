@@ -2,13 +2,19 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use anyhow::{Result, bail};
-use rtgi_image::{ToneMap, check_writable};
-use rtgi_render::{Accumulation, EffectPlan, Integrator, PixelSampler, RenderIdentity, RenderSettings, render};
+use rtgi_image::{
+    HdrImage, Legibility, OutputFormat, ToneMap, ToneOperator, auto_exposure, check_writable, legibility,
+};
+use rtgi_render::{
+    Accumulation, ENCLOSED, EffectPlan, Integrator, PixelSampler, RenderIdentity, RenderSettings, render, room_light,
+    sky_visibility,
+};
+use rtgi_scene::{Camera, Light, Scene};
 
-use crate::cli::EnvironmentArg;
 use crate::cli::RenderArgs;
+use crate::cli::{EnvironmentArg, ToneArgs};
 use crate::common::{
-    LoadedScene, apply_lighting, check_output_folder, choose_camera, load_scene, refuse_inputs_as_outputs, thread_pool,
+    LoadedScene, apply_lighting, check_output_folder, choose_camera, load_scene, refuse_inputs_as_outputs,
 };
 use crate::interrupt;
 use crate::output::{out, outln};
@@ -35,11 +41,24 @@ pub(crate) fn check_output(path: &Path) -> Result<()> {
 }
 
 pub(crate) fn run(args: &RenderArgs) -> Result<()> {
+    render_image(args).map(|_| ())
+}
+
+/// What `rtgi render` made: the image and how its PNG was tone-mapped
+/// (`None` when no sample finished).
+pub(crate) struct Rendered {
+    pub(crate) image: Option<(HdrImage, ToneMap)>,
+}
+
+/// `rtgi render`, returning the image it wrote.
+pub(crate) fn render_image(args: &RenderArgs) -> Result<Rendered> {
     let started = Instant::now();
     let job = &args.job;
+    let output = args.output();
+    let (width, height, spp) = args.resolution();
     // Refuse unusable outputs and options before spending time on loading and rendering.
-    check_output(&args.output)?;
-    if job.is_part() && !is_accumulation(&args.output) {
+    check_output(&output)?;
+    if job.is_part() && !is_accumulation(&output) {
         bail!(
             "--samples and --tile render a part of an image: write it to an .{ACCUMULATION_EXTENSION} file \
              (-o part.{ACCUMULATION_EXTENSION}) and put the parts together with 'rtgi merge'"
@@ -49,14 +68,14 @@ pub(crate) fn run(args: &RenderArgs) -> Result<()> {
         bail!("--aov is for whole renders, not with --samples or --tile");
     }
     let aov_outputs: Vec<(Integrator, PathBuf)> =
-        args.aov.iter().map(|&kind| Ok((kind, aov_path(&args.output, kind)?))).collect::<Result<_>>()?;
+        args.aov.iter().map(|&kind| Ok((kind, aov_path(&output, kind)?))).collect::<Result<_>>()?;
     for (_, path) in &aov_outputs {
         check_writable(path)?;
     }
     if let Some(path) = &job.checkpoint {
         check_output_folder(path)?;
     }
-    let outputs: Vec<(&str, &Path)> = [("-o", args.output.as_path())]
+    let outputs: Vec<(&str, &Path)> = [("-o", output.as_path())]
         .into_iter()
         .chain(aov_outputs.iter().map(|(_, path)| ("--aov", path.as_path())))
         .chain(job.checkpoint.as_deref().map(|path| ("--checkpoint", path)))
@@ -67,14 +86,13 @@ pub(crate) fn run(args: &RenderArgs) -> Result<()> {
     }
     refuse_inputs_as_outputs(&outputs, &inputs)?;
     let resumed = job.resume.as_deref().map(Accumulation::read).transpose()?;
-    check_memory(args.size.width, args.size.height)?;
+    check_memory(width, height)?;
 
     let LoadedScene { mut scene, name: scene_name, load_ms } = load_scene(args.scene.as_deref())?;
 
-    let spp = args.spp.unwrap_or(if args.lighting.integrator.simulates_light() { 16 } else { 1 });
     let mut settings = RenderSettings {
-        width: args.size.width,
-        height: args.size.height,
+        width,
+        height,
         samples_per_pixel: spp,
         sampler: args.sampler.unwrap_or(if spp == 1 { PixelSampler::Center } else { PixelSampler::Stratified }),
         seed: args.seed,
@@ -83,6 +101,12 @@ pub(crate) fn run(args: &RenderArgs) -> Result<()> {
     };
     apply_lighting(&args.lighting, &mut scene, &mut settings)?;
     let (rows, samples) = job.share(settings.height, spp)?;
+    let pool = args.threads.pool()?;
+
+    let accel = pool.install(|| args.accel.build(&scene))?;
+    let camera = choose_camera(&scene, accel.as_ref(), &args.camera, width as f32 / height as f32)?;
+    let room_light = light_enclosed_camera(&mut scene, accel.as_ref(), &camera, &settings);
+
     // What is printed goes on standard output; a reader that goes away
     // (`| head`) does not stop the render, and the first failed write is
     // returned once the outputs are written.
@@ -92,11 +116,13 @@ pub(crate) fn run(args: &RenderArgs) -> Result<()> {
             printed = printed.and_then(|()| outln!($($arg)*))
         };
     }
-
-    let pool = thread_pool(args.threads)?;
-
-    let accel = pool.install(|| args.accel.build(&scene))?;
-    let camera = choose_camera(&scene, accel.as_ref(), &args.camera, args.size.aspect())?;
+    if let Some(light) = room_light {
+        say!(
+            "  note: the camera is enclosed by the scene (no sky reaches it) and nothing emits light, so a point \
+             light {:.3?} above it lights the room; --light or --environment chooses others",
+            light.position - camera.position
+        );
+    }
     let identity = RenderIdentity::new(&scene, &camera, &settings);
     let mut accumulation = match resumed {
         None => Accumulation::new(identity, rows.clone(), samples.start),
@@ -147,12 +173,17 @@ pub(crate) fn run(args: &RenderArgs) -> Result<()> {
         accumulation.write(path)?;
         say!("checkpoint  {} ({} of {} samples per pixel)", path.display(), accumulation.samples().end, samples.end);
     }
-    let tone_map = ToneMap { exposure: args.exposure, operator: args.tonemap };
-    let wrote_output = if is_accumulation(&args.output) {
-        accumulation.write(&args.output)?;
+    let simulates_light = settings.integrator.simulates_light();
+    let image = (done > 0).then(|| accumulation.image());
+    let tone_map = match &image {
+        Some(image) => tone_map(&args.tone, simulates_light, image),
+        None => ToneMap::default(),
+    };
+    let wrote_output = if is_accumulation(&output) {
+        accumulation.write(&output)?;
         true
-    } else if done > 0 {
-        accumulation.image().write(&args.output, &tone_map)?;
+    } else if let Some(image) = &image {
+        image.write(&output, &tone_map)?;
         true
     } else {
         false
@@ -194,7 +225,14 @@ pub(crate) fn run(args: &RenderArgs) -> Result<()> {
     }
     if wrote_output {
         let partial = if done < samples.len() as u32 { format!(" ({done} samples per pixel)") } else { String::new() };
-        say!("wrote       {}{partial}", args.output.display());
+        say!("wrote       {}{partial}", output.display());
+        if OutputFormat::from_path(&output).is_ok_and(|f| f == OutputFormat::Png) {
+            let how = if args.tone.exposure.is_some() { "--exposure" } else { "automatic; --exposure sets it" };
+            say!("exposure    {:+.1} stops ({how}), {} tone map", tone_map.exposure, tone_map.operator);
+        }
+        if let Some(image) = &image {
+            warn_if_illegible(image, &tone_map, args.tone.exposure.is_some());
+        }
     } else {
         say!("wrote       nothing: no sample finished");
     }
@@ -208,8 +246,64 @@ pub(crate) fn run(args: &RenderArgs) -> Result<()> {
     match ending {
         Ending::Signal(signal) => Err(StoppedBySignal(signal).into()),
         Ending::TimeLimit if !wrote_output => bail!("no sample finished within the time limit"),
-        _ => printed,
+        _ => printed.map(|()| Rendered { image: image.map(|image| (image, tone_map)) }),
     }
+}
+
+/// Says so when the image came out almost black or almost white, with the
+/// options that help.
+fn warn_if_illegible(image: &HdrImage, tone_map: &ToneMap, exposure_given: bool) {
+    match legibility(image, tone_map) {
+        Some(Legibility::AlmostBlack(fraction)) => {
+            let exposure = if exposure_given { "raise --exposure, or " } else { "" };
+            eprintln!(
+                "warning: the image is almost black ({:.0}% of its pixels): the scene's lights may be too weak \
+                 or hidden from the view, or the camera inside geometry; {exposure}add light (--environment \
+                 1,1,1 or --light), or move the camera (--at, --look)",
+                100.0 * fraction
+            );
+        }
+        Some(Legibility::AlmostWhite(fraction)) => {
+            let exposure =
+                if exposure_given { "lower --exposure or leave it out (automatic)" } else { "lower --exposure" };
+            eprintln!(
+                "warning: the image is almost white ({:.0}% of its pixels): {exposure}, or use --tonemap aces",
+                100.0 * fraction
+            );
+        }
+        None => {}
+    }
+}
+
+/// For a camera that no sky can reach (a closed room) in a scene that
+/// would get the default sky and sun, adds a point light above the camera
+/// ([`room_light`]) and returns it: otherwise the image would be black.
+fn light_enclosed_camera(
+    scene: &mut Scene,
+    accel: &dyn rtgi_accel::Accel,
+    camera: &Camera,
+    settings: &RenderSettings,
+) -> Option<Light> {
+    if !EffectPlan::new(scene, settings).default_environment || sky_visibility(accel, camera.position) >= ENCLOSED {
+        return None;
+    }
+    let light = room_light(scene, accel, camera.position);
+    scene.lights.push(light.clone());
+    Some(light)
+}
+
+/// The exposure and tone map of an image's PNG: as the options say, else
+/// for light transport a filmic curve at an exposure chosen from the image
+/// ([`auto_exposure`]), for other integrators (albedo, normals, ...) the
+/// values as they are.
+pub(crate) fn tone_map(args: &ToneArgs, simulates_light: bool, image: &HdrImage) -> ToneMap {
+    let operator = args.tonemap.unwrap_or(if simulates_light { ToneOperator::Aces } else { ToneOperator::Clamp });
+    let exposure = match args.exposure {
+        Some(stops) => stops,
+        None if simulates_light => auto_exposure(image),
+        None => 0.0,
+    };
+    ToneMap { exposure, operator }
 }
 
 /// Refuses an image too large for this machine's memory before anything is

@@ -9,7 +9,7 @@ use rtgi_accel::Accel;
 use rtgi_math::{Ray, Vec3};
 
 use crate::cli::TraceArgs;
-use crate::common::{LoadedScene, check_output_folder, load_scene, refuse_inputs_as_outputs, thread_pool};
+use crate::common::{LoadedScene, check_output_folder, load_scene, refuse_inputs_as_outputs};
 
 /// Bytes of one ray in a ray file: 8 little-endian f32.
 pub(crate) const RAY_BYTES: usize = 32;
@@ -36,7 +36,7 @@ pub(crate) fn run(args: &TraceArgs) -> Result<()> {
     let mut more = input.next_chunk(&mut rays)?;
     let LoadedScene { scene, load_ms, .. } = load_scene(Some(&args.scene))?;
 
-    let pool = thread_pool(args.threads)?;
+    let pool = args.threads.pool()?;
     let build_start = Instant::now();
     let accel = pool.install(|| args.accel.build(&scene))?;
     let build_ms = build_start.elapsed().as_secs_f64() * 1e3;

@@ -10,7 +10,7 @@ use rtgi_accel::{Accel, AccelKind, BuildParams, Intersector, LinearScan, Travers
 use serde::Serialize;
 
 use crate::cli::VerifyArgs;
-use crate::common::{check_output_folder, load_scene, thread_pool, write_atomically};
+use crate::common::{check_output_folder, load_scene, write_atomically};
 use crate::output::outln;
 
 /// One row of the table: a ray kind, summed over scenes and structures.
@@ -91,7 +91,7 @@ pub(crate) fn run(args: &VerifyArgs) -> Result<()> {
     if intersectors.is_empty() {
         intersectors.push(args.build.intersector);
     }
-    let pool = thread_pool(args.threads)?;
+    let pool = args.threads.pool()?;
     let start = Instant::now();
 
     let mut kinds: BTreeMap<String, KindRow> = BTreeMap::new();

@@ -1,0 +1,83 @@
+//! `rtgi gallery`: a contact sheet of scenes rendered as `rtgi render
+//! SCENE` renders them with no options, to look at every default at once.
+
+use std::path::PathBuf;
+
+use anyhow::{Context, Result};
+use clap::{Args, Parser};
+use rtgi_image::{HdrImage, ToneMap};
+
+use crate::cli::{Cli, Command};
+use crate::output::outln;
+use crate::render_cmd::{check_output, render_image};
+
+/// `rtgi gallery`: scenes side by side, each as a first `rtgi render` shows it.
+#[derive(Debug, Args)]
+pub(crate) struct GalleryArgs {
+    /// Scene files (.obj, .gltf, .glb or .toml)
+    #[arg(required = true)]
+    pub(crate) scenes: Vec<PathBuf>,
+
+    /// The contact sheet (.png)
+    #[arg(short, long)]
+    pub(crate) output: PathBuf,
+
+    /// Width of each picture
+    #[arg(long, default_value_t = 320, value_parser = clap::value_parser!(u32).range(16..=2048))]
+    pub(crate) width: u32,
+
+    /// Height of each picture
+    #[arg(long, default_value_t = 240, value_parser = clap::value_parser!(u32).range(16..=2048))]
+    pub(crate) height: u32,
+
+    /// Pictures per row
+    #[arg(long, default_value_t = 4, value_parser = clap::value_parser!(u32).range(1..=64))]
+    pub(crate) columns: u32,
+}
+
+/// Grey between the pictures, in pixels.
+const GAP: u32 = 4;
+
+pub(crate) fn run(args: &GalleryArgs) -> Result<()> {
+    check_output(&args.output)?;
+    let scratch = std::env::temp_dir().join(format!("rtgi-gallery-{}", std::process::id()));
+    std::fs::create_dir_all(&scratch).with_context(|| format!("{}: cannot create", scratch.display()))?;
+    let mut pictures = Vec::new();
+    for (index, scene) in args.scenes.iter().enumerate() {
+        outln!("== {}", scene.display())?;
+        // Exactly what a user would type, so the sheet shows the real defaults.
+        let picture = scratch.join(format!("{index}.png"));
+        let command = [
+            "rtgi".into(),
+            "render".into(),
+            scene.clone().into_os_string(),
+            "-o".into(),
+            picture.clone().into_os_string(),
+            "--width".into(),
+            args.width.to_string().into(),
+            "--height".into(),
+            args.height.to_string().into(),
+        ];
+        let Command::Render(render) = Cli::try_parse_from(command)?.command else { unreachable!("a render command") };
+        pictures.push(render_image(&render)?.image);
+    }
+    let _ = std::fs::remove_dir_all(&scratch);
+
+    let (w, h, columns) = (args.width, args.height, args.columns.min(pictures.len() as u32).max(1));
+    let rows = (pictures.len() as u32).div_ceil(columns);
+    let mut sheet = HdrImage::new(columns * w + (columns + 1) * GAP, rows * h + (rows + 1) * GAP);
+    sheet.pixels_mut().fill(rtgi_math::Vec3::splat(0.2));
+    for (index, picture) in pictures.iter().enumerate() {
+        let (x0, y0) = (GAP + (index as u32 % columns) * (w + GAP), GAP + (index as u32 / columns) * (h + GAP));
+        let Some((image, tone_map)) = picture else { continue };
+        for y in 0..h.min(image.height()) {
+            for x in 0..w.min(image.width()) {
+                // Tone-mapped here: the sheet is written with the identity map.
+                sheet.set(x0 + x, y0 + y, tone_map.apply(image.get(x, y)));
+            }
+        }
+    }
+    sheet.write(&args.output, &ToneMap::default())?;
+    outln!("wrote       {} ({} scenes)", args.output.display(), pictures.len())?;
+    Ok(())
+}
