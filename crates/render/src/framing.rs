@@ -116,9 +116,10 @@ pub fn camera_blocked<A: Accel + ?Sized>(scene: &Scene, accel: &A, camera: &Came
             let Some(hit) = accel.intersect(&ray) else { continue };
             let triangle = &scene.triangles[hit.triangle as usize];
             let [a, b, c] = triangle.vertices.map(|v| scene.vertices[v as usize].position);
+            // The winding decides, even for double-sided materials: a leaf
+            // seen from behind is fine, a view made mostly of backs is not.
             let back_face = (b - a).cross(c - a).dot(ray.direction) > 0.0;
-            let double_sided = scene.materials.get(triangle.material as usize).is_some_and(|m| m.double_sided);
-            if (back_face && !double_sided) || hit.t * ray.direction.length() < near {
+            if back_face || hit.t * ray.direction.length() < near {
                 blocked += 1;
             }
         }

@@ -1,0 +1,123 @@
+//! What a first render says and chooses by itself: warnings for images
+//! that show nothing, a light for an enclosed unlit view, the default
+//! output name, and option errors that name the choices.
+
+use std::path::Path;
+use std::process::Command;
+
+use rtgi_tests::{Run, run_cli, scratch_dir, workspace_root};
+
+const RTGI: &str = env!("CARGO_BIN_EXE_rtgi-under-test");
+const ROOM: &str = "tests/scenes/closed-room.toml";
+
+fn rtgi(args: &[&str]) -> Run {
+    run_cli(RTGI, args)
+}
+
+fn path_str(p: &Path) -> &str {
+    p.to_str().expect("scratch paths are UTF-8")
+}
+
+fn render_room(out: &Path, extra: &[&str]) -> Run {
+    let mut args = vec!["render", ROOM, "-o", path_str(out), "--width", "32", "--height", "32", "--spp", "2"];
+    args.extend(extra);
+    rtgi(&args)
+}
+
+#[test]
+fn a_room_lit_only_from_outside_is_said_to_be_almost_black() {
+    let dir = scratch_dir("almost-black");
+    let run = render_room(&dir.join("black.png"), &["--light", "point:5,5,5:100"]);
+    assert!(run.success, "{run:?}");
+    assert!(run.stderr.contains("warning: the image is almost black (100% of its pixels)"), "{run:?}");
+    assert!(run.stderr.contains("--environment") && run.stderr.contains("--at"), "{run:?}");
+}
+
+#[test]
+fn an_overexposed_image_is_said_to_be_almost_white() {
+    let dir = scratch_dir("almost-white");
+    let run = render_room(&dir.join("white.png"), &["--light", "point:0,0.5,0:100", "--exposure", "12"]);
+    assert!(run.success, "{run:?}");
+    assert!(run.stderr.contains("warning: the image is almost white"), "{run:?}");
+    assert!(run.stderr.contains("lower --exposure"), "{run:?}");
+    // Left to the automatic exposure, the same light gives an image that shows something.
+    let run = render_room(&dir.join("auto.png"), &["--light", "point:0,0.5,0:100"]);
+    assert!(run.success && !run.stderr.contains("warning"), "{run:?}");
+    assert!(run.stdout.contains("(automatic; --exposure sets it), aces tone map"), "{run:?}");
+}
+
+#[test]
+fn an_enclosed_unlit_view_gets_a_room_light_and_says_so() {
+    let dir = scratch_dir("room-light");
+    let run = render_room(&dir.join("room.png"), &[]);
+    assert!(run.success, "{run:?}");
+    assert!(run.stdout.contains("note: the camera is enclosed by the scene"), "{run:?}");
+    assert!(!run.stderr.contains("almost black"), "{run:?}");
+}
+
+#[test]
+fn a_camera_that_sees_only_the_backs_of_faces_is_said_to_be_inside_geometry() {
+    let dir = scratch_dir("buried-camera");
+    let run = render_room(&dir.join("outside.png"), &["--at", "0,0,1.5", "--look", "0,0,0"]);
+    assert!(run.success, "{run:?}");
+    assert!(run.stderr.contains("warning: the camera seems to be inside geometry"), "{run:?}");
+}
+
+#[test]
+fn without_o_the_image_is_named_after_the_scene_in_the_current_folder() {
+    let dir = scratch_dir("default-output");
+    let scene = workspace_root().join(ROOM);
+    let run: Run = Command::new(RTGI)
+        .args(["render", path_str(&scene), "--quick", "-t", "1"])
+        .current_dir(&dir)
+        .output()
+        .unwrap()
+        .into();
+    assert!(run.success, "{run:?}");
+    let image = image::open(dir.join("closed-room.png")).expect("closed-room.png in the current folder");
+    // --quick: a quarter of the default 512 x 512.
+    assert_eq!((image.width(), image.height()), (128, 128));
+    assert!(run.stdout.contains("at 4 spp"), "{run:?}");
+}
+
+#[test]
+fn a_wrong_aov_name_lists_the_aovs() {
+    let run = rtgi(&["render", "--aov", "normals", "-o", "x.png"]);
+    assert_eq!(run.code, Some(2), "{run:?}");
+    assert!(
+        run.stderr
+            .contains("'normals' is not an output variable (expected one of albedo, normal, depth, position, cost)"),
+        "{run:?}"
+    );
+}
+
+#[test]
+fn the_readmes_trace_example_runs_on_rays_written_by_rtgi_rays() {
+    let dir = scratch_dir("rays-then-trace");
+    for (kind, expected) in [("camera", 24 * 16), ("random", 500), ("surface", 500)] {
+        let (rays, hits) = (dir.join(format!("{kind}.bin")), dir.join(format!("{kind}.hits")));
+        let run = rtgi(&[
+            "rays",
+            "scenes/cornell-box.toml",
+            "--kind",
+            kind,
+            "--count",
+            "500",
+            "--width",
+            "24",
+            "--height",
+            "16",
+            "-o",
+            path_str(&rays),
+        ]);
+        assert!(run.success, "{run:?}");
+        assert_eq!(std::fs::metadata(&rays).unwrap().len(), expected * 32, "{kind}");
+        let run = rtgi(&["trace", "scenes/cornell-box.toml", "--rays", path_str(&rays), "--out", path_str(&hits)]);
+        assert!(run.success, "{run:?}");
+        assert_eq!(std::fs::metadata(&hits).unwrap().len(), expected * 16, "{kind}");
+        // Camera rays into the closed box all hit; surface rays mostly do.
+        if kind == "camera" {
+            assert!(run.stderr.contains(&format!("{expected} hits")), "{run:?}");
+        }
+    }
+}
