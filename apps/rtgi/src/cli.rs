@@ -25,6 +25,9 @@ pub(crate) enum Command {
     Render(RenderArgs),
     /// Trace a batch of rays from a binary file and write their hits
     Trace(TraceArgs),
+    /// Write a ray file for 'rtgi trace': camera rays of a scene's view, random rays in its
+    /// bounds, or rays leaving its surfaces
+    Rays(crate::rays_cmd::RaysArgs),
     /// Measure build time, tree quality and ray throughput of acceleration structures
     Bench(BenchArgs),
     /// Export the boxes of chosen BVH levels as an OBJ file, to look at the tree

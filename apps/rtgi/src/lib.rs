@@ -16,6 +16,7 @@ mod interrupt;
 mod merge_cmd;
 mod output;
 mod progress;
+mod rays_cmd;
 mod render_cmd;
 mod render_job;
 mod trace_cmd;
@@ -44,6 +45,7 @@ pub fn main() -> ExitCode {
         cli::Command::Experiment(args) => experiment_cmd::run(&args),
         cli::Command::Merge(args) => merge_cmd::run(&args),
         cli::Command::Gallery(args) => gallery_cmd::run(&args),
+        cli::Command::Rays(args) => rays_cmd::run(&args),
     };
     // Whatever the command printed last may still sit in the buffer.
     let result = result.and_then(|()| output::flush());
