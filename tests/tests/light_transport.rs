@@ -278,14 +278,24 @@ fn plans_name_what_each_scene_needs() {
     // The primary integrator needs no light at all.
     let primary = EffectPlan::new(&scene, &RenderSettings { integrator: Integrator::Primary, ..Default::default() });
     assert!(!primary.has(Effect::DirectLight) && !primary.has(Effect::Indirect));
-    // Without lights or emitters, a white sky lights the scene, and says so.
+    // Without lights or emitters, a default sky and sun light the scene, and say so.
     let mut dark = scene.clone();
     for m in &mut dark.materials {
         m.emission = Vec3::ZERO;
     }
     let plan = EffectPlan::new(&dark, &RenderSettings::default());
     assert!(plan.default_environment && plan.has(Effect::Environment), "{plan}");
-    assert!(plan.to_string().contains("uniform white sky"));
+    assert!(plan.to_string().contains("a default sky (blue overhead, grey ground) and a sun"), "{plan}");
+    // Emitters far too weak to light the scene keep the sky, and the plan says how weak.
+    let mut glowing = scene.clone();
+    for m in &mut glowing.materials {
+        m.emission *= 1e-5;
+    }
+    let plan = EffectPlan::new(&glowing, &RenderSettings::default());
+    assert!(plan.default_environment && plan.has(Effect::Emission), "{plan}");
+    assert!(plan.to_string().contains("of the light a sky would, too little to light it"), "{plan}");
+    // The Cornell box's own light is strong enough to light it.
+    assert!(!EffectPlan::new(&scene, &RenderSettings::default()).default_environment);
     // Forcing shows in the plan.
     let forced = RenderSettings { effects: "+glossy,-indirect".parse().unwrap(), ..Default::default() };
     let plan = EffectPlan::new(&scene, &forced);
