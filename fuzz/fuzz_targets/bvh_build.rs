@@ -4,7 +4,7 @@
 //! build parameters, then queried with a few rays: nothing may panic.
 
 use libfuzzer_sys::fuzz_target;
-use rtgi_accel::{Accel, AccelKind, BuildParams, Intersector, Traversal};
+use rtgi_accel::{AccelKind, BuildParams, Intersector, Traversal};
 use rtgi_math::{Ray, Vec3};
 
 /// Values that make geometry degenerate or extreme.
