@@ -9,7 +9,7 @@
 //! Statements read: `newmtl`; the colours `Ka`, `Kd`, `Ks`, `Ke`, `Tf` (one
 //! number for grey or three for RGB, as the MTL specification allows; the
 //! `spectral` and `xyz` forms are warned about and skipped); `Ns`, `Ni`,
-//! `d` (with `-halo`), `Tr` (1 − d), `illum` (0–10), `sharpness`; the PBR
+//! `d` (with `-halo`), `Tr` (1 − d, where the material has no `d`), `illum` (0–10), `sharpness`; the PBR
 //! extension's `Pr`, `Pm`, `Ps`, `Pc`, `Pcr`, `aniso`, `anisor`; and texture
 //! maps (`map_Kd`, `map_Ka`, `map_Ks`, `map_Ke`, `map_Ns`, `map_d`, `map_Pr`,
 //! `map_Pm`, `map_Ps`, `map_bump`, `bump`, `disp`, `decal`, `norm`, `refl`)
@@ -35,6 +35,8 @@ pub(crate) struct MtlMaterial {
     pub(crate) illumination_model: Option<u8>,
     /// The file name of `map_Kd`, without its options.
     pub(crate) diffuse_texture: Option<String>,
+    /// Whether `dissolve` came from a `d` statement (which `Tr` does not override).
+    has_d: bool,
 }
 
 /// The materials of one file, in file order, and the statements that could not be read.
@@ -77,6 +79,9 @@ pub(crate) fn parse(text: &str, file: &str) -> MtlLibrary {
             continue;
         }
         let (keyword, rest) = line.split_once(char::is_whitespace).unwrap_or((line, ""));
+        // A comment may end a statement (`Ka 0.63 0.065 0.05 # Red`), except
+        // a map's, whose file name may hold a '#'.
+        let rest = if MAPS.contains(&keyword) { rest } else { rest.split('#').next().unwrap_or("") };
         let rest = rest.trim();
         let warn = |library: &mut MtlLibrary, why: &str| {
             library.warnings.push(format!("{file}:{}: '{}': {why}; the statement is ignored", number + 1, short(line)));
@@ -104,10 +109,17 @@ pub(crate) fn parse(text: &str, file: &str) -> MtlLibrary {
             "Ka" | "Tf" => color(rest).map(drop),
             "Ns" => number_of(rest).map(|n| material.shininess = Some(n)),
             "Ni" => number_of(rest).map(|n| material.optical_density = Some(n)),
-            "d" => {
-                number_of(rest.strip_prefix("-halo").map_or(rest, str::trim_start)).map(|n| material.dissolve = Some(n))
-            }
-            "Tr" => number_of(rest).map(|n| material.dissolve = Some(1.0 - n)),
+            "d" => number_of(rest.strip_prefix("-halo").map_or(rest, str::trim_start)).map(|n| {
+                material.dissolve = Some(n);
+                material.has_d = true;
+            }),
+            // Exporters disagree on whether Tr is 1 - d or d itself, so
+            // `d` wins where a material has both (as tobj, which ignored Tr).
+            "Tr" => number_of(rest).map(|n| {
+                if !material.has_d {
+                    material.dissolve = Some(1.0 - n);
+                }
+            }),
             "illum" => match rest.parse::<u8>() {
                 Ok(n) if n <= 10 => {
                     material.illumination_model = Some(n);
@@ -230,7 +242,7 @@ mod tests {
     #[test]
     fn reads_the_fields_and_map_options() {
         let text = "# c\nnewmtl a\nKd 0.5 0.25 1\nKs 0.5\nKe 1 2 3\nNs 10\nNi 1.33\nd -halo 0.5\nillum 3\n\
-                    map_Kd -bm 0.5 -s 1 2 -o 0.1 -clamp on my wall.jpg\nnewmtl b\nTr 0.25\nmap_Kd b.png\n";
+                    map_Kd -bm 0.5 -s 1 2 -o 0.1 -clamp on my wall.jpg\nTr 1\nnewmtl b\nTr 0.25\nmap_Kd b.png\n";
         let library = parse(text, "m.mtl");
         assert!(library.warnings.is_empty(), "{:?}", library.warnings);
         let [a, b] = &library.materials[..] else { panic!("{:?}", library.materials) };
@@ -245,7 +257,7 @@ mod tests {
 
     #[test]
     fn bad_statements_are_warnings_naming_line_and_token() {
-        let text = "newmtl a\nKd 0.5 0.5\nKs 1 x 1\nNs\nmap_Kd -bm\nnewmtl b\nKd 0.1 0.2 0.3\n";
+        let text = "newmtl a\nKd 0.5 0.5\nKs 1 x 1\nNs\nmap_Kd -bm\nnewmtl b\nKd 0.1 0.2 0.3 # blue\n";
         let library = parse(text, "car.mtl");
         assert_eq!(library.materials.len(), 2);
         assert_eq!(library.materials[1].diffuse, Some(Vec3::new(0.1, 0.2, 0.3)));
