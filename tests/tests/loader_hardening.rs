@@ -236,6 +236,16 @@ fn obj_texture_and_mtl_references_outside_the_folder_are_refused() {
     }
     // Both became the missing-texture checkerboard: nothing was decoded.
     assert!(scene.textures.iter().all(|t| t.width() == 8), "{:?}", scene.textures);
+    // A material library outside the folder is refused too.
+    std::fs::write(root.join("outside.mtl"), "newmtl up\nKd 1 0 0\n").unwrap();
+    std::fs::write(dir.join("u.obj"), obj_using(&["up"]).replace("mtllib m.mtl", "mtllib ../outside.mtl")).unwrap();
+    let scene = load(&dir.join("u.obj")).unwrap();
+    assert!(scene.materials.iter().all(|m| m.name != "up"), "{:?}", scene.materials);
+    assert!(
+        scene.warnings.iter().any(|w| w.contains("../outside.mtl") && w.contains("refusing")),
+        "{:?}",
+        scene.warnings
+    );
 }
 
 #[cfg(unix)]
