@@ -1,6 +1,8 @@
 //! Helpers shared by the end-to-end tests: finding the shared scenes,
 //! running the CLI, scratch folders.
 
+pub mod corpus;
+
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 

@@ -1,7 +1,7 @@
 //! A small TOML scene description: the meshes to merge and a camera.
 //!
 //! ```toml
-//! # Paths are relative to this file.
+//! # Paths are relative to this file, and must lie inside its folder.
 //! [[mesh]]
 //! file = "cornell-box/cornell-box.obj"
 //!
@@ -13,11 +13,12 @@
 //! aspect = 1.0                       # optional: width / height
 //! ```
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use rtgi_math::Vec3;
 use serde::Deserialize;
 
+use crate::files::{Files, MAX_NESTING};
 use crate::{Camera, Scene, SceneError};
 
 /// The parsed contents of a scene description file.
@@ -94,13 +95,37 @@ impl CameraEntry {
 }
 
 /// Loads a description and every mesh it lists, merged in the listed order.
-pub(crate) fn load(path: &Path) -> Result<Scene, SceneError> {
-    let text = std::fs::read_to_string(path).map_err(|source| SceneError::Io { path: path.to_owned(), source })?;
-    let description = Description::parse(&text, path)?;
-    let folder = path.parent().unwrap_or(Path::new("."));
+/// Meshes are read through `files`, so they too must lie inside the folder
+/// of the scene file that was opened; descriptions may include one another
+/// to a depth of 8.
+pub(crate) fn load(
+    bytes: &[u8],
+    path: &Path,
+    files: &Files<'_>,
+    sources: &mut Vec<PathBuf>,
+) -> Result<Scene, SceneError> {
+    let error = |message: String| SceneError::Description { path: path.to_owned(), message };
+    let text = std::str::from_utf8(bytes).map_err(|e| error(format!("not UTF-8 text ({e})")))?;
+    let description = Description::parse(text, path)?;
     let mut scene = Scene::default();
     for mesh in &description.mesh {
-        scene.append(Scene::load(&folder.join(&mesh.file))?);
+        if files.depth >= MAX_NESTING {
+            return Err(error(format!("mesh '{}': descriptions nested more than {MAX_NESTING} deep", mesh.file)));
+        }
+        let file = files.read(&mesh.file).map_err(|why| error(format!("mesh {why}")))?;
+        let nested = files.nested(&file);
+        let mesh_path = file.path.clone();
+        if !matches!(
+            mesh_path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase).as_deref(),
+            Some("obj" | "gltf" | "glb" | "toml")
+        ) {
+            return Err(SceneError::UnsupportedFormat { path: mesh_path });
+        }
+        sources.push(mesh_path.clone());
+        let mut mesh_sources = Vec::new();
+        let mesh_scene = Scene::load_read(&file.bytes, &mesh_path, &nested, &mut mesh_sources)?;
+        sources.extend(mesh_sources);
+        scene.append(mesh_scene);
     }
     scene.cameras.splice(0..0, description.camera());
     Ok(scene)

@@ -2,17 +2,21 @@
 //!
 //! Buffers and images are read here rather than by the `gltf` crate's
 //! importer, so that every URI is checked (relative to the scene file, no
-//! network, no escaping its folder) and every accessor's byte range is
-//! checked against its buffer before any data is read: a hostile file gives
-//! an error, never a panic or a huge allocation.
+//! network, nothing outside its folder: see `files.rs`). Before any data
+//! is read, the JSON is checked for everything the `gltf` crate assumes
+//! (`validate_document`: indices in range, images with a source, accessor
+//! types the readers accept), the node hierarchy for cycles, and every
+//! accessor's byte range against its buffer: a hostile file gives an error,
+//! never a panic or a huge allocation.
 
 use std::collections::HashMap;
-use std::path::{Component, Path, PathBuf};
+use std::path::{Path, PathBuf};
 
 use base64::Engine as _;
 use rayon::prelude::*;
 use rtgi_math::{Mat3, Mat4, Vec2, Vec3, Vec4};
 
+use crate::files::Files;
 use crate::{
     AlphaMode, Camera, ColorEncoding, Light, LightKind, Material, MeshBuilder, Scene, SceneError, SurfaceModel,
     Texture, TextureId, Wrap,
@@ -22,17 +26,26 @@ use crate::{
 pub const SUPPORTED_GLTF_EXTENSIONS: &[&str] =
     &["KHR_lights_punctual", "KHR_materials_transmission", "KHR_materials_ior", "KHR_materials_emissive_strength"];
 
-pub(crate) fn load(path: &Path) -> Result<Scene, SceneError> {
+pub(crate) fn load(
+    bytes: &[u8],
+    path: &Path,
+    files: &Files<'_>,
+    sources: &mut Vec<PathBuf>,
+) -> Result<Scene, SceneError> {
     let error = |message: String| SceneError::Gltf { path: path.to_owned(), message };
-    let bytes = std::fs::read(path).map_err(|source| SceneError::Io { path: path.to_owned(), source })?;
-    let gltf = gltf::Gltf::from_slice(&bytes).map_err(|e| error(e.to_string()))?;
-    let folder = path.parent().unwrap_or(Path::new(".")).to_path_buf();
-    let buffers = load_buffers(&gltf, &folder).map_err(&error)?;
+    // The gltf crate's own validation indexes the POSITION accessor without
+    // a bounds check, so the file is parsed unvalidated, checked for that
+    // first, then validated, then checked for everything else the crate
+    // would unwrap or reach `unreachable!()` on, before any accessor is read.
+    let gltf = gltf::Gltf::from_slice_without_validation(bytes).map_err(|e| error(e.to_string()))?;
+    validate_document(gltf.document.as_json()).map_err(&error)?;
+    let buffers = load_buffers(&gltf, files, sources).map_err(&error)?;
     validate_accessors(&gltf.document, &buffers).map_err(&error)?;
+    check_node_hierarchy(gltf.document.as_json()).map_err(&error)?;
 
     let mut scene =
         Scene { extensions_used: gltf.document.extensions_used().map(str::to_owned).collect(), ..Scene::default() };
-    let textures = TextureTable::new(&gltf.document, &folder, &buffers, &mut scene);
+    let textures = TextureTable::new(&gltf.document, files, &buffers, &mut scene, sources);
     for material in gltf.document.materials() {
         scene.materials.push(convert_material(&material, &textures));
     }
@@ -52,16 +65,26 @@ pub(crate) fn load(path: &Path) -> Result<Scene, SceneError> {
     };
     let mut skipped_primitives: HashMap<String, usize> = HashMap::new();
     let mut stack: Vec<(gltf::Node<'_>, Mat4)> = root.nodes().map(|n| (n, Mat4::IDENTITY)).collect();
-    let mut visited = 0usize;
+    // A node is placed once, below the first parent that reaches it: the
+    // specification gives each node at most one parent, and a file that
+    // gives some several would otherwise instance them exponentially often.
+    let mut placed = vec![false; gltf.document.nodes().len()];
+    let mut reached_again = Vec::new();
     while let Some((node, parent)) = stack.pop() {
-        visited += 1;
-        if visited > 1_000_000 {
-            return Err(error("the node hierarchy is too large or cyclic".into()));
+        if std::mem::replace(&mut placed[node.index()], true) {
+            reached_again.push(node.index());
+            continue;
         }
         let transform = parent * Mat4::from_cols_array_2d(&node.transform().matrix());
         if let Some(mesh) = node.mesh() {
             add_mesh(&mesh, &transform, &buffers, default_material, &mut scene, &mut skipped_primitives)
                 .map_err(&error)?;
+            if scene.triangles.len() > files.options.max_triangles {
+                return Err(error(format!(
+                    "more than {} triangles (the limit of LoadOptions::max_triangles)",
+                    files.options.max_triangles
+                )));
+            }
         }
         if let Some(camera) = node.camera() {
             match camera.projection() {
@@ -82,6 +105,13 @@ pub(crate) fn load(path: &Path) -> Result<Scene, SceneError> {
         }
         stack.extend(node.children().map(|child| (child, transform)));
     }
+    if let Some(first) = reached_again.first() {
+        scene.warnings.push(format!(
+            "{}: {} nodes have more than one parent (the first is node {first}); each is placed once, below its first parent",
+            path.display(),
+            reached_again.len()
+        ));
+    }
     // The default material exists for primitives that name none; drop it if none did.
     if !scene.triangles.iter().any(|t| t.material == default_material) {
         scene.materials.pop();
@@ -101,8 +131,8 @@ pub(crate) fn load(path: &Path) -> Result<Scene, SceneError> {
 }
 
 /// The bytes of every buffer: the GLB binary chunk, a data URI, or a file
-/// beside the scene.
-fn load_buffers(gltf: &gltf::Gltf, folder: &Path) -> Result<Vec<Vec<u8>>, String> {
+/// inside the scene's folder.
+fn load_buffers(gltf: &gltf::Gltf, files: &Files<'_>, sources: &mut Vec<PathBuf>) -> Result<Vec<Vec<u8>>, String> {
     gltf.document
         .buffers()
         .map(|buffer| {
@@ -111,7 +141,9 @@ fn load_buffers(gltf: &gltf::Gltf, folder: &Path) -> Result<Vec<Vec<u8>>, String
                     .blob
                     .clone()
                     .ok_or_else(|| format!("buffer {} refers to a missing binary chunk", buffer.index()))?,
-                gltf::buffer::Source::Uri(uri) => read_uri(uri, folder)?,
+                gltf::buffer::Source::Uri(uri) => {
+                    read_uri(uri, files, sources).map_err(|e| format!("buffer {}: {e}", buffer.index()))?
+                }
             };
             if data.len() < buffer.length() {
                 return Err(format!(
@@ -126,10 +158,10 @@ fn load_buffers(gltf: &gltf::Gltf, folder: &Path) -> Result<Vec<Vec<u8>>, String
         .collect()
 }
 
-/// Reads a URI of the file: a base64 data URI, or a relative path inside
-/// the scene's folder. Remote URLs, absolute paths and paths that leave the
-/// folder are refused.
-fn read_uri(uri: &str, folder: &Path) -> Result<Vec<u8>, String> {
+/// Reads a URI of the file: a base64 data URI, or a relative path read
+/// through `files` (inside the scene's folder unless allowed otherwise).
+/// Remote URLs are refused.
+fn read_uri(uri: &str, files: &Files<'_>, sources: &mut Vec<PathBuf>) -> Result<Vec<u8>, String> {
     if let Some(rest) = uri.strip_prefix("data:") {
         let (_, payload) =
             rest.split_once(";base64,").ok_or_else(|| format!("data URI without base64 payload: {}", short(uri)))?;
@@ -137,32 +169,12 @@ fn read_uri(uri: &str, folder: &Path) -> Result<Vec<u8>, String> {
             .decode(payload)
             .map_err(|e| format!("data URI is not valid base64 ({e})"));
     }
-    let path = resolve_relative(uri, folder)?;
-    std::fs::read(&path).map_err(|e| format!("{}: {e}", path.display()))
-}
-
-/// The file a relative URI names inside `folder`, after percent-decoding.
-fn resolve_relative(uri: &str, folder: &Path) -> Result<PathBuf, String> {
     if uri.contains("://") || uri.starts_with("file:") {
         return Err(format!("refusing to fetch '{}': only files beside the scene are read", short(uri)));
     }
-    let decoded = percent_decode(uri);
-    let relative = Path::new(&decoded);
-    if relative.has_root() || relative.components().any(|c| matches!(c, Component::Prefix(_))) {
-        return Err(format!("refusing absolute path '{}'", short(uri)));
-    }
-    let mut depth = 0i32;
-    for component in relative.components() {
-        match component {
-            Component::ParentDir => depth -= 1,
-            Component::Normal(_) => depth += 1,
-            _ => {}
-        }
-        if depth < 0 {
-            return Err(format!("refusing '{}': it leaves the scene's folder", short(uri)));
-        }
-    }
-    Ok(folder.join(relative))
+    let file = files.read(&percent_decode(uri))?;
+    sources.push(file.path);
+    Ok(file.bytes)
 }
 
 fn percent_decode(text: &str) -> String {
@@ -192,6 +204,130 @@ fn short(uri: &str) -> String {
     } else {
         uri.to_owned()
     }
+}
+
+/// Checks the JSON for what the `gltf` crate assumes without checking:
+/// accessor indices of primitive attributes in range (its own validation
+/// indexes with them), then its validation, then images with a source,
+/// and accessors of the types the readers this importer calls accept.
+fn validate_document(root: &gltf::json::Root) -> Result<(), String> {
+    use gltf::json::accessor::{ComponentType, Type};
+    use gltf::json::mesh::Semantic;
+    use gltf::json::validation::{Checked, Validate};
+    for (m, mesh) in root.meshes.iter().enumerate() {
+        for (p, primitive) in mesh.primitives.iter().enumerate() {
+            let accessors = primitive.attributes.values().chain(&primitive.indices);
+            if let Some(bad) = accessors.map(|a| a.value()).find(|&a| a >= root.accessors.len()) {
+                return Err(format!(
+                    "mesh {m} primitive {p} names accessor {bad}, but the file has {}",
+                    root.accessors.len()
+                ));
+            }
+        }
+    }
+    let mut errors = Vec::new();
+    root.validate(root, gltf::json::Path::new, &mut |path, error| errors.push(format!("{}: {error}", path())));
+    if !errors.is_empty() {
+        let more = if errors.len() > 3 { format!(" (and {} more)", errors.len() - 3) } else { String::new() };
+        return Err(format!("invalid glTF: {}{more}", errors[..errors.len().min(3)].join("; ")));
+    }
+    for (i, image) in root.images.iter().enumerate() {
+        if image.buffer_view.is_none() && image.uri.is_none() {
+            return Err(format!("image {i} has neither a uri nor a bufferView"));
+        }
+        if image.buffer_view.is_some() && image.mime_type.is_none() {
+            return Err(format!("image {i} is in a bufferView but has no mimeType"));
+        }
+    }
+    let accessor_kind = |index: usize| {
+        let accessor = &root.accessors[index];
+        match (&accessor.type_, &accessor.component_type) {
+            (Checked::Valid(t), Checked::Valid(c)) => Some((*t, c.0)),
+            _ => None,
+        }
+    };
+    for (m, mesh) in root.meshes.iter().enumerate() {
+        for (p, primitive) in mesh.primitives.iter().enumerate() {
+            let what = |name: &str, index: usize| {
+                format!("mesh {m} primitive {p}: {name} accessor {index} has a type its reader cannot read")
+            };
+            if let Some(indices) = &primitive.indices {
+                let ok = matches!(
+                    accessor_kind(indices.value()),
+                    Some((Type::Scalar, ComponentType::U8 | ComponentType::U16 | ComponentType::U32))
+                );
+                if !ok {
+                    return Err(what("index", indices.value()));
+                }
+            }
+            for (semantic, accessor) in &primitive.attributes {
+                let kind = accessor_kind(accessor.value());
+                let ok = match semantic {
+                    Checked::Valid(Semantic::Positions | Semantic::Normals) => {
+                        kind == Some((Type::Vec3, ComponentType::F32))
+                    }
+                    Checked::Valid(Semantic::Tangents) => kind == Some((Type::Vec4, ComponentType::F32)),
+                    Checked::Valid(Semantic::TexCoords(_)) => {
+                        matches!(kind, Some((Type::Vec2, ComponentType::F32 | ComponentType::U8 | ComponentType::U16)))
+                    }
+                    _ => true,
+                };
+                if !ok {
+                    let name = match semantic {
+                        Checked::Valid(s) => s.to_string(),
+                        Checked::Invalid => "an invalid".to_owned(),
+                    };
+                    return Err(what(&name, accessor.value()));
+                }
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Refuses a node hierarchy with a cycle, naming a node on it: a
+/// depth-first search over every node's children, iterative so that deep
+/// hierarchies cannot overflow the stack.
+fn check_node_hierarchy(root: &gltf::json::Root) -> Result<(), String> {
+    #[derive(Clone, Copy, PartialEq)]
+    enum State {
+        New,
+        OnPath,
+        Done,
+    }
+    let children = |n: usize| root.nodes[n].children.as_deref().unwrap_or(&[]);
+    let mut state = vec![State::New; root.nodes.len()];
+    for start in 0..root.nodes.len() {
+        if state[start] != State::New {
+            continue;
+        }
+        // (node, how many of its children have been entered)
+        let mut path: Vec<(usize, usize)> = vec![(start, 0)];
+        state[start] = State::OnPath;
+        while let Some((node, next)) = path.last_mut() {
+            let node = *node;
+            let Some(child) = children(node).get(*next).map(|c| c.value()) else {
+                state[node] = State::Done;
+                path.pop();
+                continue;
+            };
+            *next += 1;
+            match state[child] {
+                State::OnPath => {
+                    let name = root.nodes[child].name.as_deref().map_or(String::new(), |n| format!(" ('{n}')"));
+                    return Err(format!(
+                        "the node hierarchy has a cycle: node {child}{name} is its own descendant (through node {node})"
+                    ));
+                }
+                State::New => {
+                    state[child] = State::OnPath;
+                    path.push((child, 0));
+                }
+                State::Done => {}
+            }
+        }
+    }
+    Ok(())
 }
 
 /// Checks that every accessor's elements lie inside its buffer view and
@@ -253,7 +389,13 @@ fn texture_key(texture: &gltf::Texture<'_>, srgb: bool) -> TextureKey {
 }
 
 impl TextureTable {
-    fn new(document: &gltf::Document, folder: &Path, buffers: &[Vec<u8>], scene: &mut Scene) -> Self {
+    fn new(
+        document: &gltf::Document,
+        files: &Files<'_>,
+        buffers: &[Vec<u8>],
+        scene: &mut Scene,
+        sources: &mut Vec<PathBuf>,
+    ) -> Self {
         // Which images are used as colour (sRGB) and which as data (linear).
         let mut wanted: Vec<TextureKey> = Vec::new();
         for m in document.materials() {
@@ -273,26 +415,29 @@ impl TextureTable {
             want(m.transmission().and_then(|t| t.transmission_texture()).map(|i| i.texture()), false);
         }
         let images: Vec<gltf::Image<'_>> = document.images().collect();
+        // Files are read in order (for `sources`), then decoded in parallel.
+        let mut read: HashMap<usize, Result<Vec<u8>, String>> = HashMap::new();
+        for &(index, ..) in &wanted {
+            read.entry(index).or_insert_with(|| match images[index].source() {
+                gltf::image::Source::View { view, .. } => {
+                    let buffer = &buffers[view.buffer().index()];
+                    match view.offset().checked_add(view.length()) {
+                        Some(end) if end <= buffer.len() => Ok(buffer[view.offset()..end].to_vec()),
+                        _ => Err(format!("image {index} lies outside its buffer")),
+                    }
+                }
+                gltf::image::Source::Uri { uri, .. } => {
+                    read_uri(uri, files, sources).map_err(|e| format!("image {index}: {e}"))
+                }
+            });
+        }
         let decoded: Vec<Result<Texture, String>> = wanted
             .par_iter()
             .map(|&(index, srgb, wrap_u, wrap_v)| {
-                let image = &images[index];
                 let encoding = if srgb { ColorEncoding::Srgb } else { ColorEncoding::Linear };
-                let bytes = match image.source() {
-                    gltf::image::Source::View { view, .. } => {
-                        let buffer = &buffers[view.buffer().index()];
-                        let end = view.offset() + view.length();
-                        if end > buffer.len() {
-                            return Err(format!("image {index} lies outside its buffer"));
-                        }
-                        buffer[view.offset()..end].to_vec()
-                    }
-                    gltf::image::Source::Uri { uri, .. } => {
-                        read_uri(uri, folder).map_err(|e| format!("image {index}: {e}"))?
-                    }
-                };
-                let name = image.name().map_or_else(|| format!("image {index}"), str::to_owned);
-                Texture::decode(&bytes, &name, encoding).map(|t| t.with_wrap(wrap_u, wrap_v))
+                let bytes = read[&index].as_ref().map_err(Clone::clone)?;
+                let name = images[index].name().map_or_else(|| format!("image {index}"), str::to_owned);
+                Texture::decode(bytes, &name, encoding).map(|t| t.with_wrap(wrap_u, wrap_v))
             })
             .collect();
         let mut ids = HashMap::new();

@@ -21,11 +21,14 @@
 
 mod camera;
 pub mod description;
+mod files;
+pub use files::{DEFAULT_MAX_TRIANGLES, FileReader, LoadOptions};
 mod gltf_import;
 pub use gltf_import::SUPPORTED_GLTF_EXTENSIONS;
 mod light;
 mod material;
 mod mesh;
+mod mtl;
 pub mod obj;
 mod resolve;
 mod texture;
@@ -35,7 +38,7 @@ pub use light::{Light, LightKind};
 pub use material::{AlphaMode, Material, SurfaceModel};
 pub use mesh::MeshBuilder;
 pub use resolve::resolve_case_insensitive;
-pub use texture::{ColorEncoding, Texture, TextureId, Wrap};
+pub use texture::{ColorEncoding, MAX_TEXTURE_BYTES, MAX_TEXTURE_SIDE, Texture, TextureId, Wrap};
 
 use std::path::{Path, PathBuf};
 
@@ -75,8 +78,15 @@ pub struct Scene {
     pub lights: Vec<Light>,
     /// The format extensions the file uses (glTF's `extensionsUsed`).
     pub extensions_used: Vec<String>,
-    /// Problems that did not stop the import (a missing texture, an unknown material).
+    /// Problems that did not stop the import (a missing texture, an unknown
+    /// material, an MTL statement that could not be read, a reference
+    /// refused because it leads outside the scene's folder).
     pub warnings: Vec<String>,
+    /// Every file the load read, in the order read: the scene file, MTL
+    /// libraries, textures, glTF buffers and images, the meshes of a
+    /// description. Canonical paths for scenes loaded from disk; the names
+    /// given to the [`FileReader`] for scenes loaded from memory.
+    pub sources: Vec<PathBuf>,
 }
 
 /// Why a scene could not be loaded; every variant names the file.
@@ -95,21 +105,77 @@ pub enum SceneError {
 }
 
 impl Scene {
-    /// Loads a scene, choosing the importer by the file's extension.
+    /// Loads a scene, choosing the importer by the file's extension, with
+    /// the default [`LoadOptions`]: the files the scene references are read
+    /// only from inside the scene file's folder.
     pub fn load(path: &Path) -> Result<Scene, SceneError> {
+        Self::load_with(path, &LoadOptions::default())
+    }
+
+    /// Loads a scene with the given options.
+    pub fn load_with(path: &Path, options: &LoadOptions) -> Result<Scene, SceneError> {
+        let io_error = |source| SceneError::Io { path: path.to_owned(), source };
         if !path.is_file() {
             let source = if path.exists() {
                 std::io::Error::new(std::io::ErrorKind::InvalidInput, "not a file")
             } else {
                 std::io::Error::new(std::io::ErrorKind::NotFound, "no such file")
             };
-            return Err(SceneError::Io { path: path.to_owned(), source });
+            return Err(io_error(source));
         }
+        Self::check_format(path)?;
+        let canonical = path.canonicalize().map_err(io_error)?;
+        let bytes = std::fs::read(path).map_err(io_error)?;
+        let files = files::Files::disk(path, &canonical, options);
+        let mut sources = vec![canonical];
+        let mut scene = Self::load_read(&bytes, path, &files, &mut sources)?;
+        scene.sources = sources;
+        Ok(scene)
+    }
+
+    /// Loads a scene from bytes in memory: `name` gives the format by its
+    /// extension (`.obj`, `.gltf`, `.glb`, `.toml`) and names the scene in
+    /// messages, and the files the scene references (MTL libraries,
+    /// textures, buffers, images, meshes) are asked of `read` by the name
+    /// the scene gives them. Nothing is read from disk.
+    ///
+    /// ```
+    /// let obj = b"mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl red\nf 1 2 3\n";
+    /// let read = |name: &str| (name == "m.mtl").then(|| b"newmtl red\nKd 1 0 0\n".to_vec());
+    /// let scene = rtgi_scene::Scene::load_from_bytes("tri.obj", obj, &read)?;
+    /// assert_eq!(scene.materials[0].name, "red");
+    /// # Ok::<(), rtgi_scene::SceneError>(())
+    /// ```
+    pub fn load_from_bytes(name: &str, bytes: &[u8], read: &FileReader<'_>) -> Result<Scene, SceneError> {
+        let path = Path::new(name);
+        Self::check_format(path)?;
+        let files = files::Files::memory(read, &LoadOptions::default());
+        let mut sources = vec![path.to_owned()];
+        let mut scene = Self::load_read(bytes, path, &files, &mut sources)?;
+        scene.sources = sources;
+        Ok(scene)
+    }
+
+    fn check_format(path: &Path) -> Result<(), SceneError> {
         let extension = path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase);
         match extension.as_deref() {
-            Some("obj") => obj::load(path),
-            Some("toml") => description::load(path),
-            Some("gltf") | Some("glb") => gltf_import::load(path),
+            Some("obj" | "toml" | "gltf" | "glb") => Ok(()),
+            _ => Err(SceneError::UnsupportedFormat { path: path.to_owned() }),
+        }
+    }
+
+    /// Imports a scene file already read, by its extension.
+    fn load_read(
+        bytes: &[u8],
+        path: &Path,
+        files: &files::Files<'_>,
+        sources: &mut Vec<PathBuf>,
+    ) -> Result<Scene, SceneError> {
+        let extension = path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase);
+        match extension.as_deref() {
+            Some("obj") => obj::load(bytes, path, files, sources),
+            Some("toml") => description::load(bytes, path, files, sources),
+            Some("gltf") | Some("glb") => gltf_import::load(bytes, path, files, sources),
             _ => Err(SceneError::UnsupportedFormat { path: path.to_owned() }),
         }
     }
@@ -151,6 +217,7 @@ impl Scene {
         self.lights.extend(other.lights);
         self.extensions_used.extend(other.extensions_used);
         self.warnings.extend(other.warnings);
+        self.sources.extend(other.sources);
     }
 
     /// Interpolates a vertex attribute at barycentric coordinates `(beta, gamma)`.

@@ -1,12 +1,17 @@
-//! Wavefront OBJ + MTL import, through `tobj`.
+//! Wavefront OBJ import through `tobj`, with MTL libraries read by our own
+//! parser (`mtl.rs`) and every referenced file read through the scene's
+//! files, which keeps reads inside the scene's folder (`files.rs`).
 
+use std::cell::RefCell;
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 
 use rayon::prelude::*;
 use rtgi_math::{Vec2, Vec3};
 
-use crate::{ColorEncoding, Material, MeshBuilder, Scene, SceneError, Texture, TextureId, resolve_case_insensitive};
+use crate::files::{Files, ReadFile};
+use crate::mtl::{self, MtlMaterial};
+use crate::{ColorEncoding, LoadOptions, Material, MeshBuilder, Scene, SceneError, Texture, TextureId};
 
 const LOAD_OPTIONS: tobj::LoadOptions = tobj::LoadOptions {
     // Fan triangulation keeps file order: polygon (0 1 2 3) gives (0 1 2), (0 2 3).
@@ -16,49 +21,94 @@ const LOAD_OPTIONS: tobj::LoadOptions = tobj::LoadOptions {
     ignore_lines: true,
 };
 
-/// Loads an OBJ file and the MTL files it names, relative to its folder.
-pub(crate) fn load(path: &Path) -> Result<Scene, SceneError> {
-    let file = std::fs::File::open(path).map_err(|source| SceneError::Io { path: path.to_owned(), source })?;
-    let folder = path.parent().map(Path::to_path_buf).unwrap_or_default();
-    let mut reader = std::io::BufReader::new(file);
-    let mtl_errors = std::cell::RefCell::new(Vec::new());
-    let (models, materials) = tobj::load_obj_buf(&mut reader, &LOAD_OPTIONS, |mtl_name| {
-        let mtl_text = mtl_name.to_string_lossy();
-        let Some(mtl_path) = resolve_case_insensitive(&folder, &mtl_text) else {
-            mtl_errors.borrow_mut().push(format!("{}: material library '{mtl_text}' not found", path.display()));
+/// The most vertices one OBJ face (or line, or point statement) may name:
+/// tobj builds each polygon in memory before triangulating it, so a face of
+/// 10^8 references would take gigabytes; no real model comes near.
+pub const MAX_FACE_VERTICES: usize = 65_536;
+
+/// Loads OBJ text whose MTL libraries and textures are read through `files`.
+pub(crate) fn load(
+    bytes: &[u8],
+    path: &Path,
+    files: &Files<'_>,
+    sources: &mut Vec<PathBuf>,
+) -> Result<Scene, SceneError> {
+    let error = |message: String| SceneError::Obj { path: path.to_owned(), message };
+    check_face_sizes(bytes).map_err(error)?;
+    // tobj's loader is a `Fn`: what it collects goes through cells.
+    let warnings = RefCell::new(Vec::new());
+    let materials: RefCell<Vec<MtlMaterial>> = RefCell::new(Vec::new());
+    let libraries_read: RefCell<Vec<String>> = RefCell::new(Vec::new());
+    let read_sources = RefCell::new(Vec::new());
+    let loader = |mtl_name: &Path| -> tobj::MTLLoadResult {
+        let reference = mtl_name.to_string_lossy().into_owned();
+        // A library named again adds nothing: tobj keeps the names it mapped.
+        if libraries_read.borrow().contains(&reference) {
             return Ok(Default::default());
+        }
+        libraries_read.borrow_mut().push(reference.clone());
+        let file = match files.read(&reference) {
+            Ok(file) => file,
+            Err(why) => {
+                warnings.borrow_mut().push(format!("{}: material library {why}", path.display()));
+                return Ok(Default::default());
+            }
         };
-        let file = std::fs::File::open(&mtl_path).map_err(|_| tobj::LoadError::OpenFileFailed)?;
-        tobj::load_mtl_buf(&mut std::io::BufReader::new(file)).inspect_err(|e| {
-            mtl_errors.borrow_mut().push(format!("{}: cannot parse: {e}", mtl_path.display()));
-        })
-    })
-    .map_err(|e| SceneError::Obj { path: path.to_owned(), message: e.to_string() })?;
-    let materials = materials.unwrap_or_default();
-    let mut scene = from_tobj(&models, &materials, &folder, path)?;
-    scene.warnings.splice(0..0, mtl_errors.into_inner());
+        let library = mtl::parse(&String::from_utf8_lossy(&file.bytes), &file.path.display().to_string());
+        read_sources.borrow_mut().push(file.path);
+        warnings.borrow_mut().extend(library.warnings);
+        let names = mtl::index_by_name(&library.materials);
+        let placeholders =
+            library.materials.iter().map(|m| tobj::Material { name: m.name.clone(), ..Default::default() }).collect();
+        materials.borrow_mut().extend(library.materials);
+        Ok((placeholders, names.into_iter().collect()))
+    };
+    let (models, _) = tobj::load_obj_buf(&mut &bytes[..], &LOAD_OPTIONS, loader).map_err(|e| error(e.to_string()))?;
+    sources.extend(read_sources.into_inner());
+    let mut scene = from_tobj(&models, &materials.into_inner(), files, path, sources)?;
+    scene.warnings.splice(0..0, warnings.into_inner());
     Ok(scene)
 }
 
+/// Refuses faces with more than [`MAX_FACE_VERTICES`] vertices before tobj
+/// allocates them: a cheap scan of the statements' words.
+fn check_face_sizes(bytes: &[u8]) -> Result<(), String> {
+    for (number, line) in bytes.split(|&b| b == b'\n').enumerate() {
+        let mut words = line.split(|b| b.is_ascii_whitespace()).filter(|w| !w.is_empty());
+        if !matches!(words.next(), Some(b"f" | b"l" | b"p")) {
+            continue;
+        }
+        let count = words.count();
+        if count > MAX_FACE_VERTICES {
+            return Err(format!(
+                "line {}: a face with {count} vertices (at most {MAX_FACE_VERTICES} are read)",
+                number + 1
+            ));
+        }
+    }
+    Ok(())
+}
+
 /// Loads OBJ text whose MTL text is given too; for scenes built into programs.
+/// Every `mtllib` statement reads `mtl`; textures are not read.
 pub fn load_from_text(obj: &str, mtl: &str, name: &str) -> Result<Scene, SceneError> {
-    let path = PathBuf::from(name);
-    let (models, materials) =
-        tobj::load_obj_buf(&mut obj.as_bytes(), &LOAD_OPTIONS, |_| tobj::load_mtl_buf(&mut mtl.as_bytes()))
-            .map_err(|e| SceneError::Obj { path: path.clone(), message: e.to_string() })?;
-    let materials = materials.map_err(|e| SceneError::Obj { path: path.clone(), message: e.to_string() })?;
-    from_tobj(&models, &materials, Path::new("."), &path)
+    let read = |reference: &str| {
+        Path::new(reference).extension().is_some_and(|e| e.eq_ignore_ascii_case("mtl")).then(|| mtl.as_bytes().to_vec())
+    };
+    let files = Files::memory(&read, &LoadOptions::default());
+    load(obj.as_bytes(), Path::new(name), &files, &mut Vec::new())
 }
 
 fn from_tobj(
     models: &[tobj::Model],
-    obj_materials: &[tobj::Material],
-    folder: &Path,
+    mtl_materials: &[MtlMaterial],
+    files: &Files<'_>,
     path: &Path,
+    sources: &mut Vec<PathBuf>,
 ) -> Result<Scene, SceneError> {
     let mut scene = Scene::default();
-    let texture_paths = load_materials(&mut scene, obj_materials, folder, path);
-    load_textures(&mut scene, texture_paths);
+    let texture_files = load_materials(&mut scene, mtl_materials, files, path, sources);
+    load_textures(&mut scene, texture_files);
 
     // Faces without a material (none named, or a name the MTL does not
     // define) share one default material, added only if needed.
@@ -66,7 +116,7 @@ fn from_tobj(
     for model in models {
         let mesh = &model.mesh;
         let material = match mesh.material_id {
-            Some(id) if id < obj_materials.len() => id as u32,
+            Some(id) if id < mtl_materials.len() => id as u32,
             _ => *default_material.get_or_insert_with(|| {
                 scene.materials.push(Material::default());
                 scene.materials.len() as u32 - 1
@@ -104,24 +154,28 @@ fn from_tobj(
     Ok(scene)
 }
 
-/// Converts the MTL materials; returns the texture files to decode, by texture index.
+/// Converts the MTL materials; returns each texture's file, read, by texture
+/// index (or why it could not be read).
 fn load_materials(
     scene: &mut Scene,
-    obj_materials: &[tobj::Material],
-    folder: &Path,
+    mtl_materials: &[MtlMaterial],
+    files: &Files<'_>,
     path: &Path,
-) -> Vec<Result<PathBuf, String>> {
+    sources: &mut Vec<PathBuf>,
+) -> Vec<Result<ReadFile, String>> {
     let mut texture_index: HashMap<String, u32> = HashMap::new();
-    let mut texture_paths = Vec::new();
-    for m in obj_materials {
+    let mut texture_files = Vec::new();
+    for m in mtl_materials {
         let base_color_texture = m.diffuse_texture.as_deref().map(|name| {
-            let id =
-                *texture_index.entry(name.to_owned()).or_insert_with(|| {
-                    texture_paths.push(find_texture(folder, name).ok_or_else(|| {
-                        format!("{}: material '{}': texture '{name}' not found", path.display(), m.name)
-                    }));
-                    texture_paths.len() as u32 - 1
-                });
+            let id = *texture_index.entry(name.to_owned()).or_insert_with(|| {
+                let file =
+                    files.read(name).map_err(|why| format!("{}: material '{}': texture {why}", path.display(), m.name));
+                if let Ok(file) = &file {
+                    sources.push(file.path.clone());
+                }
+                texture_files.push(file);
+                texture_files.len() as u32 - 1
+            });
             TextureId(id)
         });
         let shininess = m.shininess.unwrap_or(0.0);
@@ -131,33 +185,28 @@ fn load_materials(
         let refracts = matches!(illumination, 4 | 6 | 7 | 9);
         scene.materials.push(Material {
             name: m.name.clone(),
-            base_color: m.diffuse.map_or(defaults.base_color, Vec3::from),
+            base_color: m.diffuse.unwrap_or(defaults.base_color),
             base_color_texture,
-            specular: m.specular.map_or(Vec3::ZERO, Vec3::from),
+            specular: m.specular.unwrap_or(Vec3::ZERO),
             shininess,
             roughness: if mirror { 0.0 } else { Material::roughness_from_shininess(shininess) },
             transmission: if refracts { 1.0 } else { 0.0 },
-            emission: m.emissive.map_or(Vec3::ZERO, Vec3::from),
+            emission: m.emissive.unwrap_or(Vec3::ZERO),
             ior: m.optical_density.filter(|n| *n > 0.0).unwrap_or(1.5),
             opacity: m.dissolve.unwrap_or(1.0).clamp(0.0, 1.0),
             ..defaults
         });
     }
-    texture_paths
-}
-
-/// MTL map statements may carry options before the file name
-/// (`map_Kd -bm 0.5 wall.jpg`); the name is then the last word.
-fn find_texture(folder: &Path, statement: &str) -> Option<PathBuf> {
-    resolve_case_insensitive(folder, statement.trim())
-        .or_else(|| statement.split_whitespace().last().and_then(|name| resolve_case_insensitive(folder, name)))
+    texture_files
 }
 
 /// Decodes the textures in parallel; those that fail become a visible
 /// checkerboard and a warning.
-fn load_textures(scene: &mut Scene, paths: Vec<Result<PathBuf, String>>) {
-    let decoded: Vec<Result<Texture, String>> =
-        paths.into_par_iter().map(|p| p.and_then(|path| Texture::load(&path, ColorEncoding::Srgb))).collect();
+fn load_textures(scene: &mut Scene, files: Vec<Result<ReadFile, String>>) {
+    let decoded: Vec<Result<Texture, String>> = files
+        .into_par_iter()
+        .map(|f| f.and_then(|file| Texture::decode(&file.bytes, &file.path.display().to_string(), ColorEncoding::Srgb)))
+        .collect();
     for texture in decoded {
         match texture {
             Ok(t) => scene.textures.push(t),

@@ -3,6 +3,13 @@ use std::sync::LazyLock;
 
 use rtgi_math::{Vec2, Vec4};
 
+/// The widest and tallest texture read, in texels (16384: four times the
+/// largest textures of the shared scenes; a 16384² RGBA image takes 1 GiB).
+pub const MAX_TEXTURE_SIDE: u32 = 16_384;
+
+/// The most memory the image decoder may allocate for one texture.
+pub const MAX_TEXTURE_BYTES: u64 = 1 << 30;
+
 /// Index of a texture in [`Scene::textures`](crate::Scene::textures).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub struct TextureId(pub u32);
@@ -108,9 +115,29 @@ impl Texture {
         Self::decode(&bytes, &path.display().to_string(), encoding)
     }
 
-    /// Decodes PNG or JPEG bytes; `name` is used in messages.
+    /// Decodes PNG or JPEG bytes; `name` is used in messages. Images wider
+    /// or taller than [`MAX_TEXTURE_SIDE`] are refused from their header,
+    /// before any pixel is allocated, and the decoder may allocate at most
+    /// [`MAX_TEXTURE_BYTES`].
     pub fn decode(bytes: &[u8], name: &str, encoding: ColorEncoding) -> Result<Self, String> {
-        let decoded = image::load_from_memory(bytes).map_err(|e| format!("{name}: {e}"))?.to_rgba8();
+        let reader = || {
+            image::ImageReader::new(std::io::Cursor::new(bytes))
+                .with_guessed_format()
+                .map_err(|e| format!("{name}: {e}"))
+        };
+        let (width, height) = reader()?.into_dimensions().map_err(|e| format!("{name}: {e}"))?;
+        if width > MAX_TEXTURE_SIDE || height > MAX_TEXTURE_SIDE {
+            return Err(format!(
+                "{name}: the image is {width} x {height} texels, larger than the {MAX_TEXTURE_SIDE} a side that are read"
+            ));
+        }
+        let mut limits = image::Limits::default();
+        limits.max_image_width = Some(MAX_TEXTURE_SIDE);
+        limits.max_image_height = Some(MAX_TEXTURE_SIDE);
+        limits.max_alloc = Some(MAX_TEXTURE_BYTES);
+        let mut reader = reader()?;
+        reader.limits(limits);
+        let decoded = reader.decode().map_err(|e| format!("{name}: {e}"))?.to_rgba8();
         let (width, height) = decoded.dimensions();
         let texels = decoded.pixels().map(|p| p.0).collect();
         Self::from_rgba8(name, width, height, texels, encoding).ok_or_else(|| format!("{name}: empty image"))
