@@ -92,3 +92,48 @@ fn trace_refuses_to_write_its_hits_over_its_rays() {
     assert!(run.stderr.contains("is --rays, which the command reads"), "{run:?}");
     assert_eq!(std::fs::read(&rays).unwrap(), ray);
 }
+
+/// A one-triangle OBJ in `dir/scene/` whose material's texture is `texture`.
+fn textured_triangle(dir: &Path, texture: &str) -> std::path::PathBuf {
+    let scene = dir.join("scene");
+    std::fs::create_dir_all(&scene).unwrap();
+    std::fs::write(scene.join("t.mtl"), format!("newmtl textured\nKd 1 1 1\nmap_Kd {texture}\n")).unwrap();
+    let obj = "mtllib t.mtl\nv -1 -1 0\nv 1 -1 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0.5 1\nusemtl textured\nf 1/1 2/2 3/3\n";
+    std::fs::write(scene.join("t.obj"), obj).unwrap();
+    scene.join("t.obj")
+}
+
+fn write_png(path: &Path) {
+    let mut image = rtgi_image::HdrImage::new(4, 4);
+    image.pixels_mut().fill(rtgi_math::Vec3::new(0.2, 0.4, 0.8));
+    image.write(path, &rtgi_image::ToneMap::default()).unwrap();
+}
+
+#[test]
+fn a_texture_is_not_overwritten_by_the_render_that_reads_it() {
+    let dir = scratch_dir("output-is-texture");
+    let obj = textured_triangle(&dir, "wood.png");
+    let texture = dir.join("scene/wood.png");
+    write_png(&texture);
+    let before = std::fs::read(&texture).unwrap();
+    let run = rtgi(&["render", path_str(&obj), "-o", path_str(&texture), "--width", "8", "--height", "8"]);
+    assert_eq!(run.code, Some(1), "{run:?}");
+    assert!(run.stderr.contains("is a file of the scene"), "{run:?}");
+    assert_eq!(std::fs::read(&texture).unwrap(), before);
+}
+
+#[test]
+fn a_texture_outside_the_scene_folder_is_read_only_with_allow_outside_scene() {
+    let dir = scratch_dir("outside-scene");
+    write_png(&dir.join("outside.png"));
+    let obj = textured_triangle(&dir, "../outside.png");
+    let out = dir.join("out.png");
+    let args = ["render", path_str(&obj), "-o", path_str(&out), "--width", "8", "--height", "8"];
+    let run = rtgi(&args);
+    assert!(run.success, "{run:?}");
+    assert!(run.stderr.contains("../outside.png") && run.stderr.contains("refusing"), "{run:?}");
+    let trusted: Vec<&str> = args.iter().copied().chain(["--allow-outside-scene"]).collect();
+    let run = rtgi(&trusted);
+    assert!(run.success, "{run:?}");
+    assert!(!run.stderr.contains("refusing"), "{run:?}");
+}

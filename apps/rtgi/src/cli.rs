@@ -17,6 +17,11 @@ pub(crate) const MAX_IMAGE_SIDE: u32 = 16_384;
 pub(crate) struct Cli {
     #[command(subcommand)]
     pub(crate) command: Command,
+
+    /// Let a scene's references (OBJ mtllib and textures, glTF buffers and images, meshes of a
+    /// TOML description) reach outside the scene file's folder: only for scenes you trust
+    #[arg(long, global = true)]
+    pub(crate) allow_outside_scene: bool,
 }
 
 #[derive(Debug, Subcommand)]

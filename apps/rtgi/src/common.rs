@@ -6,7 +6,7 @@ use std::time::Instant;
 use anyhow::{Context, Result, bail};
 use rtgi_accel::Accel;
 use rtgi_render::{Environment, RenderSettings, camera_blocked, frame_scene};
-use rtgi_scene::{Camera, Scene};
+use rtgi_scene::{Camera, LoadOptions, Scene};
 
 use crate::cli::{CameraArgs, EnvironmentArg, LightingArgs};
 use crate::default_scene;
@@ -21,11 +21,21 @@ pub(crate) struct LoadedScene {
     pub(crate) load_ms: f64,
 }
 
+/// `--allow-outside-scene`, set once by `main` for every command.
+pub(crate) static ALLOW_OUTSIDE_SCENE: std::sync::OnceLock<bool> = std::sync::OnceLock::new();
+
 /// Loads a scene file (or the built-in Cornell box) and prints its warnings.
+/// References outside the scene's folder are refused unless `--allow-outside-scene`.
 pub(crate) fn load_scene(path: Option<&Path>) -> Result<LoadedScene> {
     let start = Instant::now();
     let (scene, name) = match path {
-        Some(path) => (Scene::load(path)?, path.display().to_string()),
+        Some(path) => {
+            let options = LoadOptions {
+                allow_outside_folder: ALLOW_OUTSIDE_SCENE.get() == Some(&true),
+                ..LoadOptions::default()
+            };
+            (Scene::load_with(path, &options)?, path.display().to_string())
+        }
         None => (default_scene::load()?, default_scene::NAME.to_owned()),
     };
     let load_ms = start.elapsed().as_secs_f64() * 1e3;

@@ -32,6 +32,7 @@ pub fn main() -> ExitCode {
         Ok(cli) => cli,
         Err(e) => return cli::report_parse_error(e),
     };
+    let _ = common::ALLOW_OUTSIDE_SCENE.set(cli.allow_outside_scene);
     let result = match cli.command {
         cli::Command::Render(args) => render_cmd::run(&args),
         cli::Command::Trace(args) => trace_cmd::run(&args),

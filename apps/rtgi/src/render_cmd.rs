@@ -89,6 +89,14 @@ pub(crate) fn render_image(args: &RenderArgs) -> Result<Rendered> {
     check_memory(width, height)?;
 
     let LoadedScene { mut scene, name: scene_name, load_ms } = load_scene(args.scene.as_deref())?;
+    // The files the scene read (textures, material libraries, buffers) are inputs too.
+    let sources: Vec<(String, &Path)> = scene
+        .sources
+        .iter()
+        .map(|path| (format!("a file of the scene ({})", path.display()), path.as_path()))
+        .collect();
+    let sources: Vec<(&str, &Path)> = sources.iter().map(|(what, path)| (what.as_str(), *path)).collect();
+    refuse_inputs_as_outputs(&outputs, &sources)?;
 
     let mut settings = RenderSettings {
         width,
