@@ -97,11 +97,7 @@ pub(crate) fn run(args: &InfoArgs) -> Result<()> {
                 emission: m.emission.to_array(),
                 transmission: m.transmission,
                 ior: m.ior,
-                alpha: match m.alpha_mode {
-                    AlphaMode::Opaque => "opaque".into(),
-                    AlphaMode::Mask { cutoff } => format!("mask (cutoff {cutoff})"),
-                    AlphaMode::Blend => "blend".into(),
-                },
+                alpha: see_through(m),
             })
             .collect(),
         textures: scene
@@ -241,4 +237,22 @@ fn read_exr(path: &Path) -> Result<HdrImage> {
         bail!("{}: cannot read: not a file", path.display());
     }
     Ok(HdrImage::read_exr(path)?)
+}
+
+/// How light gets through a material, as the renderer treats it: cut-out
+/// holes (alpha mask), partial coverage (alpha blend), transmission
+/// through the surface (glass, thin sheets), or none.
+fn see_through(m: &rtgi_scene::Material) -> String {
+    let mut parts = Vec::new();
+    let mask = if m.alpha_texture.is_some() { ", from a mask texture" } else { "" };
+    match m.alpha_mode {
+        AlphaMode::Opaque => {}
+        AlphaMode::Mask { cutoff } => parts.push(format!("cut-out (alpha mask, cutoff {cutoff}{mask})")),
+        AlphaMode::Blend => parts.push(format!("alpha blend (opacity {}{mask})", m.opacity)),
+    }
+    if m.transmission > 0.0 || m.transmission_texture.is_some() {
+        let texture = if m.transmission_texture.is_some() { " x texture" } else { "" };
+        parts.push(format!("transmits {}{texture} (ior {})", m.transmission, m.ior));
+    }
+    if parts.is_empty() { "opaque".into() } else { parts.join(", ") }
 }

@@ -103,11 +103,14 @@ pub fn alpha_accepts(scene: &Scene, triangle: u32, beta: f32, gamma: f32, u: f32
     let triangle = &scene.triangles[triangle as usize];
     let material = &scene.materials[triangle.material as usize];
     let alpha = || {
-        let texture = material.base_color_texture.map_or(1.0, |t| {
-            let uv = scene.interpolate(triangle, beta, gamma, |v| v.uv);
-            scene.textures[t.0 as usize].sample(uv).w
+        let uv = || scene.interpolate(triangle, beta, gamma, |v| v.uv);
+        let texture = material.base_color_texture.map_or(1.0, |t| scene.textures[t.0 as usize].sample(uv()).w);
+        let mask = material.alpha_texture.map_or(1.0, |t| {
+            let mask = &scene.textures[t.0 as usize];
+            let texel = mask.sample(uv());
+            if mask.has_alpha() { texel.w } else { texel.x }
         });
-        material.opacity * texture
+        material.opacity * texture * mask
     };
     match material.alpha_mode {
         AlphaMode::Opaque => true,

@@ -486,6 +486,7 @@ fn convert_material(m: &gltf::Material<'_>, textures: &TextureTable) -> Material
             gltf::material::AlphaMode::Mask => AlphaMode::Mask { cutoff: m.alpha_cutoff().unwrap_or(0.5) },
             gltf::material::AlphaMode::Blend => AlphaMode::Blend,
         },
+        alpha_texture: None,
         double_sided: m.double_sided(),
     }
 }

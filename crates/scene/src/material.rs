@@ -54,6 +54,9 @@ pub struct Material {
     /// Multiplies `transmission` by its red channel (linear).
     pub transmission_texture: Option<TextureId>,
     pub alpha_mode: AlphaMode,
+    /// Multiplies alpha by its alpha channel, or by its red channel where it
+    /// has none (an MTL `map_d` mask, often greyscale).
+    pub alpha_texture: Option<TextureId>,
     /// Whether the back side is lit as the front (glTF); OBJ surfaces are two-sided.
     pub double_sided: bool,
 }
@@ -100,6 +103,7 @@ impl Default for Material {
             transmission: 0.0,
             transmission_texture: None,
             alpha_mode: AlphaMode::Opaque,
+            alpha_texture: None,
             double_sided: true,
         }
     }

@@ -35,6 +35,8 @@ pub(crate) struct MtlMaterial {
     pub(crate) illumination_model: Option<u8>,
     /// The file name of `map_Kd`, without its options.
     pub(crate) diffuse_texture: Option<String>,
+    /// The file name of `map_d` (a cut-out mask: leaves, fences), without its options.
+    pub(crate) dissolve_texture: Option<String>,
     /// Whether `dissolve` came from a `d` statement (which `Tr` does not override).
     has_d: bool,
 }
@@ -131,6 +133,8 @@ pub(crate) fn parse(text: &str, file: &str) -> MtlLibrary {
             map => map_file(rest).map(|name| {
                 if map == "map_Kd" {
                     material.diffuse_texture = Some(name.to_owned());
+                } else if map == "map_d" {
+                    material.dissolve_texture = Some(name.to_owned());
                 }
             }),
         };

@@ -11,7 +11,7 @@ use rtgi_math::{Vec2, Vec3};
 
 use crate::files::{Files, ReadFile};
 use crate::mtl::{self, MtlMaterial};
-use crate::{ColorEncoding, LoadOptions, Material, MeshBuilder, Scene, SceneError, Texture, TextureId};
+use crate::{AlphaMode, ColorEncoding, LoadOptions, Material, MeshBuilder, Scene, SceneError, Texture, TextureId};
 
 const LOAD_OPTIONS: tobj::LoadOptions = tobj::LoadOptions {
     // Fan triangulation keeps file order: polygon (0 1 2 3) gives (0 1 2), (0 2 3).
@@ -166,7 +166,7 @@ fn load_materials(
     let mut texture_index: HashMap<String, u32> = HashMap::new();
     let mut texture_files = Vec::new();
     for m in mtl_materials {
-        let base_color_texture = m.diffuse_texture.as_deref().map(|name| {
+        let mut texture = |name: &str| {
             let id = *texture_index.entry(name.to_owned()).or_insert_with(|| {
                 let file =
                     files.read(name).map_err(|why| format!("{}: material '{}': texture {why}", path.display(), m.name));
@@ -177,7 +177,9 @@ fn load_materials(
                 texture_files.len() as u32 - 1
             });
             TextureId(id)
-        });
+        };
+        let base_color_texture = m.diffuse_texture.as_deref().map(&mut texture);
+        let alpha_texture = m.dissolve_texture.as_deref().map(&mut texture);
         let shininess = m.shininess.unwrap_or(0.0);
         let defaults = Material::default();
         let illumination = m.illumination_model.unwrap_or(2);
@@ -194,6 +196,16 @@ fn load_materials(
             emission: m.emissive.unwrap_or(Vec3::ZERO),
             ior: m.optical_density.filter(|n| *n > 0.0).unwrap_or(1.5),
             opacity: m.dissolve.unwrap_or(1.0).clamp(0.0, 1.0),
+            // A map_d mask cuts holes (leaves, fences); a constant d below 1
+            // lets light through in proportion (stochastic transparency).
+            alpha_mode: if alpha_texture.is_some() {
+                AlphaMode::Mask { cutoff: 0.5 }
+            } else if m.dissolve.is_some_and(|d| d < 1.0) {
+                AlphaMode::Blend
+            } else {
+                AlphaMode::Opaque
+            },
+            alpha_texture,
             ..defaults
         });
     }
