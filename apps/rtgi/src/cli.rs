@@ -247,9 +247,11 @@ pub(crate) struct LightingArgs {
     #[arg(long, default_value = "mis")]
     pub(crate) direct_strategy: DirectStrategy,
 
-    /// Clamp the light each path brings in after two or more bounces to this value: fewer
-    /// fireflies (caustics), at the price of a bias [default: no clamp]
-    #[arg(long, value_parser = parse_positive, allow_negative_numbers = true)]
+    /// Clamp the light each path brings in after two or more bounces to this value (brightest
+    /// channel): fewer fireflies from caustics and glossy paths at low sample counts, at the
+    /// price of a bias (darker caustics and highlights); the plan says when it is on [default:
+    /// no clamp]
+    #[arg(long, visible_alias = "clamp", value_parser = parse_positive, allow_negative_numbers = true)]
     pub(crate) clamp_indirect: Option<f32>,
 
     /// Light from far away: a radiance R,G,B or an equirectangular .exr image

@@ -119,7 +119,7 @@ pub struct PlannedEffect {
 }
 
 /// Which effects a render simulates, and why.
-#[derive(Clone, Debug, PartialEq, Eq, Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct EffectPlan {
     #[serde(serialize_with = "as_name")]
     pub integrator: Integrator,
@@ -129,6 +129,9 @@ pub struct EffectPlan {
     pub default_environment: bool,
     /// Bounces the integrator follows after the camera ray.
     pub max_depth: u32,
+    /// The clamp on light brought in after two or more bounces
+    /// ([`RenderSettings::indirect_clamp`]), when indirect light is simulated.
+    pub indirect_clamp: Option<f32>,
 }
 
 /// The effects whose code the light-transport loop is compiled with or
@@ -430,7 +433,8 @@ impl EffectPlan {
 
         let default_environment = default_environment && environment;
         let max_depth = if indirect { max_depth } else { max_depth.min(1) };
-        Self { integrator, effects, default_environment, max_depth }
+        let indirect_clamp = settings.indirect_clamp.filter(|_| indirect);
+        Self { integrator, effects, default_environment, max_depth, indirect_clamp }
     }
 
     /// The effects the plan simulates.
@@ -506,6 +510,13 @@ impl fmt::Display for EffectPlan {
             let sign = if e.enabled { '+' } else { '-' };
             let forced = if e.forced { '!' } else { ' ' };
             writeln!(f, "  {sign}{forced}{:<13} {}", e.effect.name(), e.reason)?;
+        }
+        if let Some(clamp) = self.indirect_clamp {
+            writeln!(
+                f,
+                "  clamp         light brought in after two or more bounces is clamped at {clamp}: fewer fireflies, \
+                 but caustics and glossy highlights come out darker (biased; leave out --clamp for the exact image)"
+            )?;
         }
         Ok(())
     }
