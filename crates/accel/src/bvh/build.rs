@@ -109,6 +109,14 @@ fn build_node(
             SplitMethod::SweepSah => sah::sweep(ctx, prims, &range),
         }
     };
+    // A split method that puts every primitive on one side (found by
+    // fuzzing: extreme finite coordinates, whose boxes overflow to
+    // infinity) would index past the slots; the object median always
+    // splits in two.
+    let split = match split {
+        Some(s) if s.left_count == 0 || s.left_count >= n => Some(median::object_median(prims, &range)),
+        split => split,
+    };
     let (this, rest) = slots.split_first_mut().expect("a subtree over n primitives has 2n - 1 slots");
     let Some(Split { left_count, left: left_range, right: right_range }) = split else {
         *this = Slot::new(range.bounds, first, n as u32);
