@@ -1,43 +1,7 @@
-//! What the fuzz targets share: the files a fuzzed scene may reference.
-//! They match `rtgi_tests::corpus`, so that an input the fuzzers find
-//! behaves the same in the test corpus (`tests/corpus/`).
+//! What the fuzz targets share: the files a fuzzed scene may reference,
+//! the same as the test corpus's (`tests/src/corpus/referenced_files.rs`,
+//! included here so that the two cannot drift apart).
 
-use std::path::Path;
-
-/// An OBJ file that uses the materials of `m.mtl`: MTL inputs are loaded through it.
-pub const MTL_HOST_OBJ: &str = "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0 1\n\
-usemtl a\nf 1/1 2/2 3/3\nusemtl b\nf 1/1 3/3 2/2\nusemtl c\nf 3 2 1\n";
-
-/// The MTL that OBJ inputs reference as any `*.mtl`.
-pub const REFERENCED_MTL: &str = "newmtl a\nKd 0.5 0.5 0.5\nmap_Kd tex.png\nnewmtl b\nKe 1 1 1\n";
-
-/// The OBJ that descriptions reference as any `*.obj`.
-pub const REFERENCED_OBJ: &str = "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
-
-/// A 2 × 2 RGBA PNG, for any referenced image.
-pub const REFERENCED_PNG: [u8; 74] = [
-    137, 80, 78, 71, 13, 10, 26, 10, 0, 0, 0, 13, 73, 72, 68, 82, 0, 0, 0, 2, 0, 0, 0, 2, 8, 6, 0, 0, 0, 114, 182, 13,
-    36, 0, 0, 0, 17, 73, 68, 65, 84, 120, 156, 99, 56, 145, 98, 244, 31, 132, 25, 96, 12, 0, 84, 64, 9, 117, 166, 104,
-    144, 194, 0, 0, 0, 0, 73, 69, 78, 68, 174, 66, 96, 130,
-];
-
-/// Three positions, three normals, three texture coordinates, indices 0 1 2 (u16): 104 bytes.
-pub fn referenced_bin() -> Vec<u8> {
-    let floats: [f32; 24] =
-        [0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 1.0, 0.0, 0.0, 1.0, 0.0, 0.0, 1.0, 0.0, 0.0, 1.0];
-    let mut bytes: Vec<u8> = floats.iter().flat_map(|f| f.to_le_bytes()).collect();
-    bytes.extend([0, 0, 1, 0, 2, 0, 0, 0]);
-    bytes
-}
-
-/// The bytes of a referenced file, by its extension; `mtl` answers `*.mtl`.
-pub fn referenced(name: &str, mtl: &[u8]) -> Option<Vec<u8>> {
-    let extension = Path::new(name).extension()?.to_str()?.to_ascii_lowercase();
-    match extension.as_str() {
-        "mtl" => Some(mtl.to_vec()),
-        "obj" => Some(REFERENCED_OBJ.as_bytes().to_vec()),
-        "bin" => Some(referenced_bin()),
-        "png" => Some(REFERENCED_PNG.to_vec()),
-        _ => None,
-    }
-}
+#[path = "../../tests/src/corpus/referenced_files.rs"]
+mod referenced_files;
+pub use referenced_files::*;
