@@ -5,14 +5,13 @@ use std::time::Instant;
 
 use anyhow::{Context, Result, bail};
 use rtgi_accel::Accel;
-use rtgi_render::{Environment, RenderSettings, camera_blocked, frame_scene};
+use rtgi_render::{
+    DEFAULT_VERTICAL_FOV_DEGREES, Environment, RenderSettings, camera_blocked, default_camera, frame_scene,
+};
 use rtgi_scene::{Camera, LoadOptions, Scene};
 
 use crate::cli::{CameraArgs, EnvironmentArg, LightingArgs};
 use crate::default_scene;
-
-/// Field of view of the automatic framing when no camera is given.
-pub(crate) const DEFAULT_FOV_DEGREES: f32 = 40.0;
 
 pub(crate) struct LoadedScene {
     pub(crate) scene: Scene,
@@ -93,11 +92,12 @@ pub(crate) fn choose_camera(scene: &Scene, accel: &dyn Accel, options: &CameraAr
             bail!("--fov {degrees}: the field of view must be between 0 and 180 degrees")
         }
         Some(degrees) => degrees.to_radians(),
-        None => chosen.map_or(DEFAULT_FOV_DEGREES.to_radians(), |c| c.vertical_fov),
+        None => chosen.map_or(DEFAULT_VERTICAL_FOV_DEGREES.to_radians(), |c| c.vertical_fov),
     };
     let automatic = chosen.is_none() && options.at.is_none();
     let mut camera = match chosen {
         Some(camera) => *camera,
+        None if options.fov.is_none() => default_camera(scene, accel, aspect),
         None => frame_scene(scene, accel, fov, aspect),
     };
     camera.vertical_fov = fov;

@@ -16,8 +16,7 @@
 //! sixteen rays as packets, with the same answers.
 //!
 //! ```
-//! use rtgi_accel::{Accel, AccelKind, BuildParams};
-//! use rtgi_math::{Ray, Vec3};
+//! use rtgi_accel::{Accel, AccelKind, BuildParams, Ray, Vec3};
 //!
 //! let triangles = [[Vec3::new(-1.0, -1.0, 0.0), Vec3::new(1.0, -1.0, 0.0), Vec3::new(0.0, 1.0, 0.0)]];
 //! let accel = AccelKind::Linear.build(&triangles, &BuildParams::default());
@@ -89,7 +88,10 @@ pub use linear::LinearScan;
 pub use triangle::{Intersector, TriangleHit};
 pub use wide::{Bvh4, Bvh8, WideBvh};
 
-use rtgi_math::Ray;
+/// The math types this crate takes and returns, re-exported so that a user
+/// needs one dependency and sees the same glam version as the crate.
+pub use rtgi_math::{Aabb, Ray, Rng, Vec3};
+
 use serde::Serialize;
 
 /// The closest hit of a ray: its distance `t` along the ray, the index of

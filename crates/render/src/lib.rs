@@ -8,13 +8,14 @@
 //!
 //! ```no_run
 //! use rtgi_accel::{AccelKind, BuildParams};
-//! use rtgi_render::{RenderSettings, render};
-//! use rtgi_scene::{Camera, Scene};
+//! use rtgi_render::{RenderSettings, default_camera, render};
+//! use rtgi_scene::Scene;
 //!
 //! let scene = Scene::load("scenes/cornell-box.toml".as_ref())?;
 //! let accel = AccelKind::Linear.build(&scene.triangle_positions(), &BuildParams::default());
 //! let settings = RenderSettings { width: 256, height: 256, ..RenderSettings::default() };
-//! let camera = scene.cameras[0];
+//! // The scene's first camera, or a view framing it if it has none.
+//! let camera = default_camera(&scene, accel.as_ref(), 1.0);
 //! let (image, stats) = render(&scene, accel.as_ref(), &camera, &settings, &|_| {});
 //! println!("{} rays in {:.1} ms", stats.rays, stats.render_ms);
 //! # Ok::<(), Box<dyn std::error::Error>>(())
@@ -44,7 +45,7 @@ pub use default_lighting::{ENCLOSED, default_sky, default_sun, room_light, sky_v
 pub use distribution::Distribution1D;
 pub use effect_set::EffectSet;
 pub use effects::{Effect, EffectOverrides, EffectPlan, PlannedEffect, Reversal};
-pub use framing::{camera_blocked, frame_scene, three_quarter_view};
+pub use framing::{DEFAULT_VERTICAL_FOV_DEGREES, camera_blocked, default_camera, frame_scene, three_quarter_view};
 pub use identity::{Difference, RenderIdentity, scene_fingerprint};
 pub use integrator::{DirectStrategy, Integrator};
 pub use lights::{Environment, EnvironmentMap, LightSet};
