@@ -70,6 +70,10 @@ use crate::integrator::Transport;
 pub const TILE_SIZE: u32 = 16;
 
 /// What to render and how.
+///
+/// The default is what the `rtgi` command renders: a 512 × 512 path-traced
+/// image of 16 stratified samples per pixel (antialiased), MIS for direct
+/// light, up to 8 bounces with Russian roulette.
 #[derive(Clone, Debug, PartialEq)]
 pub struct RenderSettings {
     pub width: u32,
@@ -104,8 +108,8 @@ impl Default for RenderSettings {
         Self {
             width: 512,
             height: 512,
-            samples_per_pixel: 1,
-            sampler: PixelSampler::Center,
+            samples_per_pixel: 16,
+            sampler: PixelSampler::Stratified,
             seed: 0,
             background: Vec3::new(0.05, 0.05, 0.06),
             integrator: Integrator::Path,
