@@ -6,11 +6,11 @@ use std::time::Instant;
 use anyhow::{Context, Result, bail};
 use rtgi_accel::Accel;
 use rtgi_render::{
-    DEFAULT_VERTICAL_FOV_DEGREES, Environment, RenderSettings, camera_blocked, default_camera, frame_scene,
+    DEFAULT_VERTICAL_FOV_DEGREES, EnvironmentSpec, RenderSettings, camera_blocked, default_camera, frame_scene,
 };
 use rtgi_scene::{Camera, LoadOptions, Scene};
 
-use crate::cli::{CameraArgs, EnvironmentArg, LightingArgs};
+use crate::cli::{CameraArgs, LightingArgs};
 use crate::default_scene;
 
 pub(crate) struct LoadedScene {
@@ -138,11 +138,7 @@ pub(crate) fn apply_lighting(args: &LightingArgs, scene: &mut Scene, settings: &
     settings.direct_strategy = args.direct_strategy;
     settings.indirect_clamp = args.clamp_indirect;
     settings.effects = args.effects.clone();
-    settings.environment = match &args.environment {
-        None => None,
-        Some(EnvironmentArg::Uniform(radiance)) => Some(Environment::Uniform(*radiance)),
-        Some(EnvironmentArg::File(path)) => Some(Environment::load(path)?),
-    };
+    settings.environment = args.environment.as_ref().map(EnvironmentSpec::load).transpose()?;
     Ok(())
 }
 

@@ -48,7 +48,7 @@ pub use effects::{Effect, EffectOverrides, EffectPlan, PlannedEffect, Reversal};
 pub use framing::{DEFAULT_VERTICAL_FOV_DEGREES, camera_blocked, default_camera, frame_scene, three_quarter_view};
 pub use identity::{Difference, RenderIdentity, scene_fingerprint};
 pub use integrator::{DirectStrategy, Integrator};
-pub use lights::{Environment, EnvironmentMap, LightSet};
+pub use lights::{Environment, EnvironmentMap, EnvironmentSpec, EnvironmentSpecError, LightSet};
 pub use sampler::{PixelSample, PixelSampler};
 pub use shade::{albedo, alpha_accepts, has_alpha, shade_primary, shading_normal};
 

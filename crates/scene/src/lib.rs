@@ -34,7 +34,7 @@ mod resolve;
 mod texture;
 
 pub use camera::Camera;
-pub use light::{Light, LightKind};
+pub use light::{Light, LightKind, LightSpecError};
 pub use material::{AlphaMode, Material, SurfaceModel};
 pub use mesh::MeshBuilder;
 pub use resolve::resolve_case_insensitive;
