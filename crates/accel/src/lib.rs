@@ -64,6 +64,11 @@
 //! [`AccelKind::ALL`]. Its module is the one place of the workspace where
 //! `unsafe` code is allowed.
 
+// The README's examples are compiled and run as doctests.
+#[doc = include_str!("../README.md")]
+#[cfg(doctest)]
+pub struct ReadmeDoctests;
+
 mod boxa;
 mod bvh;
 mod contract;

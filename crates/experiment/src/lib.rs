@@ -16,6 +16,11 @@
 //! - each repeat of a measured render uses another seed, and its error is
 //!   averaged as mean squared error.
 
+// The README's examples are compiled and run as doctests.
+#[doc = include_str!("../README.md")]
+#[cfg(doctest)]
+pub struct ReadmeDoctests;
+
 use std::path::PathBuf;
 
 use rtgi_accel::Accel;

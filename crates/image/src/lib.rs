@@ -18,6 +18,11 @@
 //! # Ok::<(), rtgi_image::ImageError>(())
 //! ```
 
+// The README's examples are compiled and run as doctests.
+#[doc = include_str!("../README.md")]
+#[cfg(doctest)]
+pub struct ReadmeDoctests;
+
 mod atomic;
 mod compare;
 mod exposure;

@@ -14,6 +14,11 @@
 //! assert!(t_exit >= 2.0);
 //! ```
 
+// The README's examples are compiled and run as doctests.
+#[doc = include_str!("../README.md")]
+#[cfg(doctest)]
+pub struct ReadmeDoctests;
+
 mod aabb;
 mod choices;
 mod float;

@@ -19,6 +19,11 @@
 //! # Ok::<(), rtgi_scene::SceneError>(())
 //! ```
 
+// The README's examples are compiled and run as doctests.
+#[doc = include_str!("../README.md")]
+#[cfg(doctest)]
+pub struct ReadmeDoctests;
+
 mod camera;
 pub mod description;
 mod files;
