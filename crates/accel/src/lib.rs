@@ -64,6 +64,8 @@
 //! [`AccelKind::ALL`]. Its module is the one place of the workspace where
 //! `unsafe` code is allowed.
 
+#![warn(missing_docs)]
+
 // The README's examples are compiled and run as doctests.
 #[doc = include_str!("../README.md")]
 #[cfg(doctest)]
@@ -104,9 +106,13 @@ use serde::Serialize;
 /// barycentric coordinates of the hit point on that triangle.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Hit {
+    /// Distance along the ray, in multiples of its direction, within `[t_min, t_max]`.
     pub t: f32,
+    /// Index of the triangle in the order the structure was built from.
     pub triangle: u32,
+    /// Barycentric coordinate of the triangle's second corner.
     pub beta: f32,
+    /// Barycentric coordinate of the triangle's third corner.
     pub gamma: f32,
 }
 
@@ -120,8 +126,11 @@ pub struct BuildStats {
     /// Triangles left out because they can never be hit (zero area, or a
     /// NaN or infinite coordinate).
     pub excluded_triangles: usize,
+    /// Wall-clock time of the build, in milliseconds.
     pub build_ms: f64,
+    /// Nodes of the tree, leaves included (0 for the linear scan).
     pub nodes: usize,
+    /// Leaves of the tree.
     pub leaves: usize,
     /// Edges on the longest path from the root to a leaf.
     pub depth: usize,

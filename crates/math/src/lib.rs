@@ -14,6 +14,8 @@
 //! assert!(t_exit >= 2.0);
 //! ```
 
+#![warn(missing_docs)]
+
 // The README's examples are compiled and run as doctests.
 #[doc = include_str!("../README.md")]
 #[cfg(doctest)]

@@ -3,7 +3,9 @@ use rtgi_math::{Vec3, parse_vec3};
 /// A light that is not a surface (emissive surfaces are materials).
 #[derive(Clone, Debug, PartialEq)]
 pub struct Light {
+    /// A name for messages: the file's name for the light, or its specification text.
     pub name: String,
+    /// Point, spot or directional, with the spot's cone.
     pub kind: LightKind,
     /// Where a point or spot light is.
     pub position: Vec3,
@@ -17,14 +19,19 @@ pub struct Light {
     pub range: Option<f32>,
 }
 
+/// The shape of a light's emission.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum LightKind {
+    /// Light from one point, equally in every direction.
     Point,
     /// Full intensity inside `inner_cone`, none outside `outer_cone` (half-angles in radians).
     Spot {
+        /// Half-angle of full intensity, in radians.
         inner_cone: f32,
+        /// Half-angle beyond which there is no light, in radians, at least `inner_cone`.
         outer_cone: f32,
     },
+    /// Parallel light from infinitely far away (the sun), along `direction`.
     Directional,
 }
 
