@@ -21,6 +21,8 @@
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 
+#![warn(missing_docs)]
+
 // The README's examples are compiled and run as doctests.
 #[doc = include_str!("../README.md")]
 #[cfg(doctest)]
@@ -81,17 +83,23 @@ pub const TILE_SIZE: u32 = 16;
 /// light, up to 8 bounces with Russian roulette.
 #[derive(Clone, Debug, PartialEq)]
 pub struct RenderSettings {
+    /// Image width in pixels.
     pub width: u32,
+    /// Image height in pixels.
     pub height: u32,
     /// Samples per pixel.
     pub samples_per_pixel: u32,
+    /// Where in its pixel each sample's camera ray passes.
     pub sampler: PixelSampler,
+    /// Seed of the random numbers: every sample draws from `(seed, pixel, sample)`, so one seed gives one image.
     pub seed: u64,
     /// Radiance of camera rays that hit nothing, when no environment is seen.
     pub background: Vec3,
+    /// What a camera ray's sample computes: an AOV, direct light, or full paths.
     pub integrator: Integrator,
     /// Bounces a path may take after the camera ray (1 = direct light only).
     pub max_depth: u32,
+    /// How direct light is sampled: from the lights, from the BSDF, or both weighted by MIS.
     pub direct_strategy: DirectStrategy,
     /// Largest value (brightest channel) of the light one path brings in
     /// after two or more bounces: removes the fireflies of caustics at the
@@ -131,15 +139,20 @@ impl Default for RenderSettings {
 /// What a render did and how long it took.
 #[derive(Clone, Debug, Default, PartialEq, Serialize)]
 pub struct RenderStats {
+    /// Image width in pixels.
     pub width: u32,
+    /// Image height in pixels.
     pub height: u32,
+    /// Samples per pixel rendered.
     pub samples_per_pixel: u32,
     /// Rays traced, of all kinds.
     pub rays: u64,
+    /// Wall-clock time of the render, in milliseconds.
     pub render_ms: f64,
 }
 
 impl RenderStats {
+    /// Rays traced per second of wall-clock time.
     pub fn rays_per_second(&self) -> f64 {
         self.rays as f64 / (self.render_ms * 1e-3).max(1e-9)
     }

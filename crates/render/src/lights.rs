@@ -201,6 +201,7 @@ impl Environment {
 }
 
 impl EnvironmentMap {
+    /// An environment map over `image`, with the distributions that sample it in proportion to brightness.
     pub fn new(image: HdrImage) -> Self {
         let (w, h) = (image.width(), image.height());
         let columns: Vec<Distribution1D> =
@@ -269,16 +270,23 @@ struct Cone {
 /// An emissive triangle, as an area light.
 #[derive(Clone, Debug, PartialEq)]
 pub struct EmissiveTriangle {
+    /// The triangle's index in the scene.
     pub triangle: u32,
+    /// Its corners in world space.
     pub corners: [Vec3; 3],
+    /// Texture coordinates of its corners, for a textured emission.
     pub uvs: [Vec2; 3],
     /// Unit geometric normal (right-hand rule); the front side.
     pub normal: Vec3,
     /// The triangle's [`rtgi_math::elongation`], for the error bound of points on it.
     pub elongation: f32,
+    /// Its area, in square scene units.
     pub area: f32,
+    /// Emitted radiance (linear RGB), multiplied by the texture where there is one.
     pub emission: Vec3,
+    /// The emission texture, if any.
     pub texture: Option<TextureId>,
+    /// Whether the back side emits too (else only the front, the side of `normal`).
     pub two_sided: bool,
 }
 
@@ -416,6 +424,7 @@ impl LightSet {
         Self { sources, choice, source_of_triangle, environment_index }
     }
 
+    /// Whether there is no light at all (no light, emitter or environment).
     pub fn is_empty(&self) -> bool {
         self.sources.is_empty()
     }
