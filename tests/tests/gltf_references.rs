@@ -85,7 +85,13 @@ fn alpha_masks_cut_holes_that_opaque_rendering_fills() {
     let scene = Scene::load(&path).unwrap();
     let accel = AccelKind::Sah.build(&scene.triangle_positions(), &BuildParams::default());
     let camera = frame_scene(&scene, accel.as_ref(), 20f32.to_radians(), 2.0);
-    let settings = RenderSettings { width: 200, height: 100, ..RenderSettings::default() };
+    let settings = RenderSettings {
+        width: 200,
+        height: 100,
+        samples_per_pixel: 1,
+        sampler: PixelSampler::Center,
+        ..RenderSettings::default()
+    };
     let (with_alpha, _) = render(&scene, accel.as_ref(), &camera, &settings, &|_| {});
     let mut opaque_scene = scene.clone();
     opaque_scene.materials.iter_mut().for_each(|m| m.alpha_mode = rtgi_scene::AlphaMode::Opaque);

@@ -169,8 +169,14 @@ fn diffuse_plane_under_a_point_light_matches_the_analytic_irradiance() {
     let camera = Camera::look_at(Vec3::new(0.0, 0.0, 5.0), Vec3::ZERO, Vec3::Y, 1.0);
     let (width, height) = (32, 32);
     for integrator in [Integrator::Direct, Integrator::Path] {
-        let settings =
-            RenderSettings { width, height, integrator, sampler: PixelSampler::Center, ..RenderSettings::default() };
+        let settings = RenderSettings {
+            width,
+            height,
+            integrator,
+            samples_per_pixel: 1,
+            sampler: PixelSampler::Center,
+            ..RenderSettings::default()
+        };
         let image = render_scene(&scene, &camera, &settings);
         let rays = CameraRays::new(&camera, width, height);
         let mut worst = 0.0f32;

@@ -5,8 +5,8 @@ use clap::{Args, Parser, Subcommand};
 use rtgi_accel::{AccelKind, BuildError, BuildParams, Intersector, Traversal};
 use rtgi_image::ToneOperator;
 use rtgi_math::Vec3;
-use rtgi_render::{DirectStrategy, EffectOverrides, Integrator, PixelSampler};
-use rtgi_scene::{Light, LightKind};
+use rtgi_render::{DirectStrategy, EffectOverrides, EnvironmentSpec, EnvironmentSpecError, Integrator, PixelSampler};
+use rtgi_scene::{Light, LightSpecError};
 
 /// Largest image side accepted: beyond this a typo (an extra zero) would
 /// ask for gigabytes of memory and hours of rendering.
@@ -256,7 +256,7 @@ pub(crate) struct LightingArgs {
 
     /// Light from far away: a radiance R,G,B or an equirectangular .exr image
     #[arg(long, value_parser = parse_environment, allow_hyphen_values = true)]
-    pub(crate) environment: Option<EnvironmentArg>,
+    pub(crate) environment: Option<EnvironmentSpec>,
 
     /// Add a light (repeatable): point:X,Y,Z:INTENSITY[:R,G,B],
     /// directional:DX,DY,DZ:IRRADIANCE[:R,G,B] (the direction light travels),
@@ -267,13 +267,6 @@ pub(crate) struct LightingArgs {
     /// Force effects on or off, like +glossy,-textures (see the plan `rtgi info` prints)
     #[arg(long, allow_hyphen_values = true, default_value = "")]
     pub(crate) effects: EffectOverrides,
-}
-
-/// The `--environment` option before the file is read.
-#[derive(Clone, Debug)]
-pub(crate) enum EnvironmentArg {
-    Uniform(Vec3),
-    File(PathBuf),
 }
 
 /// Parses a finite number that `accept` allows; the error names the
@@ -313,79 +306,14 @@ pub(crate) fn parse_direction(text: &str) -> Result<Vec3, String> {
     })
 }
 
-fn parse_environment(text: &str) -> Result<EnvironmentArg, String> {
-    if let Ok(radiance) = parse_vec3(text) {
-        if radiance.min_element() < 0.0 {
-            return Err(format!("environment radiance must not be negative (got '{text}')"));
-        }
-        return Ok(EnvironmentArg::Uniform(radiance));
-    }
-    let path = PathBuf::from(text);
-    if path.extension().is_some_and(|e| e.eq_ignore_ascii_case("exr")) {
-        Ok(EnvironmentArg::File(path))
-    } else {
-        Err(format!("expected a radiance R,G,B or an .exr file (got '{text}')"))
-    }
+/// Parses `--environment` (the file is read later, once the outputs are checked).
+fn parse_environment(text: &str) -> Result<EnvironmentSpec, String> {
+    text.parse().map_err(|e: EnvironmentSpecError| e.to_string())
 }
 
 /// Parses `--light`: fields separated by colons, vectors by commas.
 pub(crate) fn parse_light(text: &str) -> Result<Light, String> {
-    let fields: Vec<&str> = text.split(':').map(str::trim).collect();
-    let number = |s: &str, what: &str| -> Result<f32, String> {
-        s.parse::<f32>()
-            .ok()
-            .filter(|v| v.is_finite() && *v >= 0.0)
-            .ok_or_else(|| format!("light '{text}': {what} must be a non-negative number (got '{s}')"))
-    };
-    let vector = |s: &str| parse_vec3(s).map_err(|e| format!("light '{text}': {e}"));
-    let colour = |rest: &[&str]| -> Result<Vec3, String> {
-        match rest {
-            [] => Ok(Vec3::ONE),
-            [c] => parse_colour(c).map_err(|e| format!("light '{text}': the colour: {e}")),
-            _ => Err(format!("light '{text}': too many fields")),
-        }
-    };
-    let unit = |v: Vec3| v.try_normalize().ok_or_else(|| format!("light '{text}': the direction is zero"));
-    let mut light = Light {
-        name: text.to_owned(),
-        kind: LightKind::Point,
-        position: Vec3::ZERO,
-        direction: Vec3::NEG_Y,
-        color: Vec3::ONE,
-        intensity: 1.0,
-        range: None,
-    };
-    match fields.as_slice() {
-        ["point", position, intensity, rest @ ..] => {
-            light.position = vector(position)?;
-            light.intensity = number(intensity, "the intensity")?;
-            light.color = colour(rest)?;
-        }
-        ["directional", direction, irradiance, rest @ ..] => {
-            light.kind = LightKind::Directional;
-            light.direction = unit(vector(direction)?)?;
-            light.intensity = number(irradiance, "the irradiance")?;
-            light.color = colour(rest)?;
-        }
-        ["spot", position, direction, intensity, inner, outer, rest @ ..] => {
-            let (inner, outer) = (number(inner, "the inner angle")?, number(outer, "the outer angle")?);
-            if !(inner <= outer && outer <= 90.0) {
-                return Err(format!("light '{text}': angles must satisfy inner <= outer <= 90 degrees"));
-            }
-            light.kind = LightKind::Spot { inner_cone: inner.to_radians(), outer_cone: outer.to_radians() };
-            light.position = vector(position)?;
-            light.direction = unit(vector(direction)?)?;
-            light.intensity = number(intensity, "the intensity")?;
-            light.color = colour(rest)?;
-        }
-        _ => {
-            return Err(format!(
-                "light '{text}': expected point:X,Y,Z:INTENSITY, directional:DX,DY,DZ:IRRADIANCE or \
-                 spot:X,Y,Z:DX,DY,DZ:INTENSITY:INNER:OUTER, each optionally followed by :R,G,B"
-            ));
-        }
-    }
-    Ok(light)
+    text.parse().map_err(|e: LightSpecError| e.to_string())
 }
 
 /// `rtgi bvh-boxes`: the boxes of some levels of a BVH as a wireframe-able mesh.
@@ -761,12 +689,8 @@ pub(crate) struct CameraArgs {
 
 /// Parses "x,y,z" into a vector of finite numbers.
 pub(crate) fn parse_vec3(text: &str) -> Result<Vec3, String> {
-    let parts: Vec<&str> = text.split(',').map(str::trim).collect();
-    let numbers: Result<Vec<f32>, _> = parts.iter().map(|p| p.parse::<f32>()).collect();
-    match numbers {
-        Ok(n) if n.len() == 3 && n.iter().all(|c| c.is_finite()) => Ok(Vec3::new(n[0], n[1], n[2])),
-        _ => Err(format!("expected three finite numbers separated by commas, like 0,1.5,-2 (got '{text}')")),
-    }
+    rtgi_math::parse_vec3(text)
+        .ok_or_else(|| format!("expected three finite numbers separated by commas, like 0,1.5,-2 (got '{text}')"))
 }
 
 /// Prints a command-line error as one line (help and version as clap writes them).

@@ -5,14 +5,13 @@ use std::time::Instant;
 
 use anyhow::{Context, Result, bail};
 use rtgi_accel::Accel;
-use rtgi_render::{Environment, RenderSettings, camera_blocked, frame_scene};
+use rtgi_render::{
+    DEFAULT_VERTICAL_FOV_DEGREES, EnvironmentSpec, RenderSettings, camera_blocked, default_camera, frame_scene,
+};
 use rtgi_scene::{Camera, LoadOptions, Scene};
 
-use crate::cli::{CameraArgs, EnvironmentArg, LightingArgs};
+use crate::cli::{CameraArgs, LightingArgs};
 use crate::default_scene;
-
-/// Field of view of the automatic framing when no camera is given.
-pub(crate) const DEFAULT_FOV_DEGREES: f32 = 40.0;
 
 pub(crate) struct LoadedScene {
     pub(crate) scene: Scene,
@@ -93,11 +92,12 @@ pub(crate) fn choose_camera(scene: &Scene, accel: &dyn Accel, options: &CameraAr
             bail!("--fov {degrees}: the field of view must be between 0 and 180 degrees")
         }
         Some(degrees) => degrees.to_radians(),
-        None => chosen.map_or(DEFAULT_FOV_DEGREES.to_radians(), |c| c.vertical_fov),
+        None => chosen.map_or(DEFAULT_VERTICAL_FOV_DEGREES.to_radians(), |c| c.vertical_fov),
     };
     let automatic = chosen.is_none() && options.at.is_none();
     let mut camera = match chosen {
         Some(camera) => *camera,
+        None if options.fov.is_none() => default_camera(scene, accel, aspect),
         None => frame_scene(scene, accel, fov, aspect),
     };
     camera.vertical_fov = fov;
@@ -138,11 +138,7 @@ pub(crate) fn apply_lighting(args: &LightingArgs, scene: &mut Scene, settings: &
     settings.direct_strategy = args.direct_strategy;
     settings.indirect_clamp = args.clamp_indirect;
     settings.effects = args.effects.clone();
-    settings.environment = match &args.environment {
-        None => None,
-        Some(EnvironmentArg::Uniform(radiance)) => Some(Environment::Uniform(*radiance)),
-        Some(EnvironmentArg::File(path)) => Some(Environment::load(path)?),
-    };
+    settings.environment = args.environment.as_ref().map(EnvironmentSpec::load).transpose()?;
     Ok(())
 }
 

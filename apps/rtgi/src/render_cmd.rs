@@ -6,13 +6,13 @@ use rtgi_image::{
     HdrImage, Legibility, OutputFormat, ToneMap, ToneOperator, auto_exposure, check_writable, legibility,
 };
 use rtgi_render::{
-    Accumulation, ENCLOSED, EffectPlan, Integrator, PixelSampler, RenderIdentity, RenderSettings, render, room_light,
-    sky_visibility,
+    Accumulation, ENCLOSED, EffectPlan, EnvironmentSpec, Integrator, PixelSampler, RenderIdentity, RenderSettings,
+    render, room_light, sky_visibility,
 };
 use rtgi_scene::{Camera, Light, Scene};
 
 use crate::cli::RenderArgs;
-use crate::cli::{EnvironmentArg, ToneArgs};
+use crate::cli::ToneArgs;
 use crate::common::{
     LoadedScene, apply_lighting, check_output_folder, choose_camera, load_scene, refuse_inputs_as_outputs,
 };
@@ -81,7 +81,7 @@ pub(crate) fn render_image(args: &RenderArgs) -> Result<Rendered> {
         .chain(job.checkpoint.as_deref().map(|path| ("--checkpoint", path)))
         .collect();
     let mut inputs: Vec<(&str, &Path)> = args.scene.as_deref().map(|path| ("the scene", path)).into_iter().collect();
-    if let Some(EnvironmentArg::File(path)) = &args.lighting.environment {
+    if let Some(EnvironmentSpec::File(path)) = &args.lighting.environment {
         inputs.push(("--environment", path));
     }
     refuse_inputs_as_outputs(&outputs, &inputs)?;

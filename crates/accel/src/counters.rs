@@ -3,7 +3,9 @@ use serde::Serialize;
 /// Receives the work a traversal does. The no-op [`NoCounter`] compiles to
 /// nothing, so structures write their loops once, generic over this trait.
 pub trait Counter {
+    /// Called once for each node whose box the ray is tested against.
     fn node_visited(&mut self);
+    /// Called with the number of ray/triangle tests just made.
     fn triangles_tested(&mut self, count: u32);
 }
 
@@ -21,8 +23,11 @@ impl Counter for NoCounter {
 /// Work done by the queries of one or many rays.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize)]
 pub struct TraversalCounters {
+    /// Rays queried.
     pub rays: u64,
+    /// Nodes whose boxes were tested, summed over the rays.
     pub nodes_visited: u64,
+    /// Ray/triangle tests, summed over the rays.
     pub triangles_tested: u64,
 }
 

@@ -16,8 +16,7 @@
 //! sixteen rays as packets, with the same answers.
 //!
 //! ```
-//! use rtgi_accel::{Accel, AccelKind, BuildParams};
-//! use rtgi_math::{Ray, Vec3};
+//! use rtgi_accel::{Accel, AccelKind, BuildParams, Ray, Vec3};
 //!
 //! let triangles = [[Vec3::new(-1.0, -1.0, 0.0), Vec3::new(1.0, -1.0, 0.0), Vec3::new(0.0, 1.0, 0.0)]];
 //! let accel = AccelKind::Linear.build(&triangles, &BuildParams::default());
@@ -65,6 +64,13 @@
 //! [`AccelKind::ALL`]. Its module is the one place of the workspace where
 //! `unsafe` code is allowed.
 
+#![warn(missing_docs)]
+
+// The README's examples are compiled and run as doctests.
+#[doc = include_str!("../README.md")]
+#[cfg(doctest)]
+pub struct ReadmeDoctests;
+
 mod boxa;
 mod bvh;
 mod contract;
@@ -89,7 +95,10 @@ pub use linear::LinearScan;
 pub use triangle::{Intersector, TriangleHit};
 pub use wide::{Bvh4, Bvh8, WideBvh};
 
-use rtgi_math::Ray;
+/// The math types this crate takes and returns, re-exported so that a user
+/// needs one dependency and sees the same glam version as the crate.
+pub use rtgi_math::{Aabb, Ray, Rng, Vec3};
+
 use serde::Serialize;
 
 /// The closest hit of a ray: its distance `t` along the ray, the index of
@@ -97,9 +106,13 @@ use serde::Serialize;
 /// barycentric coordinates of the hit point on that triangle.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Hit {
+    /// Distance along the ray, in multiples of its direction, within `[t_min, t_max]`.
     pub t: f32,
+    /// Index of the triangle in the order the structure was built from.
     pub triangle: u32,
+    /// Barycentric coordinate of the triangle's second corner.
     pub beta: f32,
+    /// Barycentric coordinate of the triangle's third corner.
     pub gamma: f32,
 }
 
@@ -113,8 +126,11 @@ pub struct BuildStats {
     /// Triangles left out because they can never be hit (zero area, or a
     /// NaN or infinite coordinate).
     pub excluded_triangles: usize,
+    /// Wall-clock time of the build, in milliseconds.
     pub build_ms: f64,
+    /// Nodes of the tree, leaves included (0 for the linear scan).
     pub nodes: usize,
+    /// Leaves of the tree.
     pub leaves: usize,
     /// Edges on the longest path from the root to a leaf.
     pub depth: usize,

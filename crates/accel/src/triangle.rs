@@ -10,8 +10,11 @@ use crate::simd::triangles::{self, BlockHits, TriangleBlock};
 /// the second and third corners (the first corner's is `1 - beta - gamma`).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct TriangleHit {
+    /// Distance along the ray, in multiples of its direction.
     pub t: f32,
+    /// Barycentric coordinate of the second corner.
     pub beta: f32,
+    /// Barycentric coordinate of the third corner.
     pub gamma: f32,
 }
 
@@ -34,9 +37,11 @@ pub enum Intersector {
 }
 
 impl Intersector {
+    /// Every intersector, the default first.
     pub const ALL: &'static [Intersector] =
         &[Intersector::Watertight, Intersector::MollerTrumbore, Intersector::WatertightF64];
 
+    /// The name on command lines and in reports.
     pub fn name(self) -> &'static str {
         match self {
             Intersector::Watertight => "watertight",

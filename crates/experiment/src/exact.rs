@@ -113,14 +113,17 @@ impl ExactHit {
         positive(&alpha) && positive(&self.beta) && positive(&self.gamma) && positive(&self.t)
     }
 
+    /// The exact hit distance, rounded once to `f64`.
     pub fn t(&self) -> f64 {
         ratio_to_f64(&self.t, &self.det)
     }
 
+    /// The exact barycentric coordinate of the second corner, rounded once to `f64`.
     pub fn beta(&self) -> f64 {
         ratio_to_f64(&self.beta, &self.det)
     }
 
+    /// The exact barycentric coordinate of the third corner, rounded once to `f64`.
     pub fn gamma(&self) -> f64 {
         ratio_to_f64(&self.gamma, &self.det)
     }

@@ -10,7 +10,9 @@ use crate::{ExperimentError, Report};
 /// A report and the folder it was written to, relative to the index.
 #[derive(Debug)]
 pub struct IndexEntry<'a> {
+    /// The folder of the report's files, relative to the index.
     pub folder: PathBuf,
+    /// The report written there.
     pub report: &'a Report,
 }
 

@@ -16,6 +16,13 @@
 //! - each repeat of a measured render uses another seed, and its error is
 //!   averaged as mean squared error.
 
+#![warn(missing_docs)]
+
+// The README's examples are compiled and run as doctests.
+#[doc = include_str!("../README.md")]
+#[cfg(doctest)]
+pub struct ReadmeDoctests;
+
 use std::path::PathBuf;
 
 use rtgi_accel::Accel;
@@ -42,7 +49,9 @@ pub use report::{Point, Report, Series, Table};
 pub struct Subject {
     /// The scene's file, or the built-in scene's name.
     pub name: String,
+    /// The scene, with any lights the caller added.
     pub scene: Scene,
+    /// The camera every render of the experiment uses.
     pub camera: Camera,
     /// The structure renders use, unless the knob varies it.
     pub accel: Box<dyn Accel>,
@@ -57,6 +66,7 @@ impl std::fmt::Debug for Subject {
 }
 
 #[derive(Clone, Debug)]
+/// How an experiment is run: repeats, size, threads, where references are cached.
 pub struct Options {
     /// Timed runs per measurement (renders: each with its own seed).
     pub repeats: usize,
@@ -79,15 +89,36 @@ impl Options {
 }
 
 #[derive(Debug, thiserror::Error)]
+/// Why an experiment could not run or write its report.
 pub enum ExperimentError {
+    /// A report, plot or cached reference could not be written.
     #[error("{path}: cannot write: {source}")]
-    Write { path: PathBuf, source: std::io::Error },
+    Write {
+        /// The file.
+        path: PathBuf,
+        /// What the operating system said.
+        source: std::io::Error,
+    },
+    /// An image (a reference in the cache) could not be written or read.
     #[error("{path}: {message}")]
-    Image { path: PathBuf, message: String },
+    Image {
+        /// The file.
+        path: PathBuf,
+        /// What went wrong.
+        message: String,
+    },
+    /// A plot could not be drawn.
     #[error("plot {file}: {message}")]
-    Plot { file: String, message: String },
+    Plot {
+        /// The plot's file name.
+        file: String,
+        /// The plotting library's message.
+        message: String,
+    },
+    /// An acceleration structure the knob needs could not be built.
     #[error("cannot build the structure: {0}")]
     Build(String),
+    /// The knob cannot be measured on this subject; the message says why.
     #[error("{0}")]
     Unsuitable(String),
 }

@@ -3,6 +3,7 @@
 use serde::Serialize;
 
 #[derive(Clone, Debug, PartialEq, Serialize)]
+/// The machine an experiment ran on, recorded with its numbers.
 pub struct Machine {
     /// The CPU's model name, as the operating system reports it.
     pub cpu: String,
@@ -12,6 +13,7 @@ pub struct Machine {
     pub threads: usize,
     /// The widest SIMD level the acceleration structures run at.
     pub simd: String,
+    /// The operating system, as Rust names it (`linux`, `macos`, `windows`).
     pub os: String,
 }
 

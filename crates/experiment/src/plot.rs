@@ -11,6 +11,7 @@ use crate::report::format_number;
 /// One line of a plot.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Curve {
+    /// The curve's name in the legend.
     pub label: String,
     /// `(x, y)`, in the order they are joined.
     pub points: Vec<(f64, f64)>,
@@ -22,31 +23,40 @@ pub struct Curve {
 }
 
 impl Curve {
+    /// A curve of measurements through `points`, without error bars.
     pub fn new(label: impl Into<String>, points: Vec<(f64, f64)>) -> Curve {
         Curve { label: label.into(), bars: vec![None; points.len()], points, guide: false }
     }
 
+    /// The curve with an error bar per point; panics unless there is one per point.
     pub fn with_bars(mut self, bars: Vec<Option<(f64, f64)>>) -> Curve {
         assert_eq!(bars.len(), self.points.len(), "one bar per point");
         self.bars = bars;
         self
     }
 
+    /// A guide (a fitted or expected law) through `points`, drawn dashed.
     pub fn guide(label: impl Into<String>, points: Vec<(f64, f64)>) -> Curve {
         Curve { guide: true, ..Curve::new(label, points) }
     }
 }
 
 #[derive(Clone, Debug, PartialEq)]
+/// One SVG plot: curves on linear or logarithmic axes.
 pub struct Plot {
     /// File name, `*.svg`.
     pub file: String,
+    /// The title above the plot.
     pub title: String,
     /// Axis labels, with units.
     pub x_label: String,
+    /// The y axis's label, with units.
     pub y_label: String,
+    /// Whether the x axis is logarithmic.
     pub log_x: bool,
+    /// Whether the y axis is logarithmic.
     pub log_y: bool,
+    /// The curves, drawn in order.
     pub curves: Vec<Curve>,
     /// Where the legend goes: the corner the curves leave free.
     pub legend: Corner,
@@ -56,9 +66,13 @@ pub struct Plot {
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum Corner {
     #[default]
+    /// Top right.
     UpperRight,
+    /// Top left.
     UpperLeft,
+    /// Bottom right.
     LowerRight,
+    /// Bottom left.
     LowerLeft,
 }
 

@@ -32,7 +32,9 @@ struct Meta {
 /// A reference image and what is known of it.
 #[derive(Debug)]
 pub struct Reference {
+    /// The converged image, linear radiance.
     pub image: HdrImage,
+    /// How it was made: samples, seeds, its own noise, whether it was cached.
     pub info: ReferenceInfo,
 }
 

@@ -20,25 +20,30 @@ pub struct ImageError {
     /// repeats (each repeat with its own seed), and the smallest and
     /// largest RMSE of one repeat.
     pub rmse: f64,
+    /// The smallest RMSE of one repeat.
     pub rmse_min: f64,
+    /// The largest RMSE of one repeat.
     pub rmse_max: f64,
     /// Mean of `(test − reference)² / (reference² + 0.01)` over the repeats.
     pub relative_mse: f64,
     /// Mean radiance of the render, against the reference's: where they
     /// differ, energy is missing (or added), not only noise.
     pub mean: f64,
+    /// Mean radiance of the reference.
     pub reference_mean: f64,
 }
 
 /// The converged reference an experiment measured errors against.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct ReferenceInfo {
+    /// Samples per pixel, over both halves.
     pub samples_per_pixel: u32,
     /// Its seeds, independent of every measured render's.
     pub seeds: [u64; 2],
     /// The reference's own RMSE against the truth, estimated from its two
     /// independent halves: differences below it are not resolved.
     pub noise_rmse: f64,
+    /// Its render settings, described as in the cache key.
     pub settings: String,
     /// Whether it came from the cache on disk.
     pub cached: bool,
@@ -52,17 +57,21 @@ pub struct Point {
     pub x: f64,
     /// The knob's value as a person reads it.
     pub label: String,
+    /// The time the measurement took, if it was timed.
     pub time: Option<Timing>,
+    /// The image's error against the reference, if an image was measured.
     pub error: Option<ImageError>,
     /// Further figures of this point: nodes visited, disagreements, failure rates...
     pub values: BTreeMap<String, f64>,
 }
 
 impl Point {
+    /// A point at knob value `x`, labelled `label`, with nothing measured yet.
     pub fn new(x: f64, label: impl Into<String>) -> Point {
         Point { x, label: label.into(), time: None, error: None, values: BTreeMap::new() }
     }
 
+    /// The point with a further named figure.
     pub fn with(mut self, name: &str, value: f64) -> Point {
         self.values.insert(name.to_owned(), value);
         self
@@ -73,37 +82,50 @@ impl Point {
 /// structure, a scene...).
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct Series {
+    /// The setting the series is measured under, as the legend and tables name it.
     pub name: String,
+    /// The measurements, in increasing knob value.
     pub points: Vec<Point>,
 }
 
 /// A table for the Markdown file.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct Table {
+    /// The heading above the table.
     pub title: String,
+    /// Column names.
     pub header: Vec<String>,
+    /// The cells, row by row, as many as the header has columns.
     pub rows: Vec<Vec<String>>,
 }
 
 /// Everything one run of one knob produced.
 #[derive(Debug, Serialize)]
 pub struct Report {
+    /// The knob varied (`spp`, `depth`, ...).
     pub knob: String,
     /// The question the knob answers.
     pub question: String,
+    /// The scene's file, or the built-in scene's name.
     pub scene: String,
+    /// The machine it ran on.
     pub machine: Machine,
+    /// The version of rtgi that measured.
     pub rtgi_version: String,
     /// The command that produced the report, as typed.
     pub command: String,
     /// Timed runs behind each timing.
     pub repeats: usize,
+    /// Whether the reduced, quick version ran (its numbers are rough).
     pub quick: bool,
+    /// The reference errors were measured against, if the knob used one.
     pub reference: Option<ReferenceInfo>,
+    /// Every measurement, one series per setting of the other knobs.
     pub series: Vec<Series>,
     /// What the measurements show, in sentences (fitted slopes...).
     pub findings: Vec<String>,
     #[serde(skip)]
+    /// Tables for the Markdown file.
     pub tables: Vec<Table>,
     /// The plots, by file name.
     #[serde(serialize_with = "plot_files")]
@@ -175,6 +197,7 @@ impl Report {
         Ok(written)
     }
 
+    /// The report as Markdown: the question, the machine, findings, tables and plots.
     pub fn markdown(&self) -> String {
         let mut md = String::new();
         let _ = writeln!(md, "# `{}`: {}\n", self.knob, self.question);

@@ -6,9 +6,13 @@ use serde::Serialize;
 /// Repeated timings of one measurement, in milliseconds.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
 pub struct Timing {
+    /// Median of the runs, in milliseconds.
     pub median_ms: f64,
+    /// Fastest run, in milliseconds.
     pub min_ms: f64,
+    /// Slowest run, in milliseconds.
     pub max_ms: f64,
+    /// Number of runs.
     pub runs: usize,
 }
 
@@ -32,6 +36,7 @@ impl Timing {
 /// `y = a · x^exponent`, fitted by least squares to `(ln x, ln y)`.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
 pub struct PowerLaw {
+    /// The fitted exponent: the slope on log-log axes.
     pub exponent: f64,
     /// `a` above: the fitted value at `x = 1`.
     pub scale: f64,
@@ -63,6 +68,7 @@ impl PowerLaw {
         Some(PowerLaw { exponent, scale: (mean_y - exponent * mean_x).exp(), points: logs.len() })
     }
 
+    /// The fitted value `a · x^exponent` at `x`.
     pub fn at(&self, x: f64) -> f64 {
         self.scale * x.powf(self.exponent)
     }

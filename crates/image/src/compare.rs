@@ -16,9 +16,11 @@ pub struct Difference {
     pub relative_mse: f64,
     /// Largest absolute difference of a channel, and the pixel it is in.
     pub max_abs: f64,
+    /// `(x, y)` of the pixel holding that largest difference.
     pub max_at: (u32, u32),
     /// Mean over channels and pixels, of the test image and of the reference.
     pub mean: f64,
+    /// Mean of the reference over channels and pixels.
     pub reference_mean: f64,
 }
 

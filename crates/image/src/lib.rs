@@ -18,6 +18,13 @@
 //! # Ok::<(), rtgi_image::ImageError>(())
 //! ```
 
+#![warn(missing_docs)]
+
+// The README's examples are compiled and run as doctests.
+#[doc = include_str!("../README.md")]
+#[cfg(doctest)]
+pub struct ReadmeDoctests;
+
 mod atomic;
 mod compare;
 mod exposure;
@@ -51,28 +58,34 @@ impl HdrImage {
         (pixels.len() == width as usize * height as usize).then_some(Self { width, height, pixels })
     }
 
+    /// Width in pixels.
     pub fn width(&self) -> u32 {
         self.width
     }
 
+    /// Height in pixels.
     pub fn height(&self) -> u32 {
         self.height
     }
 
+    /// The pixels row by row from the top left, linear RGB.
     pub fn pixels(&self) -> &[Vec3] {
         &self.pixels
     }
 
+    /// The pixels row by row from the top left, to change in place.
     pub fn pixels_mut(&mut self) -> &mut [Vec3] {
         &mut self.pixels
     }
 
     #[inline]
+    /// The pixel in column `x` of row `y` (row 0 at the top); panics outside the image.
     pub fn get(&self, x: u32, y: u32) -> Vec3 {
         self.pixels[y as usize * self.width as usize + x as usize]
     }
 
     #[inline]
+    /// Sets the pixel in column `x` of row `y` (row 0 at the top); panics outside the image.
     pub fn set(&mut self, x: u32, y: u32, value: Vec3) {
         self.pixels[y as usize * self.width as usize + x as usize] = value;
     }

@@ -12,8 +12,10 @@ pub enum ToneOperator {
 }
 
 impl ToneOperator {
+    /// Every operator, in the order command-line help lists them.
     pub const ALL: &'static [ToneOperator] = &[ToneOperator::Clamp, ToneOperator::Reinhard, ToneOperator::Aces];
 
+    /// The operator's name on command lines and in reports (`clamp`, `reinhard`, `aces`).
     pub fn name(self) -> &'static str {
         match self {
             ToneOperator::Clamp => "clamp",
@@ -43,6 +45,7 @@ rtgi_math::named_choices!(ToneOperator, "tone map");
 pub struct ToneMap {
     /// Exposure in stops: values are multiplied by `2^exposure` first.
     pub exposure: f32,
+    /// The curve applied after the exposure, per channel.
     pub operator: ToneOperator,
 }
 

@@ -8,14 +8,36 @@ use crate::{HdrImage, ToneMap};
 /// What can go wrong writing an image; every variant names the file.
 #[derive(Debug, thiserror::Error)]
 pub enum ImageError {
+    /// The file name ends in neither `.png` nor `.exr`.
     #[error("{path}: unsupported image format (use a .png or .exr file name)")]
-    UnsupportedFormat { path: PathBuf },
+    UnsupportedFormat {
+        /// The file asked for.
+        path: PathBuf,
+    },
+    /// The file could not be created, written or renamed into place.
     #[error("{path}: cannot write: {source}")]
-    Io { path: PathBuf, source: std::io::Error },
+    Io {
+        /// The file being written.
+        path: PathBuf,
+        /// What the operating system said.
+        source: std::io::Error,
+    },
+    /// The encoder refused the pixels.
     #[error("{path}: cannot encode: {message}")]
-    Encode { path: PathBuf, message: String },
+    Encode {
+        /// The file being written.
+        path: PathBuf,
+        /// The encoder's message.
+        message: String,
+    },
+    /// The file could not be read or decoded, or holds no usable image.
     #[error("{path}: cannot read image: {message}")]
-    Read { path: PathBuf, message: String },
+    Read {
+        /// The file being read.
+        path: PathBuf,
+        /// What is wrong with it.
+        message: String,
+    },
 }
 
 /// The file formats images are written in.

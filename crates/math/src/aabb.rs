@@ -9,7 +9,9 @@ use crate::ray::RayWithInverse;
 /// point or box gives that point or box.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Aabb {
+    /// The corner with the smallest coordinates (`+∞` in every axis when empty).
     pub min: Vec3,
+    /// The corner with the largest coordinates (`-∞` in every axis when empty).
     pub max: Vec3,
 }
 
@@ -20,9 +22,11 @@ impl Default for Aabb {
 }
 
 impl Aabb {
+    /// The box holding nothing: the identity of [`Aabb::union`] and [`Aabb::grow`].
     pub const EMPTY: Aabb = Aabb { min: Vec3::INFINITY, max: Vec3::NEG_INFINITY };
 
     #[inline]
+    /// The box from corner `min` to corner `max` (not checked: `min > max` on an axis is empty).
     pub fn new(min: Vec3, max: Vec3) -> Self {
         Self { min, max }
     }
@@ -33,6 +37,7 @@ impl Aabb {
     }
 
     #[inline]
+    /// Whether the box holds no point (`min > max` on some axis).
     pub fn is_empty(&self) -> bool {
         !(self.min.x <= self.max.x && self.min.y <= self.max.y && self.min.z <= self.max.z)
     }
@@ -58,6 +63,7 @@ impl Aabb {
     }
 
     #[inline]
+    /// The box's centre, halfway between its corners.
     pub fn centroid(&self) -> Vec3 {
         0.5 * (self.min + self.max)
     }
@@ -93,11 +99,13 @@ impl Aabb {
     }
 
     #[inline]
+    /// Whether `p` lies in the box, faces included.
     pub fn contains_point(&self, p: Vec3) -> bool {
         p.cmpge(self.min).all() && p.cmple(self.max).all()
     }
 
     #[inline]
+    /// Whether `other` lies wholly inside this box, faces included (an empty `other` always does).
     pub fn contains_box(&self, other: &Aabb) -> bool {
         other.is_empty() || (other.min.cmpge(self.min).all() && other.max.cmple(self.max).all())
     }

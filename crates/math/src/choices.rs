@@ -39,3 +39,20 @@ macro_rules! named_choices {
         }
     };
 }
+
+/// Parses "x,y,z" (spaces allowed around the commas) into a vector of three
+/// finite numbers, as command lines and specification strings write them;
+/// `None` for anything else.
+///
+/// ```
+/// use rtgi_math::{Vec3, parse_vec3};
+/// assert_eq!(parse_vec3("1, -2.5,3e2"), Some(Vec3::new(1.0, -2.5, 300.0)));
+/// assert_eq!(parse_vec3("1,2,nan"), None);
+/// ```
+pub fn parse_vec3(text: &str) -> Option<crate::Vec3> {
+    let numbers: Result<Vec<f32>, _> = text.split(',').map(|p| p.trim().parse::<f32>()).collect();
+    match numbers {
+        Ok(n) if n.len() == 3 && n.iter().all(|c| c.is_finite()) => Some(crate::Vec3::new(n[0], n[1], n[2])),
+        _ => None,
+    }
+}

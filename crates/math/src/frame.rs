@@ -6,8 +6,11 @@ use glam::Vec3;
 /// `z`, so that cosines are plain `z` components.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Frame {
+    /// First tangent, unit length.
     pub x: Vec3,
+    /// Second tangent, unit length, completing the right-handed frame `(x, y, z)`.
     pub y: Vec3,
+    /// The frame's axis (a surface's normal), unit length.
     pub z: Vec3,
 }
 
@@ -26,11 +29,13 @@ impl Frame {
     }
 
     #[inline]
+    /// `v` in this frame's coordinates (its components along `x`, `y`, `z`).
     pub fn to_local(&self, v: Vec3) -> Vec3 {
         Vec3::new(v.dot(self.x), v.dot(self.y), v.dot(self.z))
     }
 
     #[inline]
+    /// The world vector whose coordinates in this frame are `v`.
     pub fn to_world(&self, v: Vec3) -> Vec3 {
         v.x * self.x + v.y * self.y + v.z * self.z
     }

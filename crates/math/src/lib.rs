@@ -14,6 +14,13 @@
 //! assert!(t_exit >= 2.0);
 //! ```
 
+#![warn(missing_docs)]
+
+// The README's examples are compiled and run as doctests.
+#[doc = include_str!("../README.md")]
+#[cfg(doctest)]
+pub struct ReadmeDoctests;
+
 mod aabb;
 mod choices;
 mod float;
@@ -23,6 +30,7 @@ mod rng;
 mod spawn;
 
 pub use aabb::Aabb;
+pub use choices::parse_vec3;
 pub use float::{gamma, next_float_down, next_float_up};
 pub use frame::{Frame, uniform_sphere};
 pub use glam;

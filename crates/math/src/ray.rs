@@ -5,9 +5,13 @@ use glam::Vec3;
 /// The direction need not be normalised; `t` is measured in multiples of it.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Ray {
+    /// Where the ray starts (`t = 0`).
     pub origin: Vec3,
+    /// The direction, not necessarily unit length.
     pub direction: Vec3,
+    /// Nearest distance counted as a hit, in multiples of `direction`.
     pub t_min: f32,
+    /// Farthest distance counted as a hit (`f32::INFINITY` for an unbounded ray).
     pub t_max: f32,
 }
 
@@ -56,15 +60,21 @@ impl Ray {
 /// to a "safe" value makes near-axis rays miss boxes they pass through).
 #[derive(Clone, Copy, Debug)]
 pub struct RayWithInverse {
+    /// Where the ray starts, as in [`Ray::origin`].
     pub origin: Vec3,
+    /// The direction, as in [`Ray::direction`].
     pub direction: Vec3,
+    /// `1 / direction` per component, `±∞` for `±0`.
     pub inv_direction: Vec3,
+    /// Nearest distance counted as a hit.
     pub t_min: f32,
+    /// Farthest distance counted as a hit.
     pub t_max: f32,
 }
 
 impl RayWithInverse {
     #[inline]
+    /// Precomputes the inverse direction of `ray`.
     pub fn new(ray: &Ray) -> Self {
         Self {
             origin: ray.origin,

@@ -31,6 +31,7 @@ impl Rng {
     }
 
     #[inline]
+    /// The next 32 uniformly distributed bits (PCG32's XSH-RR output).
     pub fn next_u32(&mut self) -> u32 {
         let old = self.state;
         self.state = old.wrapping_mul(MULTIPLIER).wrapping_add(self.increment);

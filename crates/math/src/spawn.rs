@@ -17,6 +17,7 @@ use crate::ray::Ray;
 /// error of its computed position and the triangle's geometric normal.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SurfacePoint {
+    /// The computed position on the triangle.
     pub position: Vec3,
     /// `|computed - exact| <= error` in each coordinate.
     pub error: Vec3,
@@ -102,10 +103,12 @@ impl SurfacePoint {
 pub struct TriangleShape {
     /// Unit geometric normal (either side), or zero for a degenerate triangle.
     pub normal: Vec3,
+    /// The triangle's [`elongation`]: how thin it is, which scales the error of points on it.
     pub elongation: f32,
 }
 
 impl TriangleShape {
+    /// The normal and elongation of the triangle with these corners.
     pub fn of(corners: &[Vec3; 3]) -> Self {
         Self { normal: geometric_normal(corners), elongation: elongation(corners) }
     }

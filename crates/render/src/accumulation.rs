@@ -97,16 +97,41 @@ impl fmt::Debug for Accumulation {
 /// Why parts cannot be merged, or an accumulation cannot become an image.
 #[derive(Debug, thiserror::Error, PartialEq, Eq)]
 pub enum MergeError {
+    /// The list of parts is empty.
     #[error("no parts to merge")]
     Empty,
+    /// A part's identity (size, samples, seed, scene, settings) differs from the first part's.
     #[error("part {part} is of another render than part 0: {differences}")]
-    DifferentRender { part: usize, differences: String },
+    DifferentRender {
+        /// Index of the part, in the order given.
+        part: usize,
+        /// Each difference, named.
+        differences: String,
+    },
+    /// Two parts hold the same samples of the same rows.
     #[error("parts {first} and {second} both hold samples {samples:?} of rows {rows:?}")]
-    Overlap { first: usize, second: usize, rows: Range<u32>, samples: Range<u32> },
+    Overlap {
+        /// Index of the first of the two parts.
+        first: usize,
+        /// Index of the second.
+        second: usize,
+        /// The band of rows both hold.
+        rows: Range<u32>,
+        /// The samples both hold.
+        samples: Range<u32>,
+    },
+    /// Some samples of a band are in no part.
     #[error("no part holds samples {missing:?} of rows {rows:?}")]
-    MissingSamples { rows: Range<u32>, missing: Range<u32> },
+    MissingSamples {
+        /// The band of rows.
+        rows: Range<u32>,
+        /// The samples no part holds.
+        missing: Range<u32>,
+    },
+    /// Some rows are in no part.
     #[error("rows {0:?} are in no part")]
     MissingRows(Range<u32>),
+    /// Two parts' bands of rows overlap without being equal.
     #[error("parts cut rows differently: {0:?} overlaps {1:?} without being the same band")]
     Bands(Range<u32>, Range<u32>),
 }
@@ -143,6 +168,7 @@ impl Accumulation {
         Ok(Self { identity, rows, samples, sums })
     }
 
+    /// The render these sums belong to, which merging and resuming compare.
     pub fn identity(&self) -> &RenderIdentity {
         &self.identity
     }

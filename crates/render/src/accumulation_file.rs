@@ -28,10 +28,22 @@ const MAX_HEADER: u32 = 1 << 20;
 /// Why an accumulation file cannot be read or written.
 #[derive(Debug, thiserror::Error)]
 pub enum AccumulationFileError {
+    /// The file could not be read, written or renamed into place.
     #[error("{path}: {source}")]
-    Io { path: PathBuf, source: std::io::Error },
+    Io {
+        /// The file.
+        path: PathBuf,
+        /// What the operating system said.
+        source: std::io::Error,
+    },
+    /// The file is not an accumulation: bad header, truncated, or a wrong checksum.
     #[error("{path}: not an rtgi accumulation file: {message}")]
-    Invalid { path: PathBuf, message: String },
+    Invalid {
+        /// The file.
+        path: PathBuf,
+        /// What is wrong with it.
+        message: String,
+    },
 }
 
 #[derive(Serialize, Deserialize)]

@@ -14,9 +14,13 @@ use rtgi_math::{Vec2, Vec3};
 /// directions, whose value and density are both Dirac deltas.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct BsdfSample {
+    /// The sampled incident direction, unit length, in the shading frame.
     pub wi: Vec3,
+    /// The BSDF's value for `wo` and `wi`, as [`Bsdf::eval`] gives it (for a delta, the weight divided by the cosine).
     pub value: Vec3,
+    /// The density `wi` was drawn with, per unit solid angle (meaningless when `delta`).
     pub pdf: f32,
+    /// Whether `wi` is a perfectly specular direction (mirror, smooth glass), which no other sampling strategy can find.
     pub delta: bool,
     /// The relative index of refraction crossed (n transmitted / n incident):
     /// radiance was scaled by 1/η² on the way. 1 where nothing refracted.
@@ -27,29 +31,64 @@ pub struct BsdfSample {
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Bsdf {
     /// Ideal diffuse reflection.
-    Lambert { albedo: Vec3 },
+    Lambert {
+        /// Fraction of light reflected, per channel, in `[0, 1]`.
+        albedo: Vec3,
+    },
     /// Perfect mirror reflection.
-    Mirror { reflectance: Vec3 },
+    Mirror {
+        /// Fraction of light reflected, per channel.
+        reflectance: Vec3,
+    },
     /// glTF's metallic-roughness model: a GGX (Trowbridge-Reitz) specular
     /// lobe with Schlick's Fresnel over a Lambertian base for dielectrics;
     /// `alpha` is the GGX width (perceptual roughness squared).
-    MetallicRoughness { base_color: Vec3, metallic: f32, alpha: f32 },
+    MetallicRoughness {
+        /// Diffuse colour of dielectrics, specular colour of metals (linear RGB).
+        base_color: Vec3,
+        /// From 0 (dielectric) to 1 (metal).
+        metallic: f32,
+        /// GGX width, in `(0, 1]`.
+        alpha: f32,
+    },
     /// A GGX specular lobe of constant reflectance (MTL's `Ks`, whose
     /// Fresnel behaviour the format does not describe).
-    Glossy { reflectance: Vec3, alpha: f32 },
+    Glossy {
+        /// Specular reflectance (linear RGB).
+        reflectance: Vec3,
+        /// GGX width, in `(0, 1]`.
+        alpha: f32,
+    },
     /// A smooth boundary between air (+z side) and a medium of index `ior`
     /// that reflects and refracts by Fresnel's equations; refracted light is
     /// tinted by `tint` (glTF's base colour for transmission).
-    Dielectric { ior: f32, tint: Vec3 },
+    Dielectric {
+        /// Index of refraction of the medium on the -z side.
+        ior: f32,
+        /// Colour multiplying refracted light.
+        tint: Vec3,
+    },
     /// A thin sheet of a dielectric (glTF's transmission without a volume):
     /// light reflects by Fresnel's equations, summed over the reflections
     /// inside the sheet, or passes straight through, tinted.
-    ThinDielectric { ior: f32, tint: Vec3 },
+    ThinDielectric {
+        /// Index of refraction of the sheet.
+        ior: f32,
+        /// Colour multiplying transmitted light.
+        tint: Vec3,
+    },
     /// A rough thin sheet (glTF's transmission with roughness): GGX
     /// microfacets of width `alpha` reflect as [`Bsdf::ThinDielectric`]
     /// does, and transmit into the mirror image of the reflected lobe
     /// below the sheet, so what lies behind is seen blurred. Not a delta.
-    RoughThinDielectric { ior: f32, tint: Vec3, alpha: f32 },
+    RoughThinDielectric {
+        /// Index of refraction of the sheet.
+        ior: f32,
+        /// Colour multiplying transmitted light.
+        tint: Vec3,
+        /// GGX width of the microfacets, in `(0, 1]`.
+        alpha: f32,
+    },
 }
 
 impl Bsdf {

@@ -20,6 +20,7 @@ pub struct CameraRays {
 }
 
 impl CameraRays {
+    /// The camera rays of an image of `width` × `height` pixels through `camera`.
     pub fn new(camera: &Camera, width: u32, height: u32) -> Self {
         let w = camera.direction.normalize();
         let u = w.cross(camera.up).normalize();

@@ -31,10 +31,12 @@ impl Distribution1D {
         Self { cdf, total }
     }
 
+    /// Number of entries the distribution chooses between.
     pub fn len(&self) -> usize {
         self.cdf.len() - 1
     }
 
+    /// Whether there is nothing to choose from.
     pub fn is_empty(&self) -> bool {
         self.len() == 0
     }

@@ -10,6 +10,7 @@ use serde::Serialize;
 use crate::effects::Effect;
 
 #[derive(Clone, Copy, Default, PartialEq, Eq, Hash)]
+/// A set of [`Effect`]s, one bit each, with `const` operations so that sets can be computed and checked at compile time.
 pub struct EffectSet(u16);
 
 // Every effect must have a bit of its own, and its place in `Effect::ALL` is that bit.
@@ -23,7 +24,9 @@ const _: () = {
 };
 
 impl EffectSet {
+    /// The set of no effect.
     pub const EMPTY: EffectSet = EffectSet(0);
+    /// The set of every effect.
     pub const ALL: EffectSet = EffectSet::of(Effect::ALL);
 
     const fn bit(effect: Effect) -> u16 {
@@ -52,6 +55,7 @@ impl EffectSet {
         EffectSet(bits & EffectSet::ALL.0)
     }
 
+    /// Whether `effect` is in the set.
     pub const fn contains(self, effect: Effect) -> bool {
         self.0 & EffectSet::bit(effect) != 0
     }
@@ -75,10 +79,12 @@ impl EffectSet {
         present
     }
 
+    /// The effects in either set.
     pub const fn union(self, other: EffectSet) -> EffectSet {
         EffectSet(self.0 | other.0)
     }
 
+    /// The effects in both sets.
     pub const fn intersection(self, other: EffectSet) -> EffectSet {
         EffectSet(self.0 & other.0)
     }
@@ -88,10 +94,12 @@ impl EffectSet {
         EffectSet(self.0 & !other.0)
     }
 
+    /// Whether the set holds no effect.
     pub const fn is_empty(self) -> bool {
         self.0 == 0
     }
 
+    /// Number of effects in the set.
     pub const fn len(self) -> usize {
         self.0.count_ones() as usize
     }

@@ -53,6 +53,7 @@ impl Effect {
         Effect::Alpha,
     ];
 
+    /// The effect's name in plans and overrides (`direct-light`, `glossy`, ...).
     pub fn name(self) -> &'static str {
         match self {
             Effect::DirectLight => "direct-light",
@@ -74,7 +75,9 @@ rtgi_math::named_choices!(Effect, "effect");
 /// comma-separated list such as `+glossy,-textures`.
 #[derive(Clone, Debug, Default, PartialEq, Eq)]
 pub struct EffectOverrides {
+    /// Effects forced on, whatever the scene needs.
     pub on: EffectSet,
+    /// Effects forced off, whatever the scene needs.
     pub off: EffectSet,
 }
 
@@ -110,7 +113,9 @@ fn as_name<S: serde::Serializer>(value: &impl fmt::Display, serializer: S) -> Re
 #[derive(Clone, Debug, PartialEq, Eq, Serialize)]
 pub struct PlannedEffect {
     #[serde(serialize_with = "as_name")]
+    /// The effect decided on.
     pub effect: Effect,
+    /// Whether the render simulates it.
     pub enabled: bool,
     /// Whether the user's override decided, against what the scene needs.
     pub forced: bool,
@@ -122,7 +127,9 @@ pub struct PlannedEffect {
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct EffectPlan {
     #[serde(serialize_with = "as_name")]
+    /// The integrator the plan is for (only light transport simulates light).
     pub integrator: Integrator,
+    /// Every effect with the decision and its reason, in the order of [`Effect::ALL`].
     pub effects: Vec<PlannedEffect>,
     /// The scene has no light of its own, so a uniform white environment
     /// lights it (unless the environment is forced off).
@@ -148,6 +155,7 @@ pub const SPECIALISED: EffectSet =
 /// off, or one it leaves out, forced on.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Reversal {
+    /// The effect whose decision is reversed.
     pub effect: Effect,
     /// Whether the plan simulates the effect (and the reversal forces it off).
     pub planned: bool,

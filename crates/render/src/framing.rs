@@ -18,6 +18,33 @@ const THREE_QUARTER_ELEVATION: f32 = 25.0;
 /// The part of the frame the model's bounds fill, across the narrower side.
 const FILL: f32 = 0.9;
 
+/// The vertical field of view, in degrees, of the camera [`default_camera`]
+/// makes for a scene without one (the `rtgi` command's default too).
+pub const DEFAULT_VERTICAL_FOV_DEGREES: f32 = 40.0;
+
+/// A camera for any scene: the scene's first camera, or for a scene that
+/// brings none (OBJ files, glTF files without cameras) the view
+/// [`frame_scene`] picks with a vertical field of view of
+/// [`DEFAULT_VERTICAL_FOV_DEGREES`]. `aspect` is the image's width over its
+/// height.
+///
+/// ```no_run
+/// use rtgi_accel::{AccelKind, BuildParams};
+/// use rtgi_render::default_camera;
+/// use rtgi_scene::Scene;
+///
+/// let scene = Scene::load("model.obj".as_ref())?;
+/// let accel = AccelKind::Sah.build(&scene.triangle_positions(), &BuildParams::default());
+/// let camera = default_camera(&scene, accel.as_ref(), 16.0 / 9.0);
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
+pub fn default_camera<A: Accel + ?Sized>(scene: &Scene, accel: &A, aspect: f32) -> Camera {
+    match scene.cameras.first() {
+        Some(camera) => *camera,
+        None => frame_scene(scene, accel, DEFAULT_VERTICAL_FOV_DEGREES.to_radians(), aspect),
+    }
+}
+
 /// A camera for a scene that has none: the best of a few candidate views.
 ///
 /// The candidates, in order of preference:

@@ -14,11 +14,14 @@ use crate::{Environment, RenderSettings};
 /// when their identities are equal.
 #[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
 pub struct RenderIdentity {
+    /// Image width in pixels.
     pub width: u32,
+    /// Image height in pixels.
     pub height: u32,
     /// Samples per pixel of the whole render (the stratified sampler's
     /// pattern depends on it, so a part of a render knows its total).
     pub samples_per_pixel: u32,
+    /// The seed of every sample's random numbers.
     pub seed: u64,
     /// FNV-1a of the geometry, materials, textures and lights, in hex.
     pub scene: String,
@@ -31,6 +34,7 @@ pub struct RenderIdentity {
 }
 
 impl RenderIdentity {
+    /// The identity of rendering `scene` through `camera` with `settings`.
     pub fn new(scene: &Scene, camera: &Camera, settings: &RenderSettings) -> Self {
         // Destructured without `..`, so that a new setting cannot be forgotten here.
         let RenderSettings {
@@ -120,8 +124,11 @@ impl RenderIdentity {
 /// One way two renders differ: what, and its value in each.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct Difference {
+    /// What differs, like `seed` or `camera`.
     pub what: String,
+    /// Its value in this render.
     pub ours: String,
+    /// Its value in the other.
     pub theirs: String,
 }
 

@@ -39,6 +39,7 @@ pub enum Integrator {
 }
 
 impl Integrator {
+    /// Every integrator, in the order help texts list them.
     pub const ALL: &'static [Integrator] = &[
         Integrator::Primary,
         Integrator::Albedo,
@@ -50,6 +51,7 @@ impl Integrator {
         Integrator::Path,
     ];
 
+    /// The integrator's name on command lines and in reports.
     pub fn name(self) -> &'static str {
         match self {
             Integrator::Primary => "primary",
@@ -92,8 +94,10 @@ pub enum DirectStrategy {
 }
 
 impl DirectStrategy {
+    /// Every strategy, in the order help texts list them.
     pub const ALL: &'static [DirectStrategy] = &[DirectStrategy::Light, DirectStrategy::Bsdf, DirectStrategy::Mis];
 
+    /// The strategy's name on command lines and in reports (`light`, `bsdf`, `mis`).
     pub fn name(self) -> &'static str {
         match self {
             DirectStrategy::Light => "light",

@@ -8,17 +8,25 @@
 //!
 //! ```no_run
 //! use rtgi_accel::{AccelKind, BuildParams};
-//! use rtgi_render::{RenderSettings, render};
-//! use rtgi_scene::{Camera, Scene};
+//! use rtgi_render::{RenderSettings, default_camera, render};
+//! use rtgi_scene::Scene;
 //!
 //! let scene = Scene::load("scenes/cornell-box.toml".as_ref())?;
 //! let accel = AccelKind::Linear.build(&scene.triangle_positions(), &BuildParams::default());
 //! let settings = RenderSettings { width: 256, height: 256, ..RenderSettings::default() };
-//! let camera = scene.cameras[0];
+//! // The scene's first camera, or a view framing it if it has none.
+//! let camera = default_camera(&scene, accel.as_ref(), 1.0);
 //! let (image, stats) = render(&scene, accel.as_ref(), &camera, &settings, &|_| {});
 //! println!("{} rays in {:.1} ms", stats.rays, stats.render_ms);
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
+
+#![warn(missing_docs)]
+
+// The README's examples are compiled and run as doctests.
+#[doc = include_str!("../README.md")]
+#[cfg(doctest)]
+pub struct ReadmeDoctests;
 
 mod accumulation;
 mod accumulation_file;
@@ -44,10 +52,10 @@ pub use default_lighting::{ENCLOSED, default_sky, default_sun, room_light, sky_v
 pub use distribution::Distribution1D;
 pub use effect_set::EffectSet;
 pub use effects::{Effect, EffectOverrides, EffectPlan, PlannedEffect, Reversal};
-pub use framing::{camera_blocked, frame_scene, three_quarter_view};
+pub use framing::{DEFAULT_VERTICAL_FOV_DEGREES, camera_blocked, default_camera, frame_scene, three_quarter_view};
 pub use identity::{Difference, RenderIdentity, scene_fingerprint};
 pub use integrator::{DirectStrategy, Integrator};
-pub use lights::{Environment, EnvironmentMap, LightSet};
+pub use lights::{Environment, EnvironmentMap, EnvironmentSpec, EnvironmentSpecError, LightSet};
 pub use sampler::{PixelSample, PixelSampler};
 pub use shade::{albedo, alpha_accepts, has_alpha, shade_primary, shading_normal};
 
@@ -69,19 +77,29 @@ use crate::integrator::Transport;
 pub const TILE_SIZE: u32 = 16;
 
 /// What to render and how.
+///
+/// The default is what the `rtgi` command renders: a 512 × 512 path-traced
+/// image of 16 stratified samples per pixel (antialiased), MIS for direct
+/// light, up to 8 bounces with Russian roulette.
 #[derive(Clone, Debug, PartialEq)]
 pub struct RenderSettings {
+    /// Image width in pixels.
     pub width: u32,
+    /// Image height in pixels.
     pub height: u32,
     /// Samples per pixel.
     pub samples_per_pixel: u32,
+    /// Where in its pixel each sample's camera ray passes.
     pub sampler: PixelSampler,
+    /// Seed of the random numbers: every sample draws from `(seed, pixel, sample)`, so one seed gives one image.
     pub seed: u64,
     /// Radiance of camera rays that hit nothing, when no environment is seen.
     pub background: Vec3,
+    /// What a camera ray's sample computes: an AOV, direct light, or full paths.
     pub integrator: Integrator,
     /// Bounces a path may take after the camera ray (1 = direct light only).
     pub max_depth: u32,
+    /// How direct light is sampled: from the lights, from the BSDF, or both weighted by MIS.
     pub direct_strategy: DirectStrategy,
     /// Largest value (brightest channel) of the light one path brings in
     /// after two or more bounces: removes the fireflies of caustics at the
@@ -103,8 +121,8 @@ impl Default for RenderSettings {
         Self {
             width: 512,
             height: 512,
-            samples_per_pixel: 1,
-            sampler: PixelSampler::Center,
+            samples_per_pixel: 16,
+            sampler: PixelSampler::Stratified,
             seed: 0,
             background: Vec3::new(0.05, 0.05, 0.06),
             integrator: Integrator::Path,
@@ -121,15 +139,20 @@ impl Default for RenderSettings {
 /// What a render did and how long it took.
 #[derive(Clone, Debug, Default, PartialEq, Serialize)]
 pub struct RenderStats {
+    /// Image width in pixels.
     pub width: u32,
+    /// Image height in pixels.
     pub height: u32,
+    /// Samples per pixel rendered.
     pub samples_per_pixel: u32,
     /// Rays traced, of all kinds.
     pub rays: u64,
+    /// Wall-clock time of the render, in milliseconds.
     pub render_ms: f64,
 }
 
 impl RenderStats {
+    /// Rays traced per second of wall-clock time.
     pub fn rays_per_second(&self) -> f64 {
         self.rays as f64 / (self.render_ms * 1e-3).max(1e-9)
     }

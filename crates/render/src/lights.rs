@@ -7,10 +7,11 @@
 //! the radiance arriving from each direction.
 
 use std::f32::consts::PI;
-use std::path::Path;
+use std::path::{Path, PathBuf};
+use std::str::FromStr;
 
 use rtgi_image::{HdrImage, ImageError};
-use rtgi_math::{Ray, SurfacePoint, TriangleShape, Vec2, Vec3};
+use rtgi_math::{Ray, SurfacePoint, TriangleShape, Vec2, Vec3, parse_vec3};
 use rtgi_scene::{Light, LightKind, Scene, SurfaceModel, TextureId};
 
 use crate::distribution::Distribution1D;
@@ -38,11 +39,81 @@ pub struct EnvironmentMap {
     columns: Vec<Distribution1D>,
 }
 
+/// An environment as a specification string names it (the `rtgi`
+/// command's `--environment`), before any file is read: a uniform radiance
+/// `R,G,B` or the path of an equirectangular `.exr` image.
+///
+/// ```
+/// use rtgi_render::EnvironmentSpec;
+/// use rtgi_math::Vec3;
+///
+/// assert_eq!("0.5,0.6,0.7".parse::<EnvironmentSpec>()?, EnvironmentSpec::Uniform(Vec3::new(0.5, 0.6, 0.7)));
+/// assert_eq!("sky.exr".parse::<EnvironmentSpec>()?, EnvironmentSpec::File("sky.exr".into()));
+/// assert!("sky.hdr".parse::<EnvironmentSpec>().is_err());
+/// # Ok::<(), rtgi_render::EnvironmentSpecError>(())
+/// ```
+#[derive(Clone, Debug, PartialEq)]
+pub enum EnvironmentSpec {
+    /// The same radiance from every direction: finite, not negative.
+    Uniform(Vec3),
+    /// An OpenEXR file, to be read by [`EnvironmentSpec::load`].
+    File(PathBuf),
+}
+
+/// Why an environment specification could not be used.
+#[derive(Debug, thiserror::Error)]
+pub enum EnvironmentSpecError {
+    /// A radiance with a negative component.
+    #[error("environment radiance must not be negative (got '{0}')")]
+    NegativeRadiance(String),
+    /// Neither three numbers nor a path ending in `.exr`.
+    #[error("expected a radiance R,G,B or an .exr file (got '{0}')")]
+    Unrecognised(String),
+    /// The `.exr` file could not be read or is no environment map.
+    #[error(transparent)]
+    Image(#[from] ImageError),
+}
+
+impl FromStr for EnvironmentSpec {
+    type Err = EnvironmentSpecError;
+
+    fn from_str(text: &str) -> Result<Self, Self::Err> {
+        if let Some(radiance) = parse_vec3(text) {
+            if radiance.min_element() < 0.0 {
+                return Err(EnvironmentSpecError::NegativeRadiance(text.to_owned()));
+            }
+            return Ok(EnvironmentSpec::Uniform(radiance));
+        }
+        let path = PathBuf::from(text);
+        if path.extension().is_some_and(|e| e.eq_ignore_ascii_case("exr")) {
+            Ok(EnvironmentSpec::File(path))
+        } else {
+            Err(EnvironmentSpecError::Unrecognised(text.to_owned()))
+        }
+    }
+}
+
+impl EnvironmentSpec {
+    /// The environment it names, reading the file of a map.
+    pub fn load(&self) -> Result<Environment, ImageError> {
+        match self {
+            EnvironmentSpec::Uniform(radiance) => Ok(Environment::Uniform(*radiance)),
+            EnvironmentSpec::File(path) => Environment::load(path),
+        }
+    }
+}
+
 fn luminance(c: Vec3) -> f32 {
     c.dot(Vec3::new(0.2126, 0.7152, 0.0722))
 }
 
 impl Environment {
+    /// The environment a specification names (see [`EnvironmentSpec`]): a
+    /// uniform radiance `R,G,B`, or an `.exr` file, which is read.
+    pub fn from_spec(text: &str) -> Result<Self, EnvironmentSpecError> {
+        Ok(text.parse::<EnvironmentSpec>()?.load()?)
+    }
+
     /// Reads an equirectangular environment from an OpenEXR file.
     pub fn load(path: &Path) -> Result<Self, ImageError> {
         let image = HdrImage::read_exr(path)?;
@@ -130,6 +201,7 @@ impl Environment {
 }
 
 impl EnvironmentMap {
+    /// An environment map over `image`, with the distributions that sample it in proportion to brightness.
     pub fn new(image: HdrImage) -> Self {
         let (w, h) = (image.width(), image.height());
         let columns: Vec<Distribution1D> =
@@ -198,16 +270,23 @@ struct Cone {
 /// An emissive triangle, as an area light.
 #[derive(Clone, Debug, PartialEq)]
 pub struct EmissiveTriangle {
+    /// The triangle's index in the scene.
     pub triangle: u32,
+    /// Its corners in world space.
     pub corners: [Vec3; 3],
+    /// Texture coordinates of its corners, for a textured emission.
     pub uvs: [Vec2; 3],
     /// Unit geometric normal (right-hand rule); the front side.
     pub normal: Vec3,
     /// The triangle's [`rtgi_math::elongation`], for the error bound of points on it.
     pub elongation: f32,
+    /// Its area, in square scene units.
     pub area: f32,
+    /// Emitted radiance (linear RGB), multiplied by the texture where there is one.
     pub emission: Vec3,
+    /// The emission texture, if any.
     pub texture: Option<TextureId>,
+    /// Whether the back side emits too (else only the front, the side of `normal`).
     pub two_sided: bool,
 }
 
@@ -345,6 +424,7 @@ impl LightSet {
         Self { sources, choice, source_of_triangle, environment_index }
     }
 
+    /// Whether there is no light at all (no light, emitter or environment).
     pub fn is_empty(&self) -> bool {
         self.sources.is_empty()
     }

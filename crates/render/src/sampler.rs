@@ -37,7 +37,9 @@ pub enum PixelSampler {
 /// the samplers that spread samples over a pixel need to know.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct PixelSample {
+    /// Which sample of the pixel, from 0.
     pub index: u32,
+    /// How many samples the pixel takes in the whole render.
     pub count: u32,
     /// Uniform in `[0, 1)²`, the same for every sample of the pixel: the
     /// low-discrepancy sampler's shift, and the seed of the stratified
@@ -50,9 +52,11 @@ pub struct PixelSample {
 const R2: [u64; 2] = [0xc13f_a9a9_02a6_328f, 0x91e1_0da5_c79e_7b1d];
 
 impl PixelSampler {
+    /// Every sampler, in the order help texts list them.
     pub const ALL: &'static [PixelSampler] =
         &[PixelSampler::Center, PixelSampler::Uniform, PixelSampler::Stratified, PixelSampler::LowDiscrepancy];
 
+    /// The sampler's name on command lines and in reports (`center`, `uniform`, `stratified`, `low-discrepancy`).
     pub fn name(self) -> &'static str {
         match self {
             PixelSampler::Center => "center",

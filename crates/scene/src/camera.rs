@@ -3,6 +3,7 @@ use rtgi_math::Vec3;
 /// A pinhole camera as the course defines it.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Camera {
+    /// The pinhole's position, the centre of projection.
     pub position: Vec3,
     /// The central viewing direction (need not be unit length).
     pub direction: Vec3,

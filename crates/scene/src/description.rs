@@ -26,12 +26,15 @@ use crate::{Camera, Scene, SceneError};
 #[serde(deny_unknown_fields)]
 pub struct Description {
     #[serde(default)]
+    /// The meshes the scene merges, in order (`[[mesh]]` tables).
     pub mesh: Vec<MeshEntry>,
+    /// The camera (`[camera]`); without one the scene has none.
     pub camera: Option<CameraEntry>,
 }
 
 #[derive(Clone, Debug, Deserialize, PartialEq)]
 #[serde(deny_unknown_fields)]
+/// A `[[mesh]]` entry: one mesh file to load and merge.
 pub struct MeshEntry {
     /// A mesh file, relative to the description.
     pub file: String,
@@ -39,13 +42,20 @@ pub struct MeshEntry {
 
 #[derive(Clone, Debug, Deserialize, PartialEq)]
 #[serde(deny_unknown_fields)]
+/// The `[camera]` entry, in world coordinates.
 pub struct CameraEntry {
+    /// The pinhole's position.
     pub position: [f32; 3],
+    /// A point to look at; exactly one of `look_at` and `direction` is given.
     pub look_at: Option<[f32; 3]>,
+    /// The viewing direction; exactly one of `look_at` and `direction` is given.
     pub direction: Option<[f32; 3]>,
     #[serde(default = "default_up")]
+    /// Which way is up in the image [default: +Y].
     pub up: [f32; 3],
+    /// The vertical field of view, in degrees.
     pub vertical_fov_degrees: f32,
+    /// Width over height the camera was set up for, if the file says.
     pub aspect: Option<f32>,
 }
 

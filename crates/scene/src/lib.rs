@@ -19,6 +19,13 @@
 //! # Ok::<(), rtgi_scene::SceneError>(())
 //! ```
 
+#![warn(missing_docs)]
+
+// The README's examples are compiled and run as doctests.
+#[doc = include_str!("../README.md")]
+#[cfg(doctest)]
+pub struct ReadmeDoctests;
+
 mod camera;
 pub mod description;
 mod files;
@@ -34,7 +41,7 @@ mod resolve;
 mod texture;
 
 pub use camera::Camera;
-pub use light::{Light, LightKind};
+pub use light::{Light, LightKind, LightSpecError};
 pub use material::{AlphaMode, Material, SurfaceModel};
 pub use mesh::MeshBuilder;
 pub use resolve::resolve_case_insensitive;
@@ -47,6 +54,7 @@ use rtgi_math::{Aabb, Vec2, Vec3, Vec4};
 /// A vertex as triangles reference it.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Vertex {
+    /// Position in world space.
     pub position: Vec3,
     /// Unit shading normal (computed from the faces where the file has none).
     pub normal: Vec3,
@@ -63,18 +71,26 @@ pub struct Vertex {
 /// A triangle: indices into [`Scene::vertices`] and [`Scene::materials`].
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Triangle {
+    /// Indices into [`Scene::vertices`] of the three corners, in the file's winding order.
     pub vertices: [u32; 3],
+    /// Index into [`Scene::materials`].
     pub material: u32,
 }
 
 /// Everything a renderer needs to know about a scene.
 #[derive(Clone, Debug, Default)]
 pub struct Scene {
+    /// Every vertex of every mesh, transformed to world space.
     pub vertices: Vec<Vertex>,
+    /// Every triangle, in file order: accelerators and outputs name triangles by their index here.
     pub triangles: Vec<Triangle>,
+    /// The materials, indexed by [`Triangle::material`].
     pub materials: Vec<Material>,
+    /// Decoded textures, referred to by [`TextureId`] from the materials.
     pub textures: Vec<Texture>,
+    /// The cameras the file defines, in file order (none for OBJ files).
     pub cameras: Vec<Camera>,
+    /// Point, spot and directional lights (emissive surfaces are materials).
     pub lights: Vec<Light>,
     /// The format extensions the file uses (glTF's `extensionsUsed`).
     pub extensions_used: Vec<String>,
@@ -92,16 +108,44 @@ pub struct Scene {
 /// Why a scene could not be loaded; every variant names the file.
 #[derive(Debug, thiserror::Error)]
 pub enum SceneError {
+    /// A file (the scene or one it references) could not be read.
     #[error("{path}: cannot read: {source}")]
-    Io { path: PathBuf, source: std::io::Error },
+    Io {
+        /// The file.
+        path: PathBuf,
+        /// What the operating system said.
+        source: std::io::Error,
+    },
+    /// The OBJ file (or one of its MTL libraries) is malformed or refused.
     #[error("{path}: not a valid OBJ file: {message}")]
-    Obj { path: PathBuf, message: String },
+    Obj {
+        /// The file.
+        path: PathBuf,
+        /// What is wrong, naming the line or the reference where known.
+        message: String,
+    },
+    /// The TOML scene description is malformed or names unusable meshes.
     #[error("{path}: not a valid scene description: {message}")]
-    Description { path: PathBuf, message: String },
+    Description {
+        /// The description file.
+        path: PathBuf,
+        /// What is wrong.
+        message: String,
+    },
+    /// The glTF file, its buffers or its images are malformed or refused.
     #[error("{path}: not a valid glTF file: {message}")]
-    Gltf { path: PathBuf, message: String },
+    Gltf {
+        /// The file.
+        path: PathBuf,
+        /// What is wrong, naming the accessor, node or image where known.
+        message: String,
+    },
+    /// The file's extension is none of `.obj`, `.gltf`, `.glb`, `.toml`.
     #[error("{path}: unsupported scene format (expected .obj, .gltf, .glb or .toml)")]
-    UnsupportedFormat { path: PathBuf },
+    UnsupportedFormat {
+        /// The file.
+        path: PathBuf,
+    },
 }
 
 impl Scene {

@@ -23,11 +23,13 @@ use crate::TextureId;
 /// (factor and texture) and KHR_materials_ior; `specular` and `shininess` stay zero.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Material {
+    /// The name the file gives the material (`newmtl`, or glTF's `name`).
     pub name: String,
     /// Which reflectance model the fields describe.
     pub model: SurfaceModel,
     /// Diffuse reflectance (linear RGB), multiplied by the texture where there is one.
     pub base_color: Vec3,
+    /// Multiplies `base_color` (and gives alpha), sampled at the hit's texture coordinates.
     pub base_color_texture: Option<TextureId>,
     /// Specular reflectance (linear RGB).
     pub specular: Vec3,
@@ -53,6 +55,7 @@ pub struct Material {
     pub transmission: f32,
     /// Multiplies `transmission` by its red channel (linear).
     pub transmission_texture: Option<TextureId>,
+    /// How the alpha of base colour and texture is used: ignored, a cutout mask, or blending.
     pub alpha_mode: AlphaMode,
     /// Multiplies alpha by its alpha channel, or by its red channel where it
     /// has none (an MTL `map_d` mask, often greyscale).
@@ -78,7 +81,10 @@ pub enum AlphaMode {
     /// Alpha is ignored.
     Opaque,
     /// Surfaces with alpha below the cutoff are holes.
-    Mask { cutoff: f32 },
+    Mask {
+        /// Alpha below which a point is a hole, in `[0, 1]` (glTF's default 0.5).
+        cutoff: f32,
+    },
     /// Alpha blends the surface with what lies behind.
     Blend,
 }

@@ -43,6 +43,7 @@ pub struct MeshBuilder {
 }
 
 impl MeshBuilder {
+    /// A builder over a mesh's positions, texture coordinates and normals, which faces index into.
     pub fn new(positions: Vec<Vec3>, uvs: Vec<Vec2>, normals: Vec<Vec3>) -> Self {
         Self {
             positions,

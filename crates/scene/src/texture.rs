@@ -27,8 +27,11 @@ pub enum ColorEncoding {
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
 pub enum Wrap {
     #[default]
+    /// Tile the image: coordinates are taken modulo 1.
     Repeat,
+    /// Coordinates are clamped to `[0, 1]`: the edge texels repeat outwards.
     ClampToEdge,
+    /// Tile the image, mirrored every other tile.
     MirroredRepeat,
 }
 
@@ -157,14 +160,17 @@ impl Texture {
         }
     }
 
+    /// Width in texels.
     pub fn width(&self) -> u32 {
         self.width
     }
 
+    /// Height in texels.
     pub fn height(&self) -> u32 {
         self.height
     }
 
+    /// Whether the texels are sRGB-encoded colours or linear data (normals, roughness).
     pub fn encoding(&self) -> ColorEncoding {
         self.encoding
     }

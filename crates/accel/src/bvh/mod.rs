@@ -74,18 +74,22 @@ impl BvhNode {
     }
 
     #[inline(always)]
+    /// Whether the node is a leaf (holds triangles rather than children).
     pub fn is_leaf(&self) -> bool {
         self.count() > 0
     }
 
+    /// The smallest corner of the node's box.
     pub fn min(&self) -> Vec3 {
         self.min_first.truncate()
     }
 
+    /// The largest corner of the node's box.
     pub fn max(&self) -> Vec3 {
         self.max_count.truncate()
     }
 
+    /// The node's box.
     pub fn bounds(&self) -> Aabb {
         Aabb::new(self.min(), self.max())
     }

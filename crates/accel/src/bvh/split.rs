@@ -23,6 +23,7 @@ pub enum SplitMethod {
 }
 
 impl SplitMethod {
+    /// The variant's name on command lines and in reports (`object-median`, `spatial-median`, `sah`, `sah-sweep`).
     pub fn name(self) -> &'static str {
         match self {
             SplitMethod::ObjectMedian => "object-median",

@@ -34,8 +34,10 @@ pub enum Traversal {
 }
 
 impl Traversal {
+    /// Both slab tests, the robust one first.
     pub const ALL: &'static [Traversal] = &[Traversal::Robust, Traversal::Fast];
 
+    /// The name on command lines and in reports (`robust`, `fast`).
     pub fn name(self) -> &'static str {
         match self {
             Traversal::Robust => "robust",

@@ -34,8 +34,10 @@ pub enum SimdLevel {
 }
 
 impl SimdLevel {
+    /// Every level, from the least to the most capable.
     pub const ALL: &'static [SimdLevel] = &[SimdLevel::Portable, SimdLevel::Avx2, SimdLevel::Avx512];
 
+    /// The level's name in reports and for limiting it (`portable`, `avx2`, `avx512`).
     pub fn name(self) -> &'static str {
         match self {
             SimdLevel::Portable => "portable",

@@ -11,7 +11,9 @@ use super::{Expect, ProbeRay, RayKind, point_in_cube};
 /// the generic [`RayKind`]s.
 #[derive(Clone, Debug)]
 pub struct Case {
+    /// The case's name in reports.
     pub name: String,
+    /// The scene, as triangle corners.
     pub triangles: Vec<[Vec3; 3]>,
     /// Rays made for this scene, by kind (for example rays aimed inside
     /// closed meshes, which must all hit).
@@ -86,6 +88,7 @@ fn copies() -> Case {
 /// A closed mesh and the points strictly inside it that rays are aimed at.
 #[derive(Clone, Debug)]
 pub struct Solid {
+    /// The mesh, scaled to about unit size.
     pub mesh: ClosedMesh,
     /// A point inside the unit-sized shape, from two to three uniform numbers.
     pub inside: fn(&mut Rng) -> Vec3,

@@ -32,7 +32,9 @@ use crate::{Accel, Hit};
 /// A ray and what must be true of its answer, whatever the structure.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ProbeRay {
+    /// The ray to trace.
     pub ray: Ray,
+    /// What its answer must satisfy besides agreeing with the reference.
     pub expect: Expect,
 }
 
@@ -51,7 +53,9 @@ pub enum Expect {
 /// A structure's answers to one ray: closest hit and any hit.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Answer {
+    /// The closest hit, if any.
     pub closest: Option<Hit>,
+    /// Whether the any-hit query found a hit.
     pub any: bool,
 }
 
@@ -99,6 +103,7 @@ pub fn same_hit(a: Option<Hit>, b: Option<Hit>) -> bool {
 /// How a structure's answers to a set of rays fared.
 #[derive(Clone, Debug, Default, PartialEq, Serialize)]
 pub struct Tally {
+    /// Rays traced.
     pub rays: usize,
     /// Rays compared with the reference (the reference may answer only the first ones).
     pub compared: usize,

@@ -39,6 +39,7 @@ pub enum RayKind {
 }
 
 impl RayKind {
+    /// Every kind, in the order reports list them.
     pub const ALL: &'static [RayKind] = &[
         RayKind::Random,
         RayKind::Vertex,
@@ -49,6 +50,7 @@ impl RayKind {
         RayKind::Camera,
     ];
 
+    /// The kind's name in reports.
     pub fn name(self) -> &'static str {
         match self {
             RayKind::Random => "random",

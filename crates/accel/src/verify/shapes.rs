@@ -41,11 +41,14 @@ pub fn rays_through_diagonal(size: f32, offset: Vec3, bits: u32, count: usize, s
 /// A closed mesh: vertex positions and triangles as indices.
 #[derive(Clone, Debug)]
 pub struct ClosedMesh {
+    /// Vertex positions.
     pub vertices: Vec<Vec3>,
+    /// Triangles as three indices into `vertices`.
     pub faces: Vec<[u32; 3]>,
 }
 
 impl ClosedMesh {
+    /// The triangles' corners, in face order, as the structures take them.
     pub fn triangles(&self) -> Vec<[Vec3; 3]> {
         self.faces.iter().map(|f| f.map(|i| self.vertices[i as usize])).collect()
     }

@@ -36,6 +36,7 @@ pub enum Knob {
 }
 
 impl Knob {
+    /// Every knob, in the order `all` runs them.
     pub const ALL: &'static [Knob] = &[
         Knob::Spp,
         Knob::Depth,
@@ -47,6 +48,7 @@ impl Knob {
         Knob::Precision,
     ];
 
+    /// The knob's name on command lines and in file names (`spp`, `depth`, ...).
     pub fn name(self) -> &'static str {
         match self {
             Knob::Spp => "spp",
