@@ -121,3 +121,20 @@ fn the_readmes_trace_example_runs_on_rays_written_by_rtgi_rays() {
         }
     }
 }
+
+#[test]
+fn parse_errors_are_one_line_made_from_clap_s_error_kinds() {
+    for (args, expected) in [
+        (&["rendr"][..], "error: unrecognized subcommand 'rendr'; did you mean 'render'?"),
+        (
+            &["render", "--seed", "1", "--seed", "2"][..],
+            "error: the argument '--seed <SEED>' cannot be used multiple times",
+        ),
+        (&["render", "--frobnicate"][..], "error: unexpected argument '--frobnicate'"),
+        (&["merge"][..], "error: the following required arguments were not provided: --output <OUTPUT>, <PARTS>..."),
+    ] {
+        let run = rtgi(args);
+        assert_eq!(run.code, Some(2), "{run:?}");
+        assert_eq!(run.stderr.trim(), expected, "{args:?}");
+    }
+}

@@ -702,15 +702,62 @@ pub(crate) fn report_parse_error(error: clap::Error) -> ExitCode {
         let _ = error.print();
         return ExitCode::from(if error.kind() == ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand { 2 } else { 0 });
     }
-    let rendered = error.render().to_string();
-    let message: Vec<&str> = rendered
-        .lines()
-        .map(str::trim)
-        .take_while(|l| !l.starts_with("Usage:") && !l.starts_with("For more information"))
-        .filter(|l| !l.is_empty())
-        .collect();
-    eprintln!("{}", message.join(" "));
+    eprintln!("error: {}", parse_error_line(&error));
     ExitCode::from(2)
+}
+
+/// One line for a parse error, made from clap's error kind, its context
+/// (the argument, the value, the valid values, a suggestion) and, for a
+/// value our parsers refused, their own message: not from clap's printed text.
+fn parse_error_line(error: &clap::Error) -> String {
+    use clap::error::{ContextKind, ContextValue, ErrorKind};
+    let context = |kind: ContextKind| -> Option<String> {
+        error.get(kind).map(|value| match value {
+            ContextValue::String(s) => s.clone(),
+            ContextValue::Strings(list) => list.join(", "),
+            ContextValue::StyledStr(styled) => styled.to_string(),
+            ContextValue::StyledStrs(list) => list.iter().map(|s| s.to_string()).collect::<Vec<_>>().join(", "),
+            ContextValue::Number(n) => n.to_string(),
+            other => other.to_string(),
+        })
+    };
+    let argument = context(ContextKind::InvalidArg).unwrap_or_default();
+    let value = context(ContextKind::InvalidValue).unwrap_or_default();
+    let mut line = match error.kind() {
+        ErrorKind::ValueValidation => {
+            let why = std::error::Error::source(error).map(|e| e.to_string()).unwrap_or_default();
+            format!("invalid value '{value}' for '{argument}': {why}")
+        }
+        ErrorKind::InvalidValue => format!("invalid value '{value}' for '{argument}'"),
+        ErrorKind::UnknownArgument => format!("unexpected argument '{argument}'"),
+        ErrorKind::InvalidSubcommand => {
+            format!("unrecognized subcommand '{}'", context(ContextKind::InvalidSubcommand).unwrap_or_default())
+        }
+        ErrorKind::MissingRequiredArgument => format!("the following required arguments were not provided: {argument}"),
+        ErrorKind::ArgumentConflict => {
+            let other = context(ContextKind::PriorArg).unwrap_or_default();
+            if other == argument {
+                format!("the argument '{argument}' cannot be used multiple times")
+            } else {
+                format!("the argument '{argument}' cannot be used with '{other}'")
+            }
+        }
+        ErrorKind::TooManyValues => format!("unexpected value '{value}' for '{argument}'"),
+        ErrorKind::TooFewValues | ErrorKind::WrongNumberOfValues => {
+            let expected = context(ContextKind::ExpectedNumValues).unwrap_or_default();
+            format!("'{argument}' takes {expected} value(s)")
+        }
+        ErrorKind::NoEquals => format!("'{argument}' needs a value after '='"),
+        kind if !argument.is_empty() => format!("{kind}: '{argument}'"),
+        kind => kind.to_string(),
+    };
+    if let Some(valid) = context(ContextKind::ValidValue) {
+        line.push_str(&format!(" (possible values: {valid})"));
+    }
+    if let Some(suggestion) = context(ContextKind::SuggestedArg).or_else(|| context(ContextKind::SuggestedSubcommand)) {
+        line.push_str(&format!("; did you mean '{suggestion}'?"));
+    }
+    line
 }
 
 #[cfg(test)]
