@@ -53,6 +53,9 @@ pub(crate) struct Rendered {
 /// `rtgi render`, returning the image it wrote.
 pub(crate) fn render_image(args: &RenderArgs) -> Result<Rendered> {
     let started = Instant::now();
+    // From the start: a Ctrl-C while the scene loads then stops the render
+    // before its first pass (a second one ends the process at once).
+    interrupt::install()?;
     let job = &args.job;
     let output = args.output();
     let (width, height, spp) = args.resolution();
@@ -164,7 +167,6 @@ pub(crate) fn render_image(args: &RenderArgs) -> Result<Rendered> {
         }
     };
 
-    interrupt::install()?;
     let before = accumulation.samples().end;
     let pixels = rows.len() as u64 * settings.width as u64;
     let progress = Progress::new(pixels, before, samples.end);
