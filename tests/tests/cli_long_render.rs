@@ -32,6 +32,17 @@ fn uninterrupted(dir: &Path) -> Vec<u8> {
     std::fs::read(&whole).unwrap()
 }
 
+/// Starts `rtgi` with `args` in the workspace root, its output captured.
+fn spawn(args: &[&str]) -> std::process::Child {
+    Command::new(RTGI)
+        .args(args)
+        .current_dir(rtgi_tests::workspace_root())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap()
+}
+
 /// Sends `signal` (a name kill(1) knows) to a process.
 fn send(signal: &str, pid: u32) {
     let status = Command::new("kill").args([&format!("-{signal}"), &pid.to_string()]).status().unwrap();
@@ -53,13 +64,7 @@ fn a_render_interrupted_at_a_random_moment_resumes_to_the_same_bytes() {
     let (image, checkpoint) = (dir.join("image.exr"), dir.join("render.accum"));
     let mut args = render_args(&["-o", path_str(&image), "--checkpoint", path_str(&checkpoint)]);
     args.extend(["--checkpoint-every", "0.3"]);
-    let child = Command::new(RTGI)
-        .args(&args)
-        .current_dir(rtgi_tests::workspace_root())
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
+    let child = spawn(&args);
     std::thread::sleep(random_moment());
     send("INT", child.id());
     let run: Run = child.wait_with_output().unwrap().into();
@@ -76,13 +81,7 @@ fn a_render_interrupted_at_a_random_moment_resumes_to_the_same_bytes() {
         // Resumed, interrupted once more with SIGTERM, and resumed to the end.
         let mut resume = render_args(&["-o", path_str(&image), "--resume", path_str(&checkpoint)]);
         resume.extend(["--checkpoint-every", "0.3"]);
-        let child = Command::new(RTGI)
-            .args(&resume)
-            .current_dir(rtgi_tests::workspace_root())
-            .stdout(Stdio::piped())
-            .stderr(Stdio::piped())
-            .spawn()
-            .unwrap();
+        let child = spawn(&resume);
         std::thread::sleep(Duration::from_millis(400));
         send("TERM", child.id());
         let run: Run = child.wait_with_output().unwrap().into();
@@ -99,13 +98,7 @@ fn a_second_interrupt_ends_the_render_at_once() {
     let image = dir.join("never.exr");
     let args: Vec<&str> =
         ["render", "--width", "256", "--height", "256", "--spp", "4096", "-o", path_str(&image)].into();
-    let child = Command::new(RTGI)
-        .args(&args)
-        .current_dir(rtgi_tests::workspace_root())
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
+    let child = spawn(&args);
     // Once the first pass (one sample) is done, the render is in its long second pass.
     std::thread::sleep(Duration::from_millis(1500));
     send("INT", child.id());

@@ -18,7 +18,7 @@ use std::path::{Path, PathBuf};
 use serde::{Deserialize, Serialize};
 
 use crate::accumulation::{Accumulation, PixelSum};
-use crate::identity::RenderIdentity;
+use crate::identity::{Fnv, RenderIdentity};
 
 const MAGIC: &[u8] = b"rtgi accumulation 1\n";
 
@@ -69,7 +69,7 @@ impl Accumulation {
                 for &channel in sum {
                     encode(channel, &mut bytes);
                 }
-                checksum.bytes(&bytes);
+                checksum.update(bytes.iter().copied());
                 out.write_all(&bytes)?;
             }
             out.write_all(&checksum.0.to_le_bytes())
@@ -161,7 +161,7 @@ fn decode(input: &mut impl Read, checksum: &mut Fnv) -> Result<i128, String> {
     for shift in (0..128).step_by(7) {
         let mut byte = [0u8; 1];
         read_exact(input, &mut byte)?;
-        checksum.bytes(&byte);
+        checksum.update(byte);
         let bits = (byte[0] & 0x7f) as u128;
         if shift == 126 && bits > 0b11 {
             return Err("a sum longer than 128 bits".into());
@@ -172,21 +172,6 @@ fn decode(input: &mut impl Read, checksum: &mut Fnv) -> Result<i128, String> {
         }
     }
     Err("a sum longer than 128 bits".into())
-}
-
-/// FNV-1a, 64 bits, fed in pieces.
-struct Fnv(u64);
-
-impl Fnv {
-    fn new() -> Fnv {
-        Fnv(0xcbf2_9ce4_8422_2325)
-    }
-
-    fn bytes(&mut self, bytes: &[u8]) {
-        for &b in bytes {
-            self.0 = (self.0 ^ b as u64).wrapping_mul(0x0000_0100_0000_01b3);
-        }
-    }
 }
 
 #[cfg(test)]

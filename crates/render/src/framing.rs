@@ -131,44 +131,43 @@ pub fn three_quarter_view(bounds: &Aabb, vertical_fov: f32, aspect: f32) -> Came
 /// sees only the insides of its faces; one pressed against a wall sees the
 /// wall at no distance.
 pub fn camera_blocked<A: Accel + ?Sized>(scene: &Scene, accel: &A, camera: &Camera, aspect: f32) -> Option<f32> {
-    let height = PROBE_RESOLUTION;
-    let width = ((PROBE_RESOLUTION as f32 * aspect).round() as u32).clamp(1, 4 * PROBE_RESOLUTION);
-    let rays = CameraRays::new(camera, width, height);
     let bounds = scene.bounds();
     let near = if bounds.is_empty() { 0.0 } else { 1e-4 * bounds.extent().length() };
     let mut blocked = 0u32;
-    for y in 0..height {
-        for x in 0..width {
-            let ray = rays.ray(x, y, Vec2::splat(0.5));
-            let Some(hit) = accel.intersect(&ray) else { continue };
-            let triangle = &scene.triangles[hit.triangle as usize];
-            let [a, b, c] = triangle.vertices.map(|v| scene.vertices[v as usize].position);
-            // The winding decides, even for double-sided materials: a leaf
-            // seen from behind is fine, a view made mostly of backs is not.
-            let back_face = (b - a).cross(c - a).dot(ray.direction) > 0.0;
-            if back_face || hit.t * ray.direction.length() < near {
-                blocked += 1;
-            }
+    let probes = probe_rays(camera, aspect);
+    for ray in &probes {
+        let Some(hit) = accel.intersect(ray) else { continue };
+        let triangle = &scene.triangles[hit.triangle as usize];
+        let [a, b, c] = triangle.vertices.map(|v| scene.vertices[v as usize].position);
+        // The winding decides, even for double-sided materials: a leaf
+        // seen from behind is fine, a view made mostly of backs is not.
+        let back_face = (b - a).cross(c - a).dot(ray.direction) > 0.0;
+        if back_face || hit.t * ray.direction.length() < near {
+            blocked += 1;
         }
     }
-    let fraction = blocked as f32 / (width * height) as f32;
+    let fraction = blocked as f32 / probes.len() as f32;
     (fraction > 0.5).then_some(fraction)
 }
 
 /// How many materials cover at least two of the probe rays' hits.
 fn materials_shown<A: Accel + ?Sized>(scene: &Scene, accel: &A, camera: &Camera, aspect: f32) -> usize {
-    let height = PROBE_RESOLUTION;
-    let width = ((PROBE_RESOLUTION as f32 * aspect).round() as u32).clamp(1, 4 * PROBE_RESOLUTION);
-    let rays = CameraRays::new(camera, width, height);
     let mut hits_per_material = vec![0u32; scene.materials.len()];
-    for y in 0..height {
-        for x in 0..width {
-            if let Some(hit) = accel.intersect(&rays.ray(x, y, Vec2::splat(0.5))) {
-                hits_per_material[scene.triangles[hit.triangle as usize].material as usize] += 1;
-            }
+    for ray in probe_rays(camera, aspect) {
+        if let Some(hit) = accel.intersect(&ray) {
+            hits_per_material[scene.triangles[hit.triangle as usize].material as usize] += 1;
         }
     }
     hits_per_material.iter().filter(|&&n| n >= 2).count()
+}
+
+/// The probe rays of a view: one through the centre of each pixel of a
+/// grid [`PROBE_RESOLUTION`] high, as wide as the aspect asks (up to four times).
+fn probe_rays(camera: &Camera, aspect: f32) -> Vec<rtgi_math::Ray> {
+    let height = PROBE_RESOLUTION;
+    let width = ((PROBE_RESOLUTION as f32 * aspect).round() as u32).clamp(1, 4 * PROBE_RESOLUTION);
+    let rays = CameraRays::new(camera, width, height);
+    (0..height).flat_map(|y| (0..width).map(move |x| (x, y))).map(|(x, y)| rays.ray(x, y, Vec2::splat(0.5))).collect()
 }
 
 #[cfg(test)]

@@ -156,19 +156,25 @@ pub fn scene_fingerprint(scene: &Scene) -> u64 {
     hash.bytes(described.bytes()).0
 }
 
-/// FNV-1a, 64 bits.
+/// FNV-1a, 64 bits: the scene fingerprint here, and the checksum of
+/// accumulation files.
 #[derive(Clone, Copy)]
-struct Fnv(u64);
+pub(crate) struct Fnv(pub(crate) u64);
 
 impl Fnv {
-    fn new() -> Fnv {
+    pub(crate) fn new() -> Fnv {
         Fnv(0xcbf2_9ce4_8422_2325)
     }
 
-    fn bytes(mut self, bytes: impl IntoIterator<Item = u8>) -> Fnv {
+    /// Feeds `bytes` in.
+    pub(crate) fn update(&mut self, bytes: impl IntoIterator<Item = u8>) {
         for b in bytes {
             self.0 = (self.0 ^ b as u64).wrapping_mul(0x0000_0100_0000_01b3);
         }
+    }
+
+    fn bytes(mut self, bytes: impl IntoIterator<Item = u8>) -> Fnv {
+        self.update(bytes);
         self
     }
 }
