@@ -2,7 +2,7 @@
 //! came out almost black or almost white, so that a first render is
 //! neither dark nor clipped and a failed one says so.
 
-use rtgi_math::Vec3;
+use rtgi_math::luminance;
 
 use crate::{HdrImage, ToneMap};
 
@@ -16,10 +16,6 @@ const LIMIT: f32 = 12.0;
 /// Pixels darker than this luminance are left out of the average: the
 /// black of a background that sees nothing says nothing about exposure.
 const BLACK: f32 = 1e-6;
-
-fn luminance(c: Vec3) -> f32 {
-    c.dot(Vec3::new(0.2126, 0.7152, 0.0722))
-}
 
 /// An exposure in stops for `image`: its pixels' log-average luminance
 /// brought to middle grey, but lowered if that would push more than 2% of
@@ -77,7 +73,8 @@ mod tests {
     use crate::ToneOperator;
 
     fn image_of(values: &[f32]) -> HdrImage {
-        HdrImage::from_pixels(values.len() as u32, 1, values.iter().map(|&v| Vec3::splat(v)).collect()).unwrap()
+        HdrImage::from_pixels(values.len() as u32, 1, values.iter().map(|&v| rtgi_math::Vec3::splat(v)).collect())
+            .unwrap()
     }
 
     #[test]

@@ -23,6 +23,7 @@ pub struct ReadmeDoctests;
 
 mod aabb;
 mod choices;
+mod colour;
 mod float;
 mod frame;
 mod ray;
@@ -31,6 +32,7 @@ mod spawn;
 
 pub use aabb::Aabb;
 pub use choices::parse_vec3;
+pub use colour::luminance;
 pub use float::{gamma, next_float_down, next_float_up};
 pub use frame::{Frame, uniform_sphere};
 pub use glam;

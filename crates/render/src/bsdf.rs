@@ -59,6 +59,19 @@ pub enum Bsdf {
         /// GGX width, in `(0, 1]`.
         alpha: f32,
     },
+    /// MTL's diffuse and glossy layers together: a Lambertian lobe of
+    /// albedo `Kd` plus a GGX lobe of constant reflectance `Ks`. Evaluated
+    /// as the sum of both and sampled from their mixture, chosen by
+    /// luminance, so that light sampling sees both lobes at every hit
+    /// (choosing one lobe per hit instead made directly lit walls noisy).
+    DiffuseGlossy {
+        /// Diffuse albedo (linear RGB).
+        albedo: Vec3,
+        /// Specular reflectance (linear RGB).
+        reflectance: Vec3,
+        /// GGX width, in `(0, 1]`.
+        alpha: f32,
+    },
     /// A smooth boundary between air (+z side) and a medium of index `ior`
     /// that reflects and refracts by Fresnel's equations; refracted light is
     /// tinted by `tint` (glTF's base colour for transmission).
@@ -117,6 +130,10 @@ impl Bsdf {
                 }
                 reflectance * (ggx_d(wm, alpha) * ggx_g2(wo, wi, alpha) / (4.0 * wo.z * wi.z))
             }
+            Bsdf::DiffuseGlossy { albedo, reflectance, alpha } => {
+                let glossy = Bsdf::Glossy { reflectance, alpha }.eval(wo, wi);
+                albedo / PI + glossy
+            }
             Bsdf::MetallicRoughness { base_color, metallic, alpha } => {
                 let wm = (wo + wi).normalize_or_zero();
                 if wm == Vec3::ZERO {
@@ -147,6 +164,10 @@ impl Bsdf {
             | Bsdf::ThinDielectric { .. }
             | Bsdf::RoughThinDielectric { .. } => 0.0,
             Bsdf::Glossy { alpha, .. } => ggx_reflection_pdf(wo, wi, alpha),
+            Bsdf::DiffuseGlossy { albedo, reflectance, alpha } => {
+                let p_glossy = glossy_probability(albedo, reflectance);
+                p_glossy * ggx_reflection_pdf(wo, wi, alpha) + (1.0 - p_glossy) * wi.z / PI
+            }
             Bsdf::MetallicRoughness { metallic, alpha, .. } => {
                 let p_specular = specular_probability(metallic);
                 p_specular * ggx_reflection_pdf(wo, wi, alpha) + (1.0 - p_specular) * wi.z / PI
@@ -196,6 +217,15 @@ impl Bsdf {
             Bsdf::Mirror { reflectance } => {
                 let wi = Vec3::new(-local_wo.x, -local_wo.y, local_wo.z);
                 return Some(BsdfSample { wi: back(wi), value: reflectance / wi.z, pdf: 1.0, delta: true, eta: 1.0 });
+            }
+            Bsdf::DiffuseGlossy { albedo, reflectance, alpha } => {
+                let p_glossy = glossy_probability(albedo, reflectance);
+                if u.x < p_glossy {
+                    let u = Vec2::new(u.x / p_glossy, u.y);
+                    reflect(local_wo, sample_ggx_visible_normal(local_wo, alpha, u))
+                } else {
+                    cosine_hemisphere(Vec2::new((u.x - p_glossy) / (1.0 - p_glossy), u.y))
+                }
             }
             Bsdf::MetallicRoughness { metallic, alpha, .. } => {
                 let p_specular = specular_probability(metallic);
@@ -327,6 +357,7 @@ impl Bsdf {
             Bsdf::Lambert { albedo } => albedo,
             Bsdf::Mirror { reflectance } | Bsdf::Glossy { reflectance, .. } => reflectance,
             Bsdf::MetallicRoughness { base_color, .. } => base_color,
+            Bsdf::DiffuseGlossy { albedo, reflectance, .. } => albedo + reflectance,
             Bsdf::Dielectric { tint, .. }
             | Bsdf::ThinDielectric { tint, .. }
             | Bsdf::RoughThinDielectric { tint, .. } => tint,
@@ -337,6 +368,21 @@ impl Bsdf {
 /// How often the metallic-roughness model samples its specular lobe.
 fn specular_probability(metallic: f32) -> f32 {
     0.5 + 0.5 * metallic.clamp(0.0, 1.0)
+}
+
+/// How often the diffuse-and-glossy model samples its glossy lobe: in
+/// proportion to the lobes' luminance, so the brighter lobe gets the
+/// samples, but never below 10% for either lobe while it reflects at all,
+/// so that a dim but narrow highlight is still found often enough.
+fn glossy_probability(albedo: Vec3, reflectance: Vec3) -> f32 {
+    let (diffuse, glossy) = (rtgi_math::luminance(albedo).max(0.0), rtgi_math::luminance(reflectance).max(0.0));
+    if glossy <= 0.0 {
+        return 0.0;
+    }
+    if diffuse <= 0.0 {
+        return 1.0;
+    }
+    (glossy / (diffuse + glossy)).clamp(0.1, 0.9)
 }
 
 fn to_upper(w: Vec3) -> Vec3 {
@@ -424,6 +470,8 @@ mod tests {
             Bsdf::MetallicRoughness { base_color: Vec3::new(0.9, 0.6, 0.3), metallic: 0.0, alpha: 0.5 },
             Bsdf::MetallicRoughness { base_color: Vec3::ONE, metallic: 0.5, alpha: 0.05 },
             Bsdf::Glossy { reflectance: Vec3::new(0.9, 0.9, 0.5), alpha: 0.2 },
+            Bsdf::DiffuseGlossy { albedo: Vec3::new(0.6, 0.4, 0.2), reflectance: Vec3::splat(0.2), alpha: 0.1 },
+            Bsdf::DiffuseGlossy { albedo: Vec3::splat(0.02), reflectance: Vec3::splat(0.5), alpha: 0.4 },
             Bsdf::RoughThinDielectric { ior: 1.5, tint: Vec3::new(0.9, 0.8, 0.7), alpha: 0.3 },
         ]
     }
@@ -523,6 +571,35 @@ mod tests {
         let mirror = Bsdf::Mirror { reflectance: Vec3::splat(0.9) }.sample(direction(0.7), Vec2::ZERO).unwrap();
         assert!((mirror.value * mirror.wi.z / mirror.pdf - Vec3::splat(0.9)).abs().max_element() < 1e-6);
         assert!((mirror.wi - Vec3::new(-0.7f32.sin(), 0.0, 0.7f32.cos())).length() < 1e-6);
+    }
+
+    #[test]
+    fn diffuse_glossy_reflects_what_its_two_lobes_reflect() {
+        // The mixture's importance-sampled albedo must be the Lambertian
+        // albedo plus the glossy lobe's own albedo, at every sample count
+        // (a wrong mixture weight shows up as a constant offset).
+        let (albedo, reflectance, alpha) = (Vec3::new(0.5, 0.3, 0.1), Vec3::splat(0.25), 0.15);
+        let layered = Bsdf::DiffuseGlossy { albedo, reflectance, alpha };
+        let glossy = Bsdf::Glossy { reflectance, alpha };
+        let mut rng = Rng::new(7, 8);
+        for theta in [0.2f32, 0.9, 1.3] {
+            let wo = direction(theta);
+            let estimate = |bsdf: Bsdf, n: usize, rng: &mut Rng| {
+                let mut sum = rtgi_math::glam::DVec3::ZERO;
+                for _ in 0..n {
+                    if let Some(s) = bsdf.sample(wo, Vec2::new(rng.next_f32(), rng.next_f32())) {
+                        sum += (s.value * s.wi.z.abs() / s.pdf).as_dvec3();
+                    }
+                }
+                (sum / n as f64).as_vec3()
+            };
+            let expected = albedo + estimate(glossy, 400_000, &mut rng);
+            for n in [1_000usize, 20_000, 400_000] {
+                let got = estimate(layered, n, &mut rng);
+                let tolerance = 3.0 / (n as f32).sqrt();
+                assert!((got - expected).abs().max_element() < tolerance, "{theta} with {n}: {got} vs {expected}");
+            }
+        }
     }
 
     #[test]

@@ -8,7 +8,7 @@
 //! as one with the effect forced on: the images agree, which the tests check.
 
 use rtgi_accel::{Accel, Hit};
-use rtgi_math::{Frame, Ray, Rng, SurfacePoint, TriangleShape, Vec2, Vec3, Vec4};
+use rtgi_math::{Frame, Ray, Rng, SurfacePoint, TriangleShape, Vec2, Vec3, Vec4, luminance};
 use rtgi_scene::{Material, Scene, SurfaceModel, Triangle};
 
 use crate::bsdf::Bsdf;
@@ -170,10 +170,6 @@ fn power_heuristic(a: f32, b: f32) -> f32 {
 
 static DEFAULT_SUN: std::sync::LazyLock<rtgi_scene::Light> =
     std::sync::LazyLock::new(crate::default_lighting::default_sun);
-
-fn luminance(c: Vec3) -> f32 {
-    c.dot(Vec3::new(0.2126, 0.7152, 0.0722))
-}
 
 impl<'a, A: Accel + ?Sized> Transport<'a, A> {
     pub(crate) fn new(
@@ -464,16 +460,16 @@ impl<'a, A: Accel + ?Sized> Transport<'a, A> {
                     (Bsdf::MetallicRoughness { base_color, metallic, alpha: alpha.max(MIN_ALPHA) }, Vec3::ONE)
                 }
             }
+            SurfaceModel::DiffuseSpecular if alpha >= MIN_ALPHA => {
+                (Bsdf::DiffuseGlossy { albedo: base_color, reflectance: material.specular, alpha }, Vec3::ONE)
+            }
             SurfaceModel::DiffuseSpecular => {
+                // A mirror is a delta: it cannot be summed with the diffuse
+                // lobe, so one of the two is chosen per hit.
                 let specular = material.specular;
                 let p_specular = luminance(specular) / (luminance(specular) + luminance(base_color)).max(1e-12);
                 if u < p_specular {
-                    let lobe = if alpha < MIN_ALPHA {
-                        Bsdf::Mirror { reflectance: specular }
-                    } else {
-                        Bsdf::Glossy { reflectance: specular, alpha }
-                    };
-                    (lobe, Vec3::splat(1.0 / p_specular))
+                    (Bsdf::Mirror { reflectance: specular }, Vec3::splat(1.0 / p_specular))
                 } else {
                     (Bsdf::Lambert { albedo: base_color }, Vec3::splat(1.0 / (1.0 - p_specular)))
                 }

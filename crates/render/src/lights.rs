@@ -11,7 +11,7 @@ use std::path::{Path, PathBuf};
 use std::str::FromStr;
 
 use rtgi_image::{HdrImage, ImageError};
-use rtgi_math::{Ray, SurfacePoint, TriangleShape, Vec2, Vec3, parse_vec3};
+use rtgi_math::{Ray, SurfacePoint, TriangleShape, Vec2, Vec3, luminance, parse_vec3};
 use rtgi_scene::{Light, LightKind, Scene, SurfaceModel, TextureId};
 
 use crate::distribution::Distribution1D;
@@ -101,10 +101,6 @@ impl EnvironmentSpec {
             EnvironmentSpec::File(path) => Environment::load(path),
         }
     }
-}
-
-fn luminance(c: Vec3) -> f32 {
-    c.dot(Vec3::new(0.2126, 0.7152, 0.0722))
 }
 
 impl Environment {
