@@ -128,10 +128,13 @@ pub(crate) fn render_image(args: &RenderArgs) -> Result<Rendered> {
         };
     }
     if let Some(light) = room_light {
+        let p = light.position;
         say!(
-            "  note: the camera is enclosed by the scene (no sky reaches it) and nothing emits light, so a point \
-             light {:.3?} above it lights the room; --light or --environment chooses others",
-            light.position - camera.position
+            "  note: the camera is enclosed by the scene (no sky reaches it) and nothing emits light, so a lamp \
+             at {:.3},{:.3},{:.3} shines down on the room in view; --light or --environment chooses others",
+            p.x,
+            p.y,
+            p.z
         );
     }
     let identity = RenderIdentity::new(&scene, &camera, &settings);
@@ -297,7 +300,7 @@ fn light_enclosed_camera(
     if !EffectPlan::new(scene, settings).default_environment || sky_visibility(accel, camera.position) >= ENCLOSED {
         return None;
     }
-    let light = room_light(scene, accel, camera.position);
+    let light = room_light(scene, accel, camera);
     scene.lights.push(light.clone());
     Some(light)
 }

@@ -8,7 +8,7 @@ use std::sync::LazyLock;
 use rtgi_accel::Accel;
 use rtgi_image::HdrImage;
 use rtgi_math::{Ray, Vec3};
-use rtgi_scene::{Light, LightKind, Scene};
+use rtgi_scene::{Camera, Light, LightKind, Scene};
 
 use crate::{Environment, EnvironmentMap};
 
@@ -96,22 +96,34 @@ pub fn sky_visibility<A: Accel + ?Sized>(accel: &A, position: Vec3) -> f32 {
 /// Below this [`sky_visibility`] a camera is taken to be enclosed.
 pub const ENCLOSED: f32 = 0.02;
 
-/// A light for a camera enclosed by an unlit scene (a room with no lamps):
-/// a point light above the camera, three tenths of the way to the ceiling
-/// (or, with none above, one tenth of the scene's size up): close enough
-/// that what the camera sees is lit directly, not only by bounces, bright enough
-/// to give an irradiance of about π at the camera's height.
-pub fn room_light<A: Accel + ?Sized>(scene: &Scene, accel: &A, camera: Vec3) -> Light {
+/// The room light hangs this fraction of the way from the floor in view to the ceiling.
+const ROOM_LIGHT_HEIGHT: f32 = 0.5;
+
+/// A light for a camera enclosed by an unlit scene (a room with no lamps),
+/// hung like a ceiling lamp with a shade over the room the camera looks
+/// into: a spot light shining down, above the point halfway between the
+/// camera and what its central ray hits, halfway up to the ceiling there
+/// (with no ceiling, a tenth of the scene's size up). Its intensity gives
+/// an irradiance of about π where the central ray hits, so that what the
+/// camera looks at is lit directly, not only by bounces. The shade keeps
+/// the ceiling over the lamp dark: a bare bulb close to it made a hot spot
+/// that every bounce off the ceiling turned into a firefly.
+pub fn room_light<A: Accel + ?Sized>(scene: &Scene, accel: &A, camera: &Camera) -> Light {
     let size = scene.bounds().extent().length().max(1e-6);
-    let up = Ray::new(camera, Vec3::Y);
-    let height = accel.intersect(&up).map_or(0.1 * size, |hit| 0.3 * hit.t);
+    let view = Ray::new(camera.position, camera.direction);
+    let looked_at = accel.intersect(&view).map_or(camera.position + camera.direction, |hit| view.at(hit.t));
+    let below = camera.position.lerp(looked_at, 0.5);
+    let up = Ray::new(below, Vec3::Y);
+    let rise = accel.intersect(&up).map_or(0.1 * size, |hit| ROOM_LIGHT_HEIGHT * hit.t);
+    let position = below + Vec3::Y * rise;
+    let distance = position.distance(looked_at).max(1e-6);
     Light {
         name: "default room light".into(),
         kind: LightKind::Point,
-        position: camera + Vec3::Y * height,
+        position,
         direction: Vec3::NEG_Y,
         color: SUN_COLOUR,
-        intensity: std::f32::consts::PI * height * height,
+        intensity: std::f32::consts::PI * distance * distance,
         range: None,
     }
 }

@@ -15,6 +15,13 @@ const PROBE_RESOLUTION: u32 = 24;
 const THREE_QUARTER_AZIMUTH: f32 = 35.0;
 const THREE_QUARTER_ELEVATION: f32 = 25.0;
 
+/// The corner views of a room: this far in from each wall (a fraction of
+/// the bounds), at this fraction of its height, looking at a point this
+/// high above the floor in the middle.
+const ROOM_CORNER_INSET: f32 = 0.08;
+const ROOM_CAMERA_HEIGHT: f32 = 0.6;
+const ROOM_TARGET_HEIGHT: f32 = 0.2;
+
 /// The part of the frame the model's bounds fill, across the narrower side.
 const FILL: f32 = 0.9;
 
@@ -57,7 +64,10 @@ pub fn default_camera<A: Accel + ?Sized>(scene: &Scene, accel: &A, aspect: f32) 
 /// - the bounds seen straight from +Z (the classic view into a Cornell box);
 /// - from +Z and 35 degrees above (looking into open courtyards);
 /// - from the bounds' centre, looking along its longer horizontal axis
-///   (rooms closed on all sides).
+///   (rooms closed on all sides);
+/// - when no sky reaches the bounds' centre (a closed room), from each
+///   upper corner of the bounds, a little inside, looking down across the
+///   middle of the floor (a room as a photographer shows it).
 ///
 /// A grid of probe rays counts the distinct materials each view shows; a
 /// view whose rays mostly hit back faces or start against a surface is
@@ -77,9 +87,13 @@ pub fn frame_scene<A: Accel + ?Sized>(scene: &Scene, accel: &A, vertical_fov: f3
     let along_room = if extent.x > extent.z { -Vec3::X } else { -Vec3::Z };
     let inside = Camera::look_at(centre, centre + along_room, Vec3::Y, vertical_fov);
     let product = three_quarter_view(&bounds, vertical_fov, aspect);
+    // A room closed on all sides is seen from a corner; an open courtyard
+    // keeps the views that show its sky.
+    let enclosed = crate::sky_visibility(accel, centre) < crate::ENCLOSED;
+    let corners = if enclosed { room_corner_views(&bounds, vertical_fov).to_vec() } else { Vec::new() };
 
     let mut best: Option<(Camera, usize)> = None;
-    for candidate in [product, front, above, inside] {
+    for candidate in [product, front, above, inside].into_iter().chain(corners) {
         if camera_blocked(scene, accel, &candidate, aspect).is_some() {
             continue;
         }
@@ -90,6 +104,20 @@ pub fn frame_scene<A: Accel + ?Sized>(scene: &Scene, accel: &A, vertical_fov: f3
     }
     // Every view blocked (a scene that is one solid): the product shot, from outside the bounds.
     best.map_or(product, |(camera, _)| camera)
+}
+
+/// Views from inside the four upper corners of `bounds`, each looking
+/// across to the middle of the floor on the far side of the centre: how a
+/// photographer shows a room (the whole floor, furniture and the far walls),
+/// where a view from the centre sees one wall.
+fn room_corner_views(bounds: &Aabb, vertical_fov: f32) -> [Camera; 4] {
+    let extent = bounds.extent();
+    let target = bounds.min + extent * Vec3::new(0.5, ROOM_TARGET_HEIGHT, 0.5);
+    [(0.0, 0.0), (1.0, 0.0), (0.0, 1.0), (1.0, 1.0)].map(|(x, z)| {
+        let inset = |side: f32| ROOM_CORNER_INSET + side * (1.0 - 2.0 * ROOM_CORNER_INSET);
+        let position = bounds.min + extent * Vec3::new(inset(x), ROOM_CAMERA_HEIGHT, inset(z));
+        Camera::look_at(position, target, Vec3::Y, vertical_fov)
+    })
 }
 
 /// The three-quarter view of `bounds` (see [`frame_scene`]).
@@ -173,6 +201,80 @@ fn probe_rays(camera: &Camera, aspect: f32) -> Vec<rtgi_math::Ray> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A room 10 x 3 x 8 with its faces wound inwards, a table in the
+    /// middle, chairs along it and a picture on one wall, each its own
+    /// material; without its ceiling (`open`) it is a courtyard.
+    fn furnished_room(open: bool) -> Scene {
+        let mut obj = String::from("mtllib room.mtl\n");
+        let mut vertices = 0;
+        let mut cuboid = |obj: &mut String, material: &str, min: Vec3, max: Vec3, inward: bool, skip_top: bool| {
+            obj.push_str(&format!("usemtl {material}\n"));
+            for i in 0..8 {
+                let pick = |bit: u32, lo: f32, hi: f32| if i & bit == 0 { lo } else { hi };
+                obj.push_str(&format!(
+                    "v {} {} {}\n",
+                    pick(1, min.x, max.x),
+                    pick(2, min.y, max.y),
+                    pick(4, min.z, max.z)
+                ));
+            }
+            // Outward-facing quads of the cube's corners 1..8 (bit 1: x, bit 2: y, bit 4: z).
+            let faces = [[1, 5, 7, 3], [2, 4, 8, 6], [1, 2, 6, 5], [3, 7, 8, 4], [1, 3, 4, 2], [5, 6, 8, 7]];
+            for (index, face) in faces.iter().enumerate() {
+                if skip_top && index == 3 {
+                    continue;
+                }
+                let mut face = face.map(|v| v + vertices);
+                if inward {
+                    face.reverse();
+                }
+                obj.push_str(&format!("f {} {} {} {}\n", face[0], face[1], face[2], face[3]));
+            }
+            vertices += 8;
+        };
+        cuboid(&mut obj, "walls", Vec3::new(-5.0, 0.0, -4.0), Vec3::new(5.0, 3.0, 4.0), true, open);
+        cuboid(&mut obj, "table", Vec3::new(-2.5, 0.7, -1.0), Vec3::new(2.5, 0.8, 1.0), false, false);
+        for x in [-2.0f32, -1.0, 0.0, 1.0, 2.0] {
+            for z in [-1.5f32, 1.5] {
+                let min = Vec3::new(x - 0.25, 0.0, z - 0.25);
+                cuboid(&mut obj, "chairs", min, min + Vec3::new(0.5, 0.9, 0.5), false, false);
+            }
+        }
+        cuboid(&mut obj, "picture", Vec3::new(-1.0, 1.2, 3.9), Vec3::new(1.0, 2.2, 3.95), false, false);
+        cuboid(&mut obj, "carpet", Vec3::new(-4.0, 0.0, -3.0), Vec3::new(4.0, 0.01, 3.0), false, false);
+        let mtl = "newmtl walls\nKd 0.8 0.8 0.8\nnewmtl table\nKd 0.6 0.4 0.2\nnewmtl chairs\nKd 0.8 0.1 0.1\n\
+                   newmtl picture\nKd 0.1 0.3 0.8\nnewmtl carpet\nKd 0.2 0.5 0.2\n";
+        let read = |name: &str| (name == "room.mtl").then(|| mtl.as_bytes().to_vec());
+        Scene::load_from_bytes("room.obj", obj.as_bytes(), &read).expect("the room loads")
+    }
+
+    #[test]
+    fn a_closed_room_is_seen_from_an_upper_corner_and_a_courtyard_keeps_its_sky() {
+        use rtgi_accel::{AccelKind, BuildParams};
+        let fov = DEFAULT_VERTICAL_FOV_DEGREES.to_radians();
+        for open in [false, true] {
+            let scene = furnished_room(open);
+            assert_eq!(scene.materials.len(), 5);
+            let accel = AccelKind::Sah.build(&scene.triangle_positions(), &BuildParams::default());
+            let camera = frame_scene(&scene, accel.as_ref(), fov, 1.0);
+            let bounds = scene.bounds();
+            let (min, max) = (bounds.min, bounds.max);
+            let near_a_corner = [min.x, max.x].iter().any(|x| (camera.position.x - x).abs() < 0.1 * 10.0)
+                && [min.z, max.z].iter().any(|z| (camera.position.z - z).abs() < 0.1 * 8.0);
+            if open {
+                // Sky reaches the middle of a courtyard: no corner view from inside.
+                assert!(!near_a_corner || camera.position.y > max.y, "{camera:?}");
+            } else {
+                assert!(near_a_corner && (camera.position.y - 1.8).abs() < 1e-3, "{camera:?}");
+                assert!(camera.direction.y < 0.0, "looks down across the room: {camera:?}");
+                assert!(materials_shown(&scene, accel.as_ref(), &camera, 1.0) == 5, "{camera:?}");
+                // The room light hangs inside the room, between the floor in view and the ceiling.
+                let lamp = crate::room_light(&scene, accel.as_ref(), &camera).position;
+                assert!(bounds.contains_point(lamp) && lamp.y > 1.0 && lamp.y < 3.0, "{lamp}");
+            }
+        }
+    }
 
     #[test]
     fn the_product_shot_fills_the_frame_from_the_front_right_and_above() {
