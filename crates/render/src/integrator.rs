@@ -15,7 +15,7 @@ use crate::bsdf::Bsdf;
 use crate::effects::{Effect, EffectPlan, is_glossy, transmits};
 use crate::lights::{Environment, LightSet};
 use crate::shade::{alpha_accepts, closest_hit};
-use crate::{EffectSet, RenderSettings};
+use crate::{EffectSet, PathStart, RenderSettings};
 
 /// What the renderer computes for each pixel.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -221,13 +221,8 @@ impl<'a, A: Accel + ?Sized> Transport<'a, A> {
 
     /// The radiance arriving along `ray` (a camera ray); adds the rays it
     /// traces to `rays`.
-    pub(crate) fn radiance<const S: u16>(
-        &self,
-        mut ray: Ray,
-        mut first_hit: Option<Option<Hit>>,
-        rng: &mut Rng,
-        rays: &mut u64,
-    ) -> Vec3 {
+    pub(crate) fn radiance<const S: u16>(&self, start: &PathStart, rng: &mut Rng, rays: &mut u64) -> Vec3 {
+        let (mut ray, mut first_hit) = (start.ray, start.first_hit);
         let scene = self.scene;
         let mut radiance = Vec3::ZERO;
         let mut throughput = Vec3::ONE;
@@ -238,7 +233,14 @@ impl<'a, A: Accel + ?Sized> Transport<'a, A> {
         let mut radiance_scale = 1.0f32;
         let mut depth = 0;
         loop {
-            let u: [f32; dim::COUNT] = std::array::from_fn(|_| rng.next_f32());
+            let mut u: [f32; dim::COUNT] = std::array::from_fn(|_| rng.next_f32());
+            if depth == 0 {
+                // The first vertex takes the sampler's numbers, spread over the pixel's samples.
+                let first = start.sampler.first_vertex(&start.pixel, rng);
+                [u[dim::LIGHT_CHOICE], u[dim::LOBE]] = first.choices.to_array();
+                [u[dim::LIGHT], u[dim::LIGHT + 1]] = first.light.to_array();
+                [u[dim::BSDF], u[dim::BSDF + 1]] = first.bsdf.to_array();
+            }
             *rays += 1;
             // The camera ray's hit may have been found already, with others
             // of its block (never where alpha masks filter hits).

@@ -56,7 +56,7 @@ pub use framing::{DEFAULT_VERTICAL_FOV_DEGREES, camera_blocked, default_camera, 
 pub use identity::{Difference, RenderIdentity, scene_fingerprint};
 pub use integrator::{DirectStrategy, Integrator};
 pub use lights::{Environment, EnvironmentMap, EnvironmentSpec, EnvironmentSpecError, LightSet};
-pub use sampler::{PixelSample, PixelSampler};
+pub use sampler::{FirstVertexNumbers, PixelSample, PixelSampler};
 pub use shade::{albedo, alpha_accepts, has_alpha, shade_primary, shading_normal};
 
 use std::ops::Range;
@@ -275,21 +275,21 @@ fn render_sums<A: Accel + ?Sized>(
     let first_hits: Option<&FirstHits> = if alpha { None } else { Some(&batch) };
     let pass = Pass { camera, settings, rows: rows.clone(), samples: samples.clone(), control, first_hits };
     let (sums, rays) = match settings.integrator {
-        Integrator::Primary => render_samples(&pass, |ray, first, rng, rays| {
+        Integrator::Primary => render_samples(&pass, |start, rng, rays| {
             *rays += 1;
-            let hit = match first {
+            let hit = match start.first_hit {
                 Some(hit) => hit,
-                None => shade::closest_hit(scene, accel, &ray, alpha.then(|| rng.next_f32())),
+                None => shade::closest_hit(scene, accel, &start.ray, alpha.then(|| rng.next_f32())),
             };
             match hit {
-                Some(hit) => shade_primary(scene, &ray, &hit, textures),
+                Some(hit) => shade_primary(scene, &start.ray, &hit, textures),
                 None => settings.background,
             }
         }),
         Integrator::Direct | Integrator::Path => render_transport(scene, accel, &plan, &pass),
-        aov => render_samples(&Pass { first_hits: None, ..pass }, |ray, _, rng, rays| {
+        aov => render_samples(&Pass { first_hits: None, ..pass }, |start, rng, rays| {
             *rays += 1;
-            shade::aov(aov, scene, accel, (alpha, textures), &ray, rng)
+            shade::aov(aov, scene, accel, (alpha, textures), &start.ray, rng)
         }),
     }
     .ok_or(Cancelled)?;
@@ -330,7 +330,7 @@ fn render_transport<A: Accel + ?Sized>(
         transport: &Transport<'_, A>,
         pass: &Pass<'_>,
     ) -> Option<(Vec<PixelSum>, u64)> {
-        render_samples(pass, |ray, first, rng, rays| transport.radiance::<S>(ray, first, rng, rays))
+        render_samples(pass, |start, rng, rays| transport.radiance::<S>(start, rng, rays))
     }
     // Decides the specialised effects one at a time, each both ways: the
     // leaves are the 2^n loops, one per subset, each compiled for its set's bits.
@@ -357,6 +357,16 @@ fn render_transport<A: Accel + ?Sized>(
     specialised!(for specialisation over [Effect::Alpha, Effect::Textures, Effect::Glossy, Effect::DirectLight, Effect::Emission])
 }
 
+/// Where a sample's path starts: its camera ray, the ray's closest hit if
+/// it was traced with others of its block (`None` if not), and which sample
+/// of its pixel it is, for the sampler's numbers of the first vertex.
+pub(crate) struct PathStart {
+    pub(crate) ray: Ray,
+    pub(crate) first_hit: Option<Option<Hit>>,
+    pub(crate) pixel: PixelSample,
+    pub(crate) sampler: PixelSampler,
+}
+
 /// Closest hits of a batch of camera rays ([`Accel::intersect_batch`]).
 type FirstHits<'a> = dyn Fn(&[Ray], &mut [Option<Hit>]) + Sync + 'a;
 
@@ -374,7 +384,7 @@ type FirstHits<'a> = dyn Fn(&[Ray], &mut [Option<Hit>]) + Sync + 'a;
 /// hits are the same bits either way, and so is the image.
 fn render_samples(
     pass: &Pass<'_>,
-    sample: impl Fn(Ray, Option<Option<Hit>>, &mut Rng, &mut u64) -> Vec3 + Sync,
+    sample: impl Fn(&PathStart, &mut Rng, &mut u64) -> Vec3 + Sync,
 ) -> Option<(Vec<PixelSum>, u64)> {
     let settings = pass.settings;
     let width = settings.width;
@@ -411,7 +421,10 @@ fn render_samples(
                 first_hits(&rays, &mut hits);
             }
             for (i, (ray, rng)) in rays.iter().zip(&mut generators).enumerate() {
-                let value = sample(*ray, first_hits.map(|_| hits[i]), rng, &mut traced);
+                let pixel = PixelSample { index, count: spp, pixel_shift: shifts[i] };
+                let start =
+                    PathStart { ray: *ray, first_hit: first_hits.map(|_| hits[i]), pixel, sampler: settings.sampler };
+                let value = sample(&start, rng, &mut traced);
                 accumulation::add(&mut values[i], &to_fixed(value));
             }
         }
