@@ -127,6 +127,14 @@ mod dim {
     pub(super) const COUNT: usize = 8;
 }
 
+/// The vertices of a path, from the camera ray's hit on, whose random
+/// numbers come from the pixel sampler ([`crate::PixelSampler::vertex`]);
+/// deeper ones draw them from the sample's generator. The first vertex is
+/// where it pays: at 16 spp it halved the RMSE of the sky-lit bunny and
+/// took a fifth off Sponza's, while spreading the next two vertices too
+/// gained about 1% more on the Cornell box, Sponza and the conference room.
+const SAMPLED_VERTICES: u32 = 1;
+
 /// What the light-transport loop needs, prepared once per render.
 pub(crate) struct Transport<'a, A: Accel + ?Sized> {
     scene: &'a Scene,
@@ -234,9 +242,9 @@ impl<'a, A: Accel + ?Sized> Transport<'a, A> {
         let mut depth = 0;
         loop {
             let mut u: [f32; dim::COUNT] = std::array::from_fn(|_| rng.next_f32());
-            if depth == 0 {
-                // The first vertex takes the sampler's numbers, spread over the pixel's samples.
-                let first = start.sampler.first_vertex(&start.pixel, rng);
+            if depth < SAMPLED_VERTICES {
+                // The first vertices take the sampler's numbers, spread over the pixel's samples.
+                let first = start.sampler.vertex(&start.pixel, depth, rng);
                 [u[dim::LIGHT_CHOICE], u[dim::LOBE]] = first.choices.to_array();
                 [u[dim::LIGHT], u[dim::LIGHT + 1]] = first.light.to_array();
                 [u[dim::BSDF], u[dim::BSDF + 1]] = first.bsdf.to_array();

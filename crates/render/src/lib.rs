@@ -56,7 +56,7 @@ pub use framing::{DEFAULT_VERTICAL_FOV_DEGREES, camera_blocked, default_camera, 
 pub use identity::{Difference, RenderIdentity, scene_fingerprint};
 pub use integrator::{DirectStrategy, Integrator};
 pub use lights::{Environment, EnvironmentMap, EnvironmentSpec, EnvironmentSpecError, LightSet};
-pub use sampler::{FirstVertexNumbers, PixelSample, PixelSampler};
+pub use sampler::{PixelSample, PixelSampler, VertexNumbers};
 pub use shade::{albedo, alpha_accepts, has_alpha, shade_primary, shading_normal};
 
 use std::ops::Range;

@@ -2,7 +2,7 @@ use rtgi_math::{Rng, Vec2, hash_u64, next_float_down, next_float_up};
 
 /// Where inside a pixel the samples go, and how the random numbers of each
 /// path's first vertex (light choice, point on the light, BSDF direction)
-/// are spread over the pixel's samples ([`PixelSampler::first_vertex`]):
+/// are spread over the pixel's samples ([`PixelSampler::vertex`]):
 /// the stratified and low-discrepancy samplers spread them as they spread
 /// positions, the others draw them at random.
 ///
@@ -105,13 +105,13 @@ impl PixelSampler {
     }
 }
 
-/// Random numbers of a camera path's first vertex that a sampler spreads
-/// over the pixel's samples like their positions: the pairs that choose a
-/// light and a lobe, a point on the light, and the BSDF's direction. They
-/// decide the direct light and the first bounce, most of an image's noise
-/// at low sample counts.
+/// Random numbers of a vertex of a camera path that a sampler spreads over
+/// the pixel's samples like their positions: the pairs that choose a light
+/// and a lobe, a point on the light, and the BSDF's direction. At the first
+/// vertices they decide the direct light and the first bounces, most of an
+/// image's noise at low sample counts.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct FirstVertexNumbers {
+pub struct VertexNumbers {
     /// x chooses the light, y the lobe of a layered material.
     pub choices: Vec2,
     /// The point on the chosen light (or direction of the environment).
@@ -121,7 +121,8 @@ pub struct FirstVertexNumbers {
 }
 
 impl PixelSampler {
-    /// The numbers of the first vertex of sample `sample`'s path. The
+    /// The numbers of vertex `depth` (0 for the camera ray's hit) of sample
+    /// `sample`'s path. The
     /// stratified and low-discrepancy samplers give each pair the pattern
     /// they give pixel positions, with its own permutation of the sample
     /// indices and its own shift, so that the pairs are stratified across
@@ -129,7 +130,7 @@ impl PixelSampler {
     /// position (padding, as pbrt's samplers do); the others draw them from
     /// the sample's generator. Each number is uniform in `[0, 1)` for any
     /// sample count, so estimates stay unbiased.
-    pub fn first_vertex(self, sample: &PixelSample, rng: &mut Rng) -> FirstVertexNumbers {
+    pub fn vertex(self, sample: &PixelSample, depth: u32, rng: &mut Rng) -> VertexNumbers {
         let mut pair = |dimension: u64| match self {
             PixelSampler::Center | PixelSampler::Uniform => Vec2::new(rng.next_f32(), rng.next_f32()),
             PixelSampler::Stratified | PixelSampler::LowDiscrepancy => {
@@ -143,7 +144,9 @@ impl PixelSampler {
                 self.offset(&PixelSample { index, count, pixel_shift }, rng)
             }
         };
-        FirstVertexNumbers { choices: pair(1), light: pair(2), bsdf: pair(3) }
+        // Pair 0 is the position in the pixel.
+        let first = 1 + 3 * depth as u64;
+        VertexNumbers { choices: pair(first), light: pair(first + 1), bsdf: pair(first + 2) }
     }
 }
 
@@ -237,7 +240,8 @@ mod tests {
     }
 
     /// The pixel's samples of one pair of numbers: 0 is the position in the
-    /// pixel, 1 to 3 the first vertex's choices, light and BSDF pairs.
+    /// pixel, 1 to 3 the first vertex's choices, light and BSDF pairs, 4 to
+    /// 6 the second vertex's.
     fn points(sampler: PixelSampler, count: u32, pixel: u64, pair: usize) -> Vec<Vec2> {
         // As `render` does: the pixel's shift from one generator past every sample's.
         let mut shift_rng = Rng::for_sample(1, pixel, u64::MAX);
@@ -249,8 +253,8 @@ mod tests {
                 let p = match pair {
                     0 => sampler.offset(&sample, &mut rng),
                     _ => {
-                        let first = sampler.first_vertex(&sample, &mut rng);
-                        [first.choices, first.light, first.bsdf][pair - 1]
+                        let vertex = sampler.vertex(&sample, (pair as u32 - 1) / 3, &mut rng);
+                        [vertex.choices, vertex.light, vertex.bsdf][(pair - 1) % 3]
                     }
                 };
                 assert!(p.cmpge(Vec2::ZERO).all() && p.cmplt(Vec2::ONE).all(), "{sampler} {index}/{count}: {p}");
@@ -367,7 +371,7 @@ mod tests {
         for count in 1..=64u32 {
             let (columns, rows) = grid(count);
             for pixel in 0..32 {
-                for pair in 1..=3 {
+                for pair in 1..=6 {
                     let mut strips = [vec![0u32; count as usize], vec![0u32; count as usize]];
                     let mut cells = vec![0u32; count as usize];
                     for p in points(PixelSampler::Stratified, count, pixel, pair) {
@@ -398,15 +402,15 @@ mod tests {
         }
     }
 
-    /// Padding: the pairs of one sample are not related to each other or to
-    /// its position (the same pattern for every pair would tie the light
+    /// Padding: the pairs of one sample (of its first two vertices) are not
+    /// related to each other or to its position (the same pattern for every pair would tie the light
     /// sample to the BSDF sample). Pearson's correlation over 2048 samples
     /// stays within 5 standard errors (0.11) of 0.
     #[test]
     fn first_vertex_pairs_are_uncorrelated_with_each_other_and_the_position() {
         for sampler in [PixelSampler::Stratified, PixelSampler::LowDiscrepancy] {
             let pairs: Vec<Vec<Vec2>> =
-                (0..=3).map(|pair| (0..PIXELS).flat_map(|pixel| points(sampler, 16, pixel, pair)).collect()).collect();
+                (0..=6).map(|pair| (0..PIXELS).flat_map(|pixel| points(sampler, 16, pixel, pair)).collect()).collect();
             let correlation = |a: &[f32], b: &[f32]| {
                 let n = a.len() as f64;
                 let (ma, mb) =
@@ -416,8 +420,8 @@ mod tests {
                 let vb: f64 = b.iter().map(|&y| (y as f64 - mb).powi(2)).sum();
                 cov / (va * vb).sqrt()
             };
-            for i in 0..4 {
-                for j in i + 1..4 {
+            for i in 0..pairs.len() {
+                for j in i + 1..pairs.len() {
                     for (axis_i, axis_j) in [(0, 0), (1, 1), (0, 1)] {
                         let a: Vec<f32> = pairs[i].iter().map(|p| p[axis_i]).collect();
                         let b: Vec<f32> = pairs[j].iter().map(|p| p[axis_j]).collect();
