@@ -91,15 +91,8 @@ impl PixelSampler {
                 Vec2::new(in_strip(x_strip, rng.next_f32(), count), in_strip(y_strip, rng.next_f32(), count))
             }
             PixelSampler::LowDiscrepancy => {
-                let i = sample.index as u64;
-                let shift = sample.pixel_shift.to_array();
-                let coordinate = |axis: usize| {
-                    // 1/2 + i·α + shift, modulo 1: wrapping arithmetic is exact.
-                    let fixed = (1u64 << 63).wrapping_add(i.wrapping_mul(R2[axis])).wrapping_add(to_fixed(shift[axis]));
-                    // The top 24 bits, as `Rng::next_f32` makes them: in [0, 1).
-                    (fixed >> 40) as f32 * (1.0 / 16_777_216.0)
-                };
-                Vec2::new(coordinate(0), coordinate(1))
+                let shift = sample.pixel_shift.to_array().map(to_fixed);
+                r2_point(sample.index as u64, shift)
             }
         }
     }
@@ -122,31 +115,71 @@ pub struct VertexNumbers {
 
 impl PixelSampler {
     /// The numbers of vertex `depth` (0 for the camera ray's hit) of sample
-    /// `sample`'s path. The
-    /// stratified and low-discrepancy samplers give each pair the pattern
-    /// they give pixel positions, with its own permutation of the sample
-    /// indices and its own shift, so that the pairs are stratified across
+    /// `sample`'s path. The stratified and low-discrepancy samplers give
+    /// each pair the pattern they give pixel positions (correlated
+    /// multi-jittered strips and cells, or R2), with its own permutation of
+    /// the sample indices and its own permutations or shift, so that the pairs are stratified across
     /// the pixel's samples but not correlated with each other or with the
     /// position (padding, as pbrt's samplers do); the others draw them from
     /// the sample's generator. Each number is uniform in `[0, 1)` for any
     /// sample count, so estimates stay unbiased.
     pub fn vertex(self, sample: &PixelSample, depth: u32, rng: &mut Rng) -> VertexNumbers {
-        let mut pair = |dimension: u64| match self {
-            PixelSampler::Center | PixelSampler::Uniform => Vec2::new(rng.next_f32(), rng.next_f32()),
-            PixelSampler::Stratified | PixelSampler::LowDiscrepancy => {
-                let count = sample.count.max(1);
-                let seed = hash_u64(pixel_seed(sample.pixel_shift) ^ dimension.wrapping_mul(0x9e37_79b9_7f4a_7c15));
-                let index = permute(remainder(sample.index, count), count, seed as u32);
-                // The top 24 bits of each half of another hash: a shift in [0, 1)².
-                let shift = hash_u64(seed);
-                let unit = |bits: u64| (bits >> 40) as f32 * (1.0 / 16_777_216.0);
-                let pixel_shift = Vec2::new(unit(shift), unit(shift << 24));
-                self.offset(&PixelSample { index, count, pixel_shift }, rng)
+        let count = sample.count.max(1);
+        let index = remainder(sample.index, count);
+        let (columns, rows) = grid(count);
+        let pixel = pixel_seed(sample.pixel_shift);
+        let mut pair = |dimension: u64| {
+            // Two independent 64-bit seeds per pair: one for the permutation
+            // of the sample indices, one for the pattern's own choices.
+            let seed = hash_u64(pixel ^ dimension.wrapping_mul(0x9e37_79b9_7f4a_7c15));
+            let pattern = hash_u64(seed);
+            match self {
+                PixelSampler::Center | PixelSampler::Uniform => Vec2::new(rng.next_f32(), rng.next_f32()),
+                PixelSampler::Stratified => {
+                    // The index permutation decorrelates the pairs: it must
+                    // be a good one (an affine map would relate the pairs'
+                    // indices to each other, and their numbers with them).
+                    let j = permute(index, count, seed as u32);
+                    let (column, row) = (remainder(j, columns), quotient(j, columns));
+                    let x_strip = column * rows + shuffle(row, rows, pattern);
+                    let y_strip = row * columns + shuffle(column, columns, pattern.rotate_left(32));
+                    Vec2::new(in_strip(x_strip, rng.next_f32(), count), in_strip(y_strip, rng.next_f32(), count))
+                }
+                PixelSampler::LowDiscrepancy => {
+                    r2_point(permute(index, count, seed as u32) as u64, [pattern, pattern << 24])
+                }
             }
         };
         // Pair 0 is the position in the pixel.
         let first = 1 + 3 * depth as u64;
         VertexNumbers { choices: pair(first), light: pair(first + 1), bsdf: pair(first + 2) }
+    }
+}
+
+/// Point `i` of the R2 sequence shifted by `shift` (in 0.64 fixed point):
+/// 1/2 + i·α + shift, modulo 1, where wrapping arithmetic is exact.
+fn r2_point(i: u64, shift: [u64; 2]) -> Vec2 {
+    let coordinate = |axis: usize| {
+        let fixed = (1u64 << 63).wrapping_add(i.wrapping_mul(R2[axis])).wrapping_add(shift[axis]);
+        // The top 24 bits, as `Rng::next_f32` makes them: in [0, 1).
+        (fixed >> 40) as f32 * (1.0 / 16_777_216.0)
+    };
+    Vec2::new(coordinate(0), coordinate(1))
+}
+
+/// Element `i` of a pseudo-random permutation of `0..len` chosen by `seed`,
+/// for the strips of the pairs of path vertices, whose only duty is to
+/// place each sample uniformly within its cell: for a power of two an affine map
+/// `a·i + b mod len` with `a` odd (a bijection, and for every `i` uniform
+/// over the seeds, since `b` is: what unbiasedness needs), a few cycles
+/// where [`permute`] takes dozens; [`permute`] for other lengths. Positions
+/// in the pixel keep [`permute`], whose patterns the tests measured.
+#[inline]
+fn shuffle(i: u32, len: u32, seed: u64) -> u32 {
+    if len.is_power_of_two() {
+        ((seed as u32 | 1).wrapping_mul(i).wrapping_add((seed >> 32) as u32)) & (len - 1)
+    } else {
+        permute(i, len, seed as u32)
     }
 }
 
