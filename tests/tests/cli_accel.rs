@@ -184,6 +184,32 @@ fn heatmap_counts_nodes_per_pixel() {
     assert_eq!(image::open(&png).unwrap().to_rgb8().dimensions(), (20, 10));
 }
 
+/// Without `-o`, the commands that write one file name it after their
+/// input, in the current folder; `trace --out` is an alias of `-o`.
+#[test]
+fn outputs_default_to_names_after_the_input() {
+    let dir = scratch_dir("output-defaults");
+    let scene = workspace_root().join(BOX);
+    let in_dir = |args: &[&str]| -> Run {
+        std::process::Command::new(RTGI).args(args).current_dir(&dir).output().expect("rtgi runs").into()
+    };
+    for (args, written) in [
+        (vec!["heatmap", s(&scene), "--width", "8", "--height", "8"], "cornell-box.heatmap.png"),
+        (vec!["bvh-boxes", s(&scene), "--levels", "0"], "cornell-box.boxes.obj"),
+        (vec!["rays", s(&scene), "--width", "4", "--height", "4"], "cornell-box.rays.bin"),
+        (vec!["trace", s(&scene), "--rays", "cornell-box.rays.bin"], "cornell-box.rays.hits.bin"),
+        (vec!["trace", s(&scene), "--rays", "cornell-box.rays.bin", "--out", "alias.bin"], "alias.bin"),
+    ] {
+        let run = in_dir(&args);
+        assert!(run.success, "{args:?}: {run:?}");
+        assert!(dir.join(written).is_file(), "{args:?}: no {written}");
+    }
+    assert_eq!(
+        std::fs::read(dir.join("alias.bin")).unwrap(),
+        std::fs::read(dir.join("cornell-box.rays.hits.bin")).unwrap()
+    );
+}
+
 #[test]
 fn info_describes_scenes_as_text_and_json() {
     let run = rtgi(&["info"]);

@@ -84,9 +84,10 @@ fn without_o_the_image_is_named_after_the_scene_in_the_current_folder() {
 fn a_wrong_aov_name_lists_the_aovs() {
     let run = rtgi(&["render", "--aov", "normals", "-o", "x.png"]);
     assert_eq!(run.code, Some(2), "{run:?}");
-    assert!(
-        run.stderr
-            .contains("'normals' is not an output variable (expected one of albedo, normal, depth, position, cost)"),
+    assert_eq!(
+        run.stderr.trim(),
+        "error: invalid value 'normals' for '--aov <AOV>' (possible values: albedo, normal, depth, position, cost); \
+         did you mean 'normal'?",
         "{run:?}"
     );
 }

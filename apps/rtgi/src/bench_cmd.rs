@@ -106,7 +106,7 @@ pub(crate) fn run(args: &BenchArgs) -> Result<()> {
     let camera = choose_camera(&scene, framing.as_ref(), &Default::default(), args.width as f32 / args.height as f32)?;
     drop(framing);
     let primary = primary_rays(&camera, args.width, args.height);
-    let incoherent = surface_rays(&scene, args.rays as usize, args.seed);
+    let incoherent = surface_rays(&scene, args.rays as usize, args.seed.value);
     eprintln!(
         "{name}: {} triangles; {} primary rays ({}x{}), {} incoherent rays; {} threads, median of {repeats}",
         triangles.len(),
@@ -146,7 +146,7 @@ pub(crate) fn run(args: &BenchArgs) -> Result<()> {
         repeats: args.repeats,
         primary_rays: primary.len(),
         incoherent_rays: incoherent.len(),
-        incoherent_seed: args.seed,
+        incoherent_seed: args.seed.value,
         variants,
         accuracy,
     };
@@ -382,7 +382,7 @@ fn measure_accuracy(
 ) -> Vec<AccuracyReport> {
     let kind = args.accuracy_accel;
     let (edge_triangles, edge_rays) = shared_edge_probe();
-    let (mesh_triangles, mesh_rays) = closed_mesh_probe(args.leak_rays as usize, args.seed);
+    let (mesh_triangles, mesh_rays) = closed_mesh_probe(args.leak_rays as usize, args.seed.value);
     let mut reports = Vec::new();
     for &intersector in Intersector::ALL {
         for &traversal in Traversal::ALL {

@@ -1,7 +1,9 @@
-use std::path::PathBuf;
+use std::ffi::OsStr;
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
-use clap::{Args, Parser, Subcommand};
+use clap::builder::{PossibleValue, PossibleValuesParser, TypedValueParser};
+use clap::{Args, Parser, Subcommand, ValueEnum};
 use rtgi_accel::{AccelKind, BuildError, BuildParams, Intersector, Traversal};
 use rtgi_image::ToneOperator;
 use rtgi_math::Vec3;
@@ -54,16 +56,16 @@ pub(crate) enum Command {
     Merge(crate::merge_cmd::MergeArgs),
     /// A contact sheet of scenes, each rendered as 'rtgi render SCENE' renders it with no options
     Gallery(crate::gallery_cmd::GalleryArgs),
-    /// What accuracy costs in time: vary one knob (spp, depth, accel, scaling, or all) and write
-    /// a table (KNOB.md), every measurement (KNOB.json) and SVG plots
+    /// What accuracy costs in time: vary one knob (or all) and write a table (KNOB.md), every
+    /// measurement (KNOB.json) and SVG plots
     Experiment(ExperimentArgs),
 }
 
 /// `rtgi experiment`: one knob measured as time against error.
 #[derive(Debug, Args)]
 pub(crate) struct ExperimentArgs {
-    /// The knob: spp, depth, accel, scaling, direct (light/BSDF/MIS sampling on scenes of its own), effects
-    /// (each decision of the effects planner reversed), intersector, precision, or all
+    /// The knob to vary
+    #[arg(value_parser = knob_parser())]
     pub(crate) knob: KnobChoice,
 
     /// Scene file (.obj, .gltf, .glb or .toml); the built-in Cornell box when omitted
@@ -121,12 +123,16 @@ pub(crate) enum KnobChoice {
     All,
 }
 
-impl std::str::FromStr for KnobChoice {
-    type Err = String;
-
-    fn from_str(text: &str) -> Result<Self, String> {
-        if text == "all" { Ok(KnobChoice::All) } else { text.parse().map(KnobChoice::One) }
-    }
+/// The knobs' names (from [`rtgi_experiment::Knob`]'s `ValueEnum`) and `all`.
+fn knob_parser() -> impl TypedValueParser<Value = KnobChoice> {
+    let all = PossibleValue::new("all").help("Every knob in turn, one folder each");
+    PossibleValuesParser::new(
+        rtgi_experiment::Knob::value_variants().iter().filter_map(ValueEnum::to_possible_value).chain([all]),
+    )
+    .map(|name| match name.as_str() {
+        "all" => KnobChoice::All,
+        name => KnobChoice::One(ValueEnum::from_str(name, false).expect("one of the possible values")),
+    })
 }
 
 /// `rtgi verify`: the exactness contract, checked on a scene or on the built-in adversarial set.
@@ -139,8 +145,8 @@ pub(crate) struct VerifyArgs {
     #[arg(long, default_value_t = 1_000_000, value_parser = clap::value_parser!(u32).range(1..=1_000_000_000))]
     pub(crate) rays: u32,
 
-    /// Structures to check against the linear scan: 'all', or names separated by commas
-    #[arg(long, default_value = "all", value_parser = parse_accel_list)]
+    /// Structures to check against the linear scan: names separated by commas, or all
+    #[arg(long, default_value = "all", value_parser = AccelParser { list: true })]
     pub(crate) accel: AccelList,
 
     /// Check every leaf size (1, 2, 4, 8, 16), bin count and intersector, as the tests do,
@@ -157,9 +163,8 @@ pub(crate) struct VerifyArgs {
     #[arg(long, default_value_t = 2_000_000_000, value_parser = clap::value_parser!(u64).range(1..))]
     pub(crate) linear_budget: u64,
 
-    /// Seed of the rays
-    #[arg(long, default_value_t = 1)]
-    pub(crate) seed: u64,
+    #[command(flatten)]
+    pub(crate) seed: SeedArgs,
 
     #[command(flatten)]
     pub(crate) threads: ThreadArgs,
@@ -235,16 +240,16 @@ pub(crate) struct InfoArgs {
 /// How light is simulated: shared by `render` and `info` (which prints the plan).
 #[derive(Debug, Args)]
 pub(crate) struct LightingArgs {
-    /// What to compute per pixel: primary, albedo, normal, depth, position, cost, direct, path
-    #[arg(long, default_value = "path")]
+    /// What to compute per pixel
+    #[arg(long, value_enum, default_value_t = Integrator::Path)]
     pub(crate) integrator: Integrator,
 
     /// Bounces a path may take after the camera ray (path integrator)
     #[arg(long, default_value_t = 8, value_parser = clap::value_parser!(u32).range(1..=1024))]
     pub(crate) max_depth: u32,
 
-    /// How direct light is sampled: light, bsdf, or mis (both, weighted)
-    #[arg(long, default_value = "mis")]
+    /// How direct light is sampled
+    #[arg(long, value_enum, default_value_t = DirectStrategy::Mis)]
     pub(crate) direct_strategy: DirectStrategy,
 
     /// Clamp the light each path brings in after two or more bounces to this value (brightest
@@ -318,13 +323,15 @@ pub(crate) fn parse_light(text: &str) -> Result<Light, String> {
 
 /// `rtgi bvh-boxes`: the boxes of some levels of a BVH as a wireframe-able mesh.
 #[derive(Debug, Args)]
+#[command(mut_arg("output", |arg| arg.help(
+    "OBJ file to write; each level becomes a group named level_N [default: SCENE.boxes.obj, in the current folder]"
+)))]
 pub(crate) struct BvhBoxesArgs {
     /// Scene file (.obj, .gltf, .glb or .toml); the built-in Cornell box when omitted
     pub(crate) scene: Option<PathBuf>,
 
-    /// OBJ file to write; each level becomes a group named level_N
-    #[arg(short, long)]
-    pub(crate) output: PathBuf,
+    #[command(flatten)]
+    pub(crate) output: OutputArgs,
 
     /// Depths to export, separated by commas (the root is 0)
     #[arg(long, default_value = "0,1,2,3", value_delimiter = ',')]
@@ -336,13 +343,15 @@ pub(crate) struct BvhBoxesArgs {
 
 /// `rtgi heatmap`: nodes visited per pixel, in false colour.
 #[derive(Debug, Args)]
+#[command(mut_arg("output", |arg| arg.help(
+    "Output image: .png for the false-colour map, .exr for the raw counts [default: SCENE.heatmap.png, in the current folder]"
+)))]
 pub(crate) struct HeatmapArgs {
     /// Scene file (.obj, .gltf, .glb or .toml); the built-in Cornell box when omitted
     pub(crate) scene: Option<PathBuf>,
 
-    /// Output image (.png for the false-colour map, .exr for the raw counts)
-    #[arg(short, long)]
-    pub(crate) output: PathBuf,
+    #[command(flatten)]
+    pub(crate) output: OutputArgs,
 
     #[command(flatten)]
     pub(crate) size: ImageSize,
@@ -371,8 +380,8 @@ pub(crate) struct BenchArgs {
     /// Scene file (.obj, .gltf, .glb or .toml); the built-in Cornell box when omitted
     pub(crate) scene: Option<PathBuf>,
 
-    /// Structures to measure: 'all', or names separated by commas
-    #[arg(long, default_value = "all", value_parser = parse_accel_list)]
+    /// Structures to measure: names separated by commas, or all
+    #[arg(long, default_value = "all", value_parser = AccelParser { list: true })]
     pub(crate) accel: AccelList,
 
     #[command(flatten)]
@@ -390,9 +399,8 @@ pub(crate) struct BenchArgs {
     #[arg(long, default_value_t = 1_000_000, value_parser = clap::value_parser!(u32).range(1..=100_000_000))]
     pub(crate) rays: u32,
 
-    /// Seed of the incoherent rays
-    #[arg(long, default_value_t = 1)]
-    pub(crate) seed: u64,
+    #[command(flatten)]
+    pub(crate) seed: SeedArgs,
 
     /// Timed runs per measurement; the median is reported
     #[arg(long, default_value_t = 5, value_parser = clap::value_parser!(u32).range(1..=1000))]
@@ -410,7 +418,7 @@ pub(crate) struct BenchArgs {
     pub(crate) json: Option<PathBuf>,
 
     /// Structure on which every intersector and traversal is compared for speed and failure rates
-    #[arg(long, default_value = "sah")]
+    #[arg(long, default_value = "sah", value_parser = AccelParser { list: false }.map(|list| list.0[0]))]
     pub(crate) accuracy_accel: AccelKind,
 
     /// Rays from inside a closed mesh for the escape rate
@@ -422,15 +430,44 @@ pub(crate) struct BenchArgs {
 #[derive(Clone, Debug)]
 pub(crate) struct AccelList(pub(crate) Vec<AccelKind>);
 
-/// `all` is our structures and the peers built in (Embree with the `embree` feature).
-fn parse_accel_list(text: &str) -> Result<AccelList, String> {
-    if text == "all" {
-        return Ok(AccelList(AccelKind::ALL.iter().chain(AccelKind::PEERS).copied().collect()));
+/// Parses the name of an acceleration structure (from [`AccelKind`]'s
+/// `ValueEnum`: an unknown name is clap's invalid-value error, with the
+/// possible values and a suggestion) or, for a `list`, names separated by
+/// commas or `all`: our structures and the peers built in. `embree` in a
+/// build without the feature is refused with [`AccelKind`]'s own message,
+/// which says how to build it in.
+#[derive(Clone, Copy, Debug)]
+struct AccelParser {
+    list: bool,
+}
+
+impl TypedValueParser for AccelParser {
+    type Value = AccelList;
+
+    fn parse_ref(&self, cmd: &clap::Command, arg: Option<&clap::Arg>, value: &OsStr) -> Result<AccelList, clap::Error> {
+        let names = PossibleValuesParser::new(self.possible_values().into_iter().flatten());
+        let text = value.to_string_lossy();
+        let items: Vec<&str> = if self.list { text.split(',').map(str::trim).collect() } else { vec![&*text] };
+        let mut kinds = Vec::new();
+        for item in items {
+            if item == "embree" && !AccelKind::PEERS.iter().any(|peer| peer.name() == "embree") {
+                // clap's value-validation error, with the library's explanation.
+                let not_built = |text: &str| text.parse::<AccelKind>().map(|_| AccelList(Vec::new()));
+                return not_built.parse_ref(cmd, arg, OsStr::new(item));
+            }
+            match names.parse_ref(cmd, arg, OsStr::new(item))?.as_str() {
+                "all" => kinds.extend(AccelKind::ALL.iter().chain(AccelKind::PEERS)),
+                name => kinds.push(AccelKind::from_str(name, false).expect("one of the possible values")),
+            }
+        }
+        Ok(AccelList(kinds))
     }
-    text.split(',')
-        .map(|name| name.trim().parse::<AccelKind>().map_err(|e| e.to_string()))
-        .collect::<Result<_, _>>()
-        .map(AccelList)
+
+    fn possible_values(&self) -> Option<Box<dyn Iterator<Item = PossibleValue> + '_>> {
+        let all = PossibleValue::new("all").help("Every structure, and the peers built in");
+        let kinds = AccelKind::value_variants().iter().filter_map(ValueEnum::to_possible_value);
+        Some(Box::new(kinds.chain(self.list.then_some(all))))
+    }
 }
 
 /// `rtgi trace`: rays in, hits out, for tests and comparisons with other ray tracers.
@@ -445,6 +482,9 @@ fn parse_accel_list(text: &str) -> Result<AccelList, String> {
 /// in memory; a ray with a NaN or infinite origin or direction, a zero
 /// direction or a NaN bound is refused, naming its index.
 #[derive(Debug, Args)]
+#[command(mut_arg("output", |arg| arg.visible_alias("out").help(
+    "Binary file of hits to write, 16 bytes each [default: RAYS.hits.bin, after the ray file, in the current folder]"
+)))]
 pub(crate) struct TraceArgs {
     /// Scene file (.obj, .gltf, .glb or .toml)
     pub(crate) scene: PathBuf,
@@ -453,9 +493,8 @@ pub(crate) struct TraceArgs {
     #[arg(long)]
     pub(crate) rays: PathBuf,
 
-    /// Binary file of hits to write (16 bytes each)
-    #[arg(long)]
-    pub(crate) out: PathBuf,
+    #[command(flatten)]
+    pub(crate) output: OutputArgs,
 
     /// Answer whether each ray is occluded (any hit) instead of its closest hit
     #[arg(long)]
@@ -468,16 +507,18 @@ pub(crate) struct TraceArgs {
     pub(crate) threads: ThreadArgs,
 }
 
+/// `rtgi render`: an image of a scene.
 #[derive(Debug, Args)]
+#[command(mut_arg("output", |arg| arg.help(
+    "Output image; the format follows the extension (.png or .exr), or .accum for the render's exact sums \
+     (a part of a split render, for 'rtgi merge') [default: SCENE.png, in the current folder]"
+)))]
 pub(crate) struct RenderArgs {
     /// Scene file (.obj, .gltf, .glb or .toml); the built-in Cornell box when omitted
     pub(crate) scene: Option<PathBuf>,
 
-    /// Output image; the format follows the extension (.png or .exr), or .accum for the
-    /// render's exact sums (a part of a split render, for 'rtgi merge') [default: the scene's
-    /// name with .png, in the current folder]
-    #[arg(short, long)]
-    pub(crate) output: Option<PathBuf>,
+    #[command(flatten)]
+    pub(crate) output: OutputArgs,
 
     #[command(flatten)]
     pub(crate) size: ImageSize,
@@ -493,18 +534,17 @@ pub(crate) struct RenderArgs {
     #[command(flatten)]
     pub(crate) lighting: LightingArgs,
 
-    /// Also write arbitrary output variables beside the output, as OUTPUT.NAME.exr: a list
-    /// of albedo, normal, depth, position, cost
-    #[arg(long, value_delimiter = ',', value_parser = parse_aov)]
+    /// Also write arbitrary output variables beside the output, as OUTPUT.NAME.exr (names
+    /// separated by commas)
+    #[arg(long, value_delimiter = ',', value_parser = aov_parser())]
     pub(crate) aov: Vec<Integrator>,
 
-    /// Where samples go in a pixel: center, uniform, stratified, low-discrepancy [default: center for 1 spp, stratified otherwise]
-    #[arg(long)]
+    /// Where samples go in a pixel [default: center for 1 spp, stratified otherwise]
+    #[arg(long, value_enum)]
     pub(crate) sampler: Option<PixelSampler>,
 
-    /// Seed of the random numbers; the same seed gives the same image
-    #[arg(long, default_value_t = 0)]
-    pub(crate) seed: u64,
+    #[command(flatten)]
+    pub(crate) seed: SeedArgs,
 
     #[command(flatten)]
     pub(crate) threads: ThreadArgs,
@@ -530,14 +570,7 @@ impl RenderArgs {
     /// Where the image goes: `-o`, else the scene's name with `.png` in the
     /// current folder (`cornell-box.png` for the built-in scene).
     pub(crate) fn output(&self) -> PathBuf {
-        match (&self.output, &self.scene) {
-            (Some(output), _) => output.clone(),
-            (None, Some(scene)) => {
-                let stem = scene.file_stem().map_or("render".into(), |s| s.to_string_lossy().into_owned());
-                PathBuf::from(format!("{stem}.png"))
-            }
-            (None, None) => PathBuf::from("cornell-box.png"),
-        }
+        self.output.or_named_after(self.scene.as_deref(), ".png")
     }
 
     /// Image width, height and samples per pixel, after `--quick`.
@@ -551,12 +584,11 @@ impl RenderArgs {
     }
 }
 
-fn parse_aov(text: &str) -> Result<Integrator, String> {
-    let aovs: Vec<&str> = Integrator::ALL.iter().filter(|i| i.is_aov()).map(|i| i.name()).collect();
-    text.parse::<Integrator>()
-        .ok()
-        .filter(|i| i.is_aov())
-        .ok_or_else(|| format!("'{text}' is not an output variable (expected one of {})", aovs.join(", ")))
+/// The arbitrary output variables: the integrators that compute a property
+/// of the closest hit ([`Integrator::is_aov`]), named as `ValueEnum` names them.
+fn aov_parser() -> impl TypedValueParser<Value = Integrator> {
+    let aovs = Integrator::value_variants().iter().filter(|i| i.is_aov()).filter_map(ValueEnum::to_possible_value);
+    PossibleValuesParser::new(aovs).map(|name| ValueEnum::from_str(&name, false).expect("one of the possible values"))
 }
 
 /// How an image becomes 8-bit PNG (EXR keeps linear floats): shared by `render` and `merge`.
@@ -567,9 +599,8 @@ pub(crate) struct ToneArgs {
     #[arg(long, value_parser = parse_exposure, allow_negative_numbers = true)]
     pub(crate) exposure: Option<f32>,
 
-    /// Tone map for PNG output: aces (filmic), reinhard, clamp [default: aces for the direct and
-    /// path integrators, clamp otherwise]
-    #[arg(long)]
+    /// Tone map for PNG output [default: aces for the direct and path integrators, clamp otherwise]
+    #[arg(long, value_enum)]
     pub(crate) tonemap: Option<ToneOperator>,
 }
 
@@ -585,6 +616,38 @@ impl ThreadArgs {
     /// A pool of that many worker threads.
     pub(crate) fn pool(&self) -> anyhow::Result<rayon::ThreadPool> {
         crate::common::thread_pool(self.count)
+    }
+}
+
+/// The seed: shared by every command that draws random numbers (`render`'s
+/// samples, the rays of `verify`, `bench` and `rays`).
+#[derive(Debug, Args)]
+pub(crate) struct SeedArgs {
+    /// Seed of the random numbers; the same seed gives the same result
+    #[arg(long = "seed", value_name = "SEED", default_value_t = 0)]
+    pub(crate) value: u64,
+}
+
+/// The one file a command writes: shared by the commands that name it
+/// after their input when `-o` is not given (each says how in its help).
+#[derive(Debug, Args)]
+pub(crate) struct OutputArgs {
+    /// The file to write [default: named after the scene, in the current folder]
+    #[arg(short, long)]
+    pub(crate) output: Option<PathBuf>,
+}
+
+impl OutputArgs {
+    /// `-o`, else the file name of `input` without its extension, followed
+    /// by `suffix`, in the current folder (`cornell-box` for the built-in scene).
+    pub(crate) fn or_named_after(&self, input: Option<&Path>, suffix: &str) -> PathBuf {
+        if let Some(output) = &self.output {
+            return output.clone();
+        }
+        let stem = input.map_or("cornell-box".into(), |path| {
+            path.file_stem().map_or("render".into(), |stem| stem.to_string_lossy().into_owned())
+        });
+        PathBuf::from(format!("{stem}{suffix}"))
     }
 }
 
@@ -607,9 +670,8 @@ impl ImageSize {
 /// The acceleration structure and its build parameters.
 #[derive(Debug, Args)]
 pub(crate) struct AccelArgs {
-    /// Acceleration structure: linear, object-median, spatial-median, sah, sah-sweep, bvh4, bvh8,
-    /// or embree (Intel Embree 3, in builds with the embree feature)
-    #[arg(long, default_value = "bvh8")]
+    /// Acceleration structure (in builds with the embree feature also embree, Intel Embree 3)
+    #[arg(long, default_value = "bvh8", value_parser = AccelParser { list: false }.map(|list| list.0[0]))]
     pub(crate) accel: AccelKind,
 
     #[command(flatten)]
@@ -631,12 +693,12 @@ pub(crate) struct BuildArgs {
     #[arg(long, value_parser = parse_positive, allow_negative_numbers = true)]
     pub(crate) traversal_cost: Option<f32>,
 
-    /// Ray/triangle test: watertight, moller-trumbore, watertight-f64 (the watertight test in double precision)
-    #[arg(long, default_value_t = Intersector::default())]
+    /// Ray/triangle test
+    #[arg(long, value_enum, default_value_t = Intersector::default())]
     pub(crate) intersector: Intersector,
 
-    /// Slab test of the binary BVHs: robust, fast (the wide BVHs always use the robust one)
-    #[arg(long, default_value_t = Traversal::default())]
+    /// Slab test of the binary BVHs (the wide BVHs always use the robust one)
+    #[arg(long, value_enum, default_value_t = Traversal::default())]
     pub(crate) traversal: Traversal,
 }
 
@@ -754,7 +816,10 @@ fn parse_error_line(error: &clap::Error) -> String {
     if let Some(valid) = context(ContextKind::ValidValue) {
         line.push_str(&format!(" (possible values: {valid})"));
     }
-    if let Some(suggestion) = context(ContextKind::SuggestedArg).or_else(|| context(ContextKind::SuggestedSubcommand)) {
+    let suggestion = [ContextKind::SuggestedArg, ContextKind::SuggestedSubcommand, ContextKind::SuggestedValue]
+        .into_iter()
+        .find_map(context);
+    if let Some(suggestion) = suggestion {
         line.push_str(&format!("; did you mean '{suggestion}'?"));
     }
     line
@@ -793,6 +858,30 @@ mod tests {
         assert_eq!(parse_direction("0,-1,0"), Ok(Vec3::NEG_Y));
         assert!(parse_direction("0,0,0").is_err() && parse_direction("0,inf,0").is_err());
         assert!(parse_light("point:0,1,0:5:1,-1,1").is_err_and(|e| e.contains("at least 0")));
+    }
+
+    /// `ValueEnum` (what clap parses and lists) and `ALL`/`name()` (what
+    /// the libraries list, print and parse) must name the same choices.
+    #[test]
+    fn value_enums_agree_with_the_named_choices() {
+        fn agree<T: ValueEnum + PartialEq + std::fmt::Debug>(all: &[T], name: fn(&T) -> &'static str) {
+            assert_eq!(T::value_variants(), all);
+            for value in T::value_variants() {
+                let possible = value.to_possible_value().expect("no variant is skipped");
+                assert_eq!(possible.get_name(), name(value), "{value:?}");
+            }
+        }
+        let accels: Vec<AccelKind> = AccelKind::ALL.iter().chain(AccelKind::PEERS).copied().collect();
+        agree(&accels, |k| k.name());
+        agree(Intersector::ALL, |i| i.name());
+        agree(Traversal::ALL, |t| t.name());
+        agree(rtgi_accel::simd::SimdLevel::ALL, |l| l.name());
+        agree(ToneOperator::ALL, |t| t.name());
+        agree(rtgi_experiment::Knob::ALL, |k| k.name());
+        agree(PixelSampler::ALL, |p| p.name());
+        agree(rtgi_render::Effect::ALL, |e| e.name());
+        agree(Integrator::ALL, |i| i.name());
+        agree(DirectStrategy::ALL, |d| d.name());
     }
 
     #[test]

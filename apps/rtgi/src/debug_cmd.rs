@@ -15,7 +15,8 @@ use crate::output::outln;
 /// quads a box, one group per level, so that viewers can show or hide
 /// levels and draw them as wireframes.
 pub(crate) fn boxes(args: &BvhBoxesArgs) -> Result<()> {
-    check_output_folder(&args.output)?;
+    let output = args.output.or_named_after(args.scene.as_deref(), ".boxes.obj");
+    check_output_folder(&output)?;
     let Some(method) = args.accel.accel.split_method() else {
         bail!("--accel {}: only BVH variants have boxes to export", args.accel.accel);
     };
@@ -59,14 +60,15 @@ pub(crate) fn boxes(args: &BvhBoxesArgs) -> Result<()> {
             let _ = writeln!(obj, "f {} {} {} {}", base + face[0], base + face[1], base + face[2], base + face[3]);
         }
     }
-    write_atomically(&args.output, obj.as_bytes())?;
-    outln!("wrote {} boxes of levels {:?} to {}", boxes.len(), args.levels, args.output.display())?;
+    write_atomically(&output, obj.as_bytes())?;
+    outln!("wrote {} boxes of levels {:?} to {}", boxes.len(), args.levels, output.display())?;
     Ok(())
 }
 
 /// Renders nodes visited (or triangles tested) per pixel in false colour.
 pub(crate) fn heatmap(args: &HeatmapArgs) -> Result<()> {
-    let format = check_writable(&args.output)?;
+    let output = args.output.or_named_after(args.scene.as_deref(), ".heatmap.png");
+    let format = check_writable(&output)?;
     if args.scale.is_some_and(|s| !(s > 0.0 && s.is_finite())) {
         bail!("--scale must be a positive number");
     }
@@ -93,7 +95,7 @@ pub(crate) fn heatmap(args: &HeatmapArgs) -> Result<()> {
             HdrImage::from_pixels(args.size.width, args.size.height, pixels).expect("one colour per pixel")
         }
     };
-    image.write(&args.output, &ToneMap::default())?;
+    image.write(&output, &ToneMap::default())?;
     let rays = total.rays.max(1) as f64;
     let what = if args.triangles { "triangle tests" } else { "nodes visited" };
     outln!("scene       {name}")?;
@@ -104,6 +106,6 @@ pub(crate) fn heatmap(args: &HeatmapArgs) -> Result<()> {
         total.triangles_tested as f64 / rays
     )?;
     outln!("colour      0 (dark) to {scale} {what} (pale yellow)")?;
-    outln!("wrote       {}", args.output.display())?;
+    outln!("wrote       {}", output.display())?;
     Ok(())
 }

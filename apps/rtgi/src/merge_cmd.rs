@@ -60,7 +60,8 @@ pub(crate) fn run(args: &MergeArgs) -> Result<()> {
         }
         let image = merged.image();
         let simulates_light = identity.settings.get("integrator").is_some_and(|name| {
-            name.parse::<rtgi_render::Integrator>().is_ok_and(|integrator| integrator.simulates_light())
+            rtgi_math::parse_choice::<rtgi_render::Integrator>(name)
+                .is_ok_and(|integrator| integrator.simulates_light())
         });
         let tone_map = tone_map(&args.tone, simulates_light, &image);
         image.write(&args.output, &tone_map).context("cannot write the merged image")?;

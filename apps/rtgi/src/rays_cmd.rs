@@ -7,7 +7,7 @@ use clap::{Args, ValueEnum};
 use rtgi_math::Ray;
 use rtgi_render::rays::{box_rays, primary_rays, surface_rays};
 
-use crate::cli::{AccelArgs, CameraArgs};
+use crate::cli::{AccelArgs, CameraArgs, OutputArgs, SeedArgs};
 use crate::common::{LoadedScene, choose_camera, load_scene, refuse_inputs_as_outputs, write_atomically};
 use crate::output::outln;
 use crate::trace_cmd::RAY_BYTES;
@@ -27,6 +27,10 @@ pub(crate) enum RayKind {
 
 /// `rtgi rays`: writes a ray file in the format `rtgi trace` reads.
 #[derive(Debug, Args)]
+#[command(mut_arg("output", |arg| arg.help(
+    "The ray file: 8 little-endian f32 per ray (origin, direction, t_min, t_max) [default: SCENE.rays.bin, \
+     in the current folder]"
+)))]
 pub(crate) struct RaysArgs {
     /// Scene file (.obj, .gltf, .glb or .toml); the built-in Cornell box when omitted
     pub(crate) scene: Option<PathBuf>,
@@ -46,9 +50,8 @@ pub(crate) struct RaysArgs {
     #[arg(long, default_value_t = 512, value_parser = clap::value_parser!(u32).range(1..=crate::cli::MAX_IMAGE_SIDE as i64))]
     pub(crate) height: u32,
 
-    /// Seed of random and surface rays
-    #[arg(long, default_value_t = 1)]
-    pub(crate) seed: u64,
+    #[command(flatten)]
+    pub(crate) seed: SeedArgs,
 
     #[command(flatten)]
     pub(crate) camera: CameraArgs,
@@ -56,14 +59,14 @@ pub(crate) struct RaysArgs {
     #[command(flatten)]
     pub(crate) accel: AccelArgs,
 
-    /// The ray file: 8 little-endian f32 per ray (origin, direction, t_min, t_max)
-    #[arg(short, long)]
-    pub(crate) output: PathBuf,
+    #[command(flatten)]
+    pub(crate) output: OutputArgs,
 }
 
 pub(crate) fn run(args: &RaysArgs) -> Result<()> {
     let inputs: Vec<(&str, &std::path::Path)> = args.scene.iter().map(|s| ("the scene", s.as_path())).collect();
-    refuse_inputs_as_outputs(&[("-o", &args.output)], &inputs)?;
+    let output = args.output.or_named_after(args.scene.as_deref(), ".rays.bin");
+    refuse_inputs_as_outputs(&[("-o", &output)], &inputs)?;
     let LoadedScene { scene, .. } = load_scene(args.scene.as_deref())?;
     let rays: Vec<Ray> = match args.kind {
         RayKind::Camera => {
@@ -72,15 +75,15 @@ pub(crate) fn run(args: &RaysArgs) -> Result<()> {
             let camera = choose_camera(&scene, accel.as_ref(), &args.camera, args.width as f32 / args.height as f32)?;
             primary_rays(&camera, args.width, args.height)
         }
-        RayKind::Random => box_rays(&scene, args.count as usize, args.seed),
-        RayKind::Surface => surface_rays(&scene, args.count as usize, args.seed),
+        RayKind::Random => box_rays(&scene, args.count as usize, args.seed.value),
+        RayKind::Surface => surface_rays(&scene, args.count as usize, args.seed.value),
     };
     let mut bytes = Vec::with_capacity(rays.len() * RAY_BYTES);
     for ray in &rays {
         let numbers = ray.origin.to_array().into_iter().chain(ray.direction.to_array()).chain([ray.t_min, ray.t_max]);
         bytes.extend(numbers.flat_map(f32::to_le_bytes));
     }
-    write_atomically(&args.output, &bytes)?;
-    outln!("wrote       {} ({} {:?} rays)", args.output.display(), rays.len(), args.kind)?;
+    write_atomically(&output, &bytes)?;
+    outln!("wrote       {} ({} {:?} rays)", output.display(), rays.len(), args.kind)?;
     Ok(())
 }

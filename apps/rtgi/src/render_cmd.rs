@@ -106,7 +106,7 @@ pub(crate) fn render_image(args: &RenderArgs) -> Result<Rendered> {
         height,
         samples_per_pixel: spp,
         sampler: args.sampler.unwrap_or(if spp == 1 { PixelSampler::Center } else { PixelSampler::Stratified }),
-        seed: args.seed,
+        seed: args.seed.value,
         background: args.background,
         ..RenderSettings::default()
     };
@@ -349,7 +349,8 @@ fn available_memory() -> Option<u64> {
 /// Where an arbitrary output variable goes: beside the output, as `NAME.KIND.exr`.
 fn aov_path(output: &Path, kind: Integrator) -> Result<PathBuf> {
     if !kind.is_aov() {
-        bail!("--aov {kind}: not an output variable (use albedo, normal, depth, position or cost)");
+        let aovs: Vec<&str> = Integrator::ALL.iter().filter(|i| i.is_aov()).map(|i| i.name()).collect();
+        bail!("--aov {kind}: not an output variable (use one of {})", aovs.join(", "));
     }
     let stem = output.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
     Ok(output.with_file_name(format!("{stem}.{kind}.exr")))

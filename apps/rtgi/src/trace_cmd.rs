@@ -27,8 +27,9 @@ const BATCH_RAYS: usize = 1024;
 const CHUNK_RAYS: usize = 64 * BATCH_RAYS;
 
 pub(crate) fn run(args: &TraceArgs) -> Result<()> {
-    refuse_inputs_as_outputs(&[("--out", &args.out)], &[("--rays", &args.rays), ("the scene", &args.scene)])?;
-    check_output_folder(&args.out)?;
+    let out = args.output.or_named_after(Some(&args.rays), ".hits.bin");
+    refuse_inputs_as_outputs(&[("-o", &out)], &[("--rays", &args.rays), ("the scene", &args.scene)])?;
+    check_output_folder(&out)?;
     // The first chunk is read before the scene, so that a file that is no
     // ray file at all (`/dev/zero`, a picture) is refused at once.
     let mut input = RayReader::open(&args.rays)?;
@@ -41,7 +42,7 @@ pub(crate) fn run(args: &TraceArgs) -> Result<()> {
     let accel = pool.install(|| args.accel.build(&scene))?;
     let build_ms = build_start.elapsed().as_secs_f64() * 1e3;
 
-    let mut output = PartialFile::create(&args.out)?;
+    let mut output = PartialFile::create(&out)?;
     let mut hits = Vec::with_capacity(CHUNK_RAYS);
     let (mut ray_count, mut hit_count, mut trace_s) = (0usize, 0usize, 0.0);
     while more {

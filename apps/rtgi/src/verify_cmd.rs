@@ -76,9 +76,9 @@ pub(crate) fn run(args: &VerifyArgs) -> Result<()> {
             (loaded.name, vec![(case, per_kind)])
         }
         None => {
-            let count = adversarial_cases(0, args.seed).len();
+            let count = adversarial_cases(0, args.seed.value).len();
             let per_kind = (args.rays as usize).div_ceil(count * kinds_per_case).max(1);
-            let cases = adversarial_cases(per_kind, args.seed).into_iter().map(|c| (c, per_kind)).collect();
+            let cases = adversarial_cases(per_kind, args.seed.value).into_iter().map(|c| (c, per_kind)).collect();
             ("built-in adversarial scenes".to_owned(), cases)
         }
     };
@@ -97,7 +97,7 @@ pub(crate) fn run(args: &VerifyArgs) -> Result<()> {
     let mut kinds: BTreeMap<String, KindRow> = BTreeMap::new();
     let mut structures: Vec<StructureRow> = Vec::new();
     for (case, per_kind) in &cases {
-        let rays = pool.install(|| case.rays(*per_kind, args.seed));
+        let rays = pool.install(|| case.rays(*per_kind, args.seed.value));
         let budget_rays = (args.linear_budget / case.triangles.len().max(1) as u64) as usize;
         pool.install(|| {
             check_case(case, &rays, &configurations, &intersectors, budget_rays, &mut kinds, &mut structures)
@@ -110,7 +110,7 @@ pub(crate) fn run(args: &VerifyArgs) -> Result<()> {
             start.elapsed().as_secs_f64()
         );
     }
-    let report = Report { scene: scene_name, seed: args.seed, kinds: kinds.into_values().collect(), structures };
+    let report = Report { scene: scene_name, seed: args.seed.value, kinds: kinds.into_values().collect(), structures };
     // A reader that stops early (`| head`) must change neither the JSON
     // written nor the exit status that says whether verification failed.
     let printed = print_report(&report);

@@ -3,7 +3,12 @@ use rtgi_math::Vec3;
 use crate::{Accel, Bvh, Bvh4, Bvh8, Intersector, LinearScan, SplitMethod, Traversal};
 
 /// The acceleration structures this crate offers, selectable by name.
+///
+/// Their names ([`AccelKind::name`]) are read back by `FromStr`, which
+/// also accepts the peers ([`AccelKind::PEERS`]); with the `clap` feature
+/// the type is a `clap::ValueEnum` with the same names.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
 pub enum AccelKind {
     /// Test every triangle: O(n) per ray.
     Linear,
@@ -19,8 +24,9 @@ pub enum AccelKind {
     Bvh4,
     /// Binned SAH BVH collapsed to eight children a node, traversed with SIMD.
     Bvh8,
-    /// Intel Embree 3 ([`crate::EmbreeBackend`], feature `embree`): a peer
-    /// to compare against, not held to the exactness contract.
+    /// Intel Embree 3, a peer to compare against, not held to the exactness contract.
+    ///
+    /// Built with the `embree` feature: [`crate::EmbreeBackend`].
     #[cfg(feature = "embree")]
     Embree,
 }
@@ -191,7 +197,7 @@ impl std::fmt::Display for AccelKind {
 }
 
 /// Parses the names of [`AccelKind::ALL`] and [`AccelKind::PEERS`] (as
-/// `rtgi_math::named_choices!` does, with the peers); `embree` in a build
+/// [`rtgi_math::parse_choice`] does, with the peers); `embree` in a build
 /// without the feature is an error that says how to get it.
 impl std::str::FromStr for AccelKind {
     type Err = String;

@@ -20,15 +20,22 @@ pub struct TriangleHit {
 
 /// The ray/triangle tests on offer.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
 pub enum Intersector {
+    /// Watertight: no ray slips through a shared edge or vertex.
+    ///
     /// Woop, Benthin and Wald, "Watertight Ray/Triangle Intersection" (JCGT
     /// 2013): a ray through a shared edge or vertex of a closed mesh always
     /// hits at least one of the triangles that share it.
     #[default]
     Watertight,
+    /// Möller-Trumbore: rays can slip through shared edges.
+    ///
     /// Möller and Trumbore (JGT 1997), the course's Cramer's rule: faster to
     /// write, but rounding lets rays slip through shared edges.
     MollerTrumbore,
+    /// The watertight test in double precision.
+    ///
     /// The watertight test evaluated in double precision from the same
     /// single-precision inputs, rounding `t`, `beta` and `gamma` to single
     /// precision only at the end: what the extra precision buys in accuracy
@@ -86,7 +93,19 @@ impl Intersector {
     }
 }
 
-rtgi_math::named_choices!(Intersector, "intersector");
+impl rtgi_math::NamedChoice for Intersector {
+    const KIND: &'static str = "intersector";
+    const ALL: &'static [Self] = Intersector::ALL;
+    fn name(self) -> &'static str {
+        Intersector::name(self)
+    }
+}
+
+impl std::fmt::Display for Intersector {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
 
 /// A ray/triangle test with per-ray precomputation, for the structures'
 /// inner loops (monomorphised, so the choice costs nothing per triangle).

@@ -181,9 +181,7 @@ impl Report {
         let mut written = Vec::new();
         let mut write = |name: &str, text: &str| -> Result<(), ExperimentError> {
             let path = folder.join(name);
-            let temporary = folder.join(format!(".{name}.partial"));
-            std::fs::write(&temporary, text)
-                .and_then(|()| std::fs::rename(&temporary, &path))
+            rtgi_image::write_atomically(&path, text.as_bytes())
                 .map_err(|source| ExperimentError::Write { path: path.clone(), source })?;
             written.push(path);
             Ok(())

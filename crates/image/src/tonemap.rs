@@ -2,6 +2,7 @@ use rtgi_math::Vec3;
 
 /// How linear radiance becomes a displayable value in `[0, 1]`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
 pub enum ToneOperator {
     /// Clip at 1: faithful for albedo-like images whose values are already in `[0, 1]`.
     Clamp,
@@ -38,7 +39,19 @@ impl ToneOperator {
     }
 }
 
-rtgi_math::named_choices!(ToneOperator, "tone map");
+impl rtgi_math::NamedChoice for ToneOperator {
+    const KIND: &'static str = "tone map";
+    const ALL: &'static [Self] = ToneOperator::ALL;
+    fn name(self) -> &'static str {
+        ToneOperator::name(self)
+    }
+}
+
+impl std::fmt::Display for ToneOperator {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
 
 /// Exposure followed by a tone operator; used for 8-bit output only.
 #[derive(Clone, Copy, Debug, PartialEq)]

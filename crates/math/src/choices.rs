@@ -1,43 +1,45 @@
-/// Implements `Display` and `FromStr` for an enum of named choices (an
-/// option of the command line: an accelerator, an intersector, a tone map):
-/// the type provides `const ALL: &[Self]` and `fn name(self) -> &'static str`,
-/// and `what` names the kind of choice in the error of an unknown name.
+/// A closed set of named choices: an option of the command line (an
+/// accelerator, an intersector, a tone map) or of a specification string
+/// (an effect). The type lists its values in `ALL` and names each with
+/// `name`; [`parse_choice`] reads a name back, with an error that lists
+/// the names. The command line parses them with clap's `ValueEnum`,
+/// derived in each crate behind its `clap` feature; a test of the app
+/// checks that `ValueEnum` and this trait agree.
 ///
 /// ```
+/// use rtgi_math::{NamedChoice, parse_choice};
+///
 /// #[derive(Clone, Copy, Debug, PartialEq)]
 /// enum Shape { Round, Square }
-/// impl Shape {
+/// impl NamedChoice for Shape {
+///     const KIND: &'static str = "shape";
 ///     const ALL: &'static [Shape] = &[Shape::Round, Shape::Square];
 ///     fn name(self) -> &'static str {
 ///         match self { Shape::Round => "round", Shape::Square => "square" }
 ///     }
 /// }
-/// rtgi_math::named_choices!(Shape, "shape");
 ///
-/// assert_eq!("square".parse::<Shape>(), Ok(Shape::Square));
-/// assert_eq!(Shape::Round.to_string(), "round");
-/// assert_eq!("oval".parse::<Shape>().unwrap_err(), "unknown shape 'oval' (expected one of: round, square)");
+/// assert_eq!(parse_choice::<Shape>("square"), Ok(Shape::Square));
+/// assert_eq!(parse_choice::<Shape>("oval").unwrap_err(), "unknown shape 'oval' (expected one of: round, square)");
 /// ```
-#[macro_export]
-macro_rules! named_choices {
-    ($type:ty, $what:literal) => {
-        impl ::std::fmt::Display for $type {
-            fn fmt(&self, f: &mut ::std::fmt::Formatter<'_>) -> ::std::fmt::Result {
-                f.write_str(self.name())
-            }
-        }
+pub trait NamedChoice: Copy + 'static {
+    /// What one choice is called in messages ("integrator", "tone map").
+    const KIND: &'static str;
+    /// Every choice, in the order lists show them.
+    const ALL: &'static [Self];
+    /// The choice's name on command lines, in reports and in file names.
+    fn name(self) -> &'static str;
+}
 
-        impl ::std::str::FromStr for $type {
-            type Err = String;
-
-            fn from_str(text: &str) -> Result<Self, Self::Err> {
-                Self::ALL.iter().copied().find(|choice| choice.name() == text).ok_or_else(|| {
-                    let names: Vec<&str> = Self::ALL.iter().map(|choice| choice.name()).collect();
-                    format!("unknown {} '{text}' (expected one of: {})", $what, names.join(", "))
-                })
-            }
-        }
-    };
+/// The choice of `T` named `text`.
+///
+/// # Errors
+/// For a name no choice has: "unknown KIND 'text' (expected one of: ...)".
+pub fn parse_choice<T: NamedChoice>(text: &str) -> Result<T, String> {
+    T::ALL.iter().copied().find(|choice| choice.name() == text).ok_or_else(|| {
+        let names: Vec<&str> = T::ALL.iter().map(|choice| choice.name()).collect();
+        format!("unknown {} '{text}' (expected one of: {})", T::KIND, names.join(", "))
+    })
 }
 
 /// Parses "x,y,z" (spaces allowed around the commas) into a vector of three

@@ -31,7 +31,7 @@ mod rng;
 mod spawn;
 
 pub use aabb::Aabb;
-pub use choices::parse_vec3;
+pub use choices::{NamedChoice, parse_choice, parse_vec3};
 pub use colour::luminance;
 pub use float::{gamma, next_float_down, next_float_up};
 pub use frame::{Frame, uniform_sphere};

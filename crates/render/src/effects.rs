@@ -17,6 +17,7 @@ use crate::{EffectSet, Integrator, RenderSettings};
 
 /// Something a render may simulate. Sets of effects are [`EffectSet`]s.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
 pub enum Effect {
     /// Light sampled from lights, emitters and the environment at every
     /// surface, with shadow rays (next-event estimation).
@@ -69,7 +70,28 @@ impl Effect {
     }
 }
 
-rtgi_math::named_choices!(Effect, "effect");
+impl rtgi_math::NamedChoice for Effect {
+    const KIND: &'static str = "effect";
+    const ALL: &'static [Self] = Effect::ALL;
+    fn name(self) -> &'static str {
+        Effect::name(self)
+    }
+}
+
+impl std::fmt::Display for Effect {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl std::str::FromStr for Effect {
+    type Err = String;
+
+    /// The choice named `text` ([`rtgi_math::parse_choice`]).
+    fn from_str(text: &str) -> Result<Self, String> {
+        rtgi_math::parse_choice(text)
+    }
+}
 
 /// Effects the user forces on (`+name`) or off (`-name`), parsed from a
 /// comma-separated list such as `+glossy,-textures`.

@@ -19,6 +19,7 @@ use crate::{EffectSet, PathStart, RenderSettings};
 
 /// What the renderer computes for each pixel.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
 pub enum Integrator {
     /// The closest hit's colour, lit from the viewer (a fast preview).
     Primary,
@@ -80,10 +81,23 @@ impl Integrator {
     }
 }
 
-rtgi_math::named_choices!(Integrator, "integrator");
+impl rtgi_math::NamedChoice for Integrator {
+    const KIND: &'static str = "integrator";
+    const ALL: &'static [Self] = Integrator::ALL;
+    fn name(self) -> &'static str {
+        Integrator::name(self)
+    }
+}
+
+impl std::fmt::Display for Integrator {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
 
 /// How direct light is estimated at each surface.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
 pub enum DirectStrategy {
     /// Sample points on lights only (misses glossy highlights of big lights).
     Light,
@@ -107,7 +121,19 @@ impl DirectStrategy {
     }
 }
 
-rtgi_math::named_choices!(DirectStrategy, "direct-light strategy");
+impl rtgi_math::NamedChoice for DirectStrategy {
+    const KIND: &'static str = "direct-light strategy";
+    const ALL: &'static [Self] = DirectStrategy::ALL;
+    fn name(self) -> &'static str {
+        DirectStrategy::name(self)
+    }
+}
+
+impl std::fmt::Display for DirectStrategy {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
 
 /// Bounces after which Russian roulette may end a path.
 const ROULETTE_AFTER: u32 = 2;

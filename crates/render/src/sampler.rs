@@ -15,11 +15,14 @@ use rtgi_math::{Rng, Vec2, hash_u64, next_float_down, next_float_up};
 /// generator, never on other samples, so images are the same for any
 /// number of threads.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
 pub enum PixelSampler {
     /// Every sample at the pixel's centre: no antialiasing, no noise.
     Center,
     /// Uniformly random positions in the pixel.
     Uniform,
+    /// Correlated multi-jittered: one sample in each cell of a grid, and in each row and column.
+    ///
     /// Correlated multi-jittered sampling (Kensler, "Correlated
     /// Multi-Jittered Sampling", Pixar technical memo 13-01, 2013) on an
     /// `m × k` grid with `m · k = n` exactly, `m` the largest divisor of `n`
@@ -30,6 +33,8 @@ pub enum PixelSampler {
     /// generator. For a prime `n` the grid is `1 × n`: the samples are then
     /// stratified in x and in y separately (n-rooks), but not in 2D.
     Stratified,
+    /// The R2 low-discrepancy sequence, shifted per pixel.
+    ///
     /// The R2 low-discrepancy sequence (Roberts 2018), shifted by a random
     /// offset per pixel (Cranley-Patterson rotation) so that neighbouring
     /// pixels do not repeat the same pattern; computed in 64-bit fixed
@@ -282,7 +287,19 @@ fn permute(mut i: u32, len: u32, seed: u32) -> u32 {
 /// The largest f32 below 1, so that offsets stay inside their pixel.
 const ONE_BELOW_ONE: f32 = 1.0 - f32::EPSILON / 2.0;
 
-rtgi_math::named_choices!(PixelSampler, "sampler");
+impl rtgi_math::NamedChoice for PixelSampler {
+    const KIND: &'static str = "sampler";
+    const ALL: &'static [Self] = PixelSampler::ALL;
+    fn name(self) -> &'static str {
+        PixelSampler::name(self)
+    }
+}
+
+impl std::fmt::Display for PixelSampler {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
 
 #[cfg(test)]
 mod tests {

@@ -20,13 +20,18 @@ pub(crate) const STACK_SIZE: usize = 128;
 
 /// How a BVH tests rays against its boxes.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
 pub enum Traversal {
-    /// Conservative: exit distances enlarged by `1 + 2γ(3)` (Ize 2013),
+    /// Conservative: never drops a box the ray touches.
+    ///
+    /// Exit distances enlarged by `1 + 2γ(3)` (Ize 2013),
     /// near and far planes chosen by the direction's sign bit, and the NaN
     /// of `0 · ∞` (an origin on a slab plane along a zero direction
     /// component) ignored. Never drops a box the ray touches.
     #[default]
     Robust,
+    /// The textbook slab test: can drop boxes that rays graze.
+    ///
     /// The common textbook slab test: `min`/`max` of the two plane
     /// distances, no enlargement. Rounding can drop boxes that rays graze,
     /// and NaN can drop boxes whose planes contain the origin.
@@ -46,7 +51,19 @@ impl Traversal {
     }
 }
 
-rtgi_math::named_choices!(Traversal, "traversal");
+impl rtgi_math::NamedChoice for Traversal {
+    const KIND: &'static str = "traversal";
+    const ALL: &'static [Self] = Traversal::ALL;
+    fn name(self) -> &'static str {
+        Traversal::name(self)
+    }
+}
+
+impl std::fmt::Display for Traversal {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
 
 /// Calls `$method` monomorphised for the structure's intersector, slab test
 /// and stack size (32, 64 or 128 entries, the smallest the depth allows):

@@ -24,6 +24,7 @@ use crate::wide::packet::{Lanes, PACKET, PacketRays};
 
 /// The instruction sets the kernels are compiled for, narrowest first.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
+#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
 pub enum SimdLevel {
     /// SSE up to 4.2: the x86-64-v2 baseline, and every other architecture's default.
     Portable,
@@ -72,7 +73,19 @@ impl SimdLevel {
     }
 }
 
-rtgi_math::named_choices!(SimdLevel, "SIMD level");
+impl rtgi_math::NamedChoice for SimdLevel {
+    const KIND: &'static str = "SIMD level";
+    const ALL: &'static [Self] = SimdLevel::ALL;
+    fn name(self) -> &'static str {
+        SimdLevel::name(self)
+    }
+}
+
+impl std::fmt::Display for SimdLevel {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
 
 /// The level in use, as `SimdLevel as u8`; `UNSET` until first asked.
 static ACTIVE: AtomicU8 = AtomicU8::new(UNSET);

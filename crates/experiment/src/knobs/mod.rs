@@ -15,6 +15,7 @@ mod spp;
 
 /// Something an experiment varies.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
 pub enum Knob {
     /// Samples per pixel, for each pixel sampler.
     Spp,
@@ -31,7 +32,9 @@ pub enum Knob {
     /// The ray/triangle tests: time, and failures on the hard cases of `rtgi verify`.
     Intersector,
     /// The triangle test in single against double precision: time, and
-    /// error against the exact answer on near-degenerate and far triangles.
+    /// error against the exact answer on hard triangles.
+    ///
+    /// The hard triangles are near-degenerate ones and far ones.
     Precision,
 }
 
@@ -100,7 +103,19 @@ impl Knob {
     }
 }
 
-rtgi_math::named_choices!(Knob, "experiment");
+impl rtgi_math::NamedChoice for Knob {
+    const KIND: &'static str = "experiment";
+    const ALL: &'static [Self] = Knob::ALL;
+    fn name(self) -> &'static str {
+        Knob::name(self)
+    }
+}
+
+impl std::fmt::Display for Knob {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
 
 pub(crate) fn run(
     knob: Knob,
