@@ -539,7 +539,8 @@ pub(crate) struct RenderArgs {
     #[arg(long, value_delimiter = ',', value_parser = aov_parser())]
     pub(crate) aov: Vec<Integrator>,
 
-    /// Where samples go in a pixel [default: center for 1 spp, stratified otherwise]
+    /// Where samples go in a pixel, and how the first bounce's light and direction samples are
+    /// spread over them [default: center for 1 spp, stratified otherwise]
     #[arg(long, value_enum)]
     pub(crate) sampler: Option<PixelSampler>,
 
