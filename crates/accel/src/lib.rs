@@ -77,11 +77,13 @@ mod contract;
 mod counters;
 #[cfg(feature = "embree")]
 mod embree;
+mod indexed_mesh;
 mod kind;
 mod linear;
 pub mod simd;
 mod slab;
 mod triangle;
+mod triangle_source;
 pub mod verify;
 mod wide;
 
@@ -90,9 +92,11 @@ pub use contract::is_hittable;
 pub use counters::{Counter, NoCounter, TraversalCounters};
 #[cfg(feature = "embree")]
 pub use embree::{EmbreeBackend, EmbreeError};
+pub use indexed_mesh::{IndexedMesh, IndexedMeshError};
 pub use kind::{AccelKind, BuildError, BuildParams};
 pub use linear::LinearScan;
 pub use triangle::{Intersector, TriangleHit};
+pub use triangle_source::TriangleSource;
 pub use wide::{Bvh4, Bvh8, WideBvh};
 
 /// The math types this crate takes and returns, re-exported so that a user
