@@ -9,11 +9,13 @@
 
 mod build;
 mod median;
+mod primitives;
 mod sah;
 mod split;
 mod traverse;
 mod validate;
 
+pub use primitives::PrimitiveBvh;
 pub use split::SplitMethod;
 pub use traverse::Traversal;
 
