@@ -105,21 +105,25 @@ pub fn run_cli(program: &str, args: &[&str]) -> Run {
 
 /// Runs `check` on every acceleration structure variant with a spread of
 /// build parameters ([`AccelKind::all_configurations`]), built over
-/// `triangles`; the label names the variant and its parameters. A new
+/// `triangles` (a soup, an indexed mesh or any [`TriangleSource`]); the
+/// label names the variant and all its parameters, one label a
+/// configuration and the same for every source, so that answers over two
+/// sources can be matched by label. A new
 /// variant is tested by every caller as soon as it is added to
 /// [`AccelKind::ALL`].
 ///
 /// [`AccelKind::all_configurations`]: rtgi_accel::AccelKind::all_configurations
 /// [`AccelKind::ALL`]: rtgi_accel::AccelKind::ALL
+/// [`TriangleSource`]: rtgi_accel::TriangleSource
 pub fn for_every_variant(
-    triangles: &[[rtgi_math::Vec3; 3]],
+    triangles: &(impl rtgi_accel::TriangleSource + ?Sized),
     mut check: impl FnMut(&str, &dyn rtgi_accel::Accel, &rtgi_accel::BuildParams),
 ) {
     for (kind, params) in rtgi_accel::AccelKind::all_configurations() {
         let accel = kind.build(triangles, &params);
         let label = format!(
-            "{kind} (leaf {}, bins {}, {}, {} traversal)",
-            params.max_leaf_size, params.sah_bins, params.intersector, params.traversal
+            "{kind} (leaf {}, bins {}, traversal cost {}, {}, {} traversal)",
+            params.max_leaf_size, params.sah_bins, params.traversal_cost, params.intersector, params.traversal
         );
         check(&label, accel.as_ref(), &params);
     }

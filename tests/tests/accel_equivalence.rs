@@ -77,4 +77,7 @@ fn helper_covers_every_variant() {
     for kind in rtgi_accel::AccelKind::ALL {
         assert!(labels.iter().any(|l| l.starts_with(kind.name())), "{kind} is not tested");
     }
+    // Labels tell configurations apart, so that answers can be matched by label.
+    let distinct: std::collections::HashSet<&String> = labels.iter().collect();
+    assert_eq!(distinct.len(), labels.len(), "two configurations share a label");
 }

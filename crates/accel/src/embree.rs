@@ -25,7 +25,7 @@ use std::time::Instant;
 use ::embree::sys;
 use rtgi_math::{Ray, Vec3};
 
-use crate::{Accel, BuildStats, Hit, TraversalCounters, is_hittable};
+use crate::{Accel, BuildStats, Hit, TraversalCounters, TriangleSource, is_hittable};
 
 /// Embree's "no geometry hit" marker (`RTC_INVALID_GEOMETRY_ID`).
 const INVALID_ID: u32 = u32::MAX;
@@ -152,17 +152,19 @@ unsafe extern "C" fn count_memory(counter: *mut c_void, bytes: isize, _post: boo
 }
 
 impl EmbreeBackend {
-    /// Builds an Embree scene over the hittable triangles of `triangles`
-    /// ([`is_hittable`]); the others are counted in
+    /// Builds an Embree scene over the hittable triangles ([`is_hittable`])
+    /// of `triangles` (a soup, an [`crate::IndexedMesh`] or any
+    /// [`TriangleSource`]); the others are counted in
     /// [`BuildStats::excluded_triangles`] and never hit.
     ///
     /// # Errors
     /// If Embree fails to create its device or to build the scene (out of
     /// memory, an unsupported CPU).
-    pub fn new(triangles: &[[Vec3; 3]]) -> Result<Self, EmbreeError> {
+    pub fn new(triangles: &(impl TriangleSource + ?Sized)) -> Result<Self, EmbreeError> {
         let start = Instant::now();
+        // Embree gets a soup of its own: its buffers are filled from it below.
         let (kept, ids): (Vec<[Vec3; 3]>, Vec<u32>) =
-            triangles.iter().enumerate().filter(|(_, t)| is_hittable(t)).map(|(i, t)| (*t, i as u32)).unzip();
+            (0..triangles.len()).map(|i| (triangles.corners(i), i as u32)).filter(|(t, _)| is_hittable(t)).unzip();
         let config = CString::new(format!("threads={}", rayon::current_num_threads()))
             .expect("a decimal number holds no NUL byte");
         // SAFETY: `config` is a NUL-terminated string that outlives the call.

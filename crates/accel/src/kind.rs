@@ -1,6 +1,4 @@
-use rtgi_math::Vec3;
-
-use crate::{Accel, Bvh, Bvh4, Bvh8, Intersector, LinearScan, SplitMethod, Traversal};
+use crate::{Accel, Bvh, Bvh4, Bvh8, Intersector, LinearScan, SplitMethod, Traversal, TriangleSource};
 
 /// The acceleration structures this crate offers, selectable by name.
 ///
@@ -139,12 +137,14 @@ impl AccelKind {
         }
     }
 
-    /// Builds this structure over `triangles`; hits name triangles by their index here.
+    /// Builds this structure over `triangles`, a soup (`&[[Vec3; 3]]`, an
+    /// array or a vector of corners), an [`crate::IndexedMesh`] or any
+    /// [`TriangleSource`]; hits name triangles by their index there.
     ///
     /// # Panics
     /// If a peer's build fails (Embree out of memory); [`AccelKind::try_build`]
     /// returns that error instead. Our structures' builds cannot fail.
-    pub fn build(self, triangles: &[[Vec3; 3]], params: &BuildParams) -> Box<dyn Accel> {
+    pub fn build(self, triangles: &(impl TriangleSource + ?Sized), params: &BuildParams) -> Box<dyn Accel> {
         self.try_build(triangles, params).unwrap_or_else(|error| panic!("{error}"))
     }
 
@@ -152,7 +152,11 @@ impl AccelKind {
     ///
     /// # Errors
     /// If Embree cannot create its device or build its scene.
-    pub fn try_build(self, triangles: &[[Vec3; 3]], params: &BuildParams) -> Result<Box<dyn Accel>, BuildError> {
+    pub fn try_build(
+        self,
+        triangles: &(impl TriangleSource + ?Sized),
+        params: &BuildParams,
+    ) -> Result<Box<dyn Accel>, BuildError> {
         #[cfg(feature = "embree")]
         if self == AccelKind::Embree {
             return match crate::EmbreeBackend::new(triangles) {

@@ -1,7 +1,10 @@
-//! Closest-hit and any-hit ray queries over a set of triangles.
+//! Closest-hit and any-hit ray queries over a set of triangles, and over
+//! primitives of the user's own.
 //!
 //! This crate knows nothing about files, materials or shading: it is given
-//! triangle corner positions, in an order of the caller's choosing, and
+//! triangle corner positions, in an order of the caller's choosing (a soup
+//! of corners, or an [`IndexedMesh`] of shared positions and index triples
+//! borrowed as they are: any [`TriangleSource`]), and
 //! answers which triangle a ray hits first ([`Accel::intersect`]) or whether
 //! it hits any ([`Accel::occluded`]). Hits name the triangle by its index in
 //! that input order and carry the barycentric coordinates `(beta, gamma)` of
@@ -25,6 +28,27 @@
 //! assert_eq!((hit.t, hit.triangle), (2.0, 0));
 //! assert!(accel.occluded(&ray));
 //! ```
+//!
+//! An indexed mesh is read where it lies, with no soup built first, and
+//! gives every structure the answers of the equivalent soup, bit for bit:
+//!
+//! ```
+//! use rtgi_accel::{Accel, AccelKind, IndexedMesh, Ray, Vec3};
+//!
+//! let positions = [Vec3::ZERO, Vec3::X, Vec3::new(1.0, 1.0, 0.0), Vec3::Y];
+//! let indices = [[0, 1, 2], [0, 2, 3]];
+//! let mesh = IndexedMesh::new(&positions, &indices).expect("every index names a vertex");
+//! let bvh = AccelKind::Bvh8.build(&mesh, &AccelKind::Bvh8.default_params());
+//! let hit = bvh.intersect(&Ray::new(Vec3::new(0.75, 0.25, 1.0), -Vec3::Z)).unwrap();
+//! assert_eq!((hit.t, hit.triangle), (1.0, 0));
+//! ```
+//!
+//! Primitives of the user's own (spheres, boxes, curves) implement
+//! [`Primitive`] (a box, optionally a centroid, and a ray test returning
+//! a distance and a payload of their choosing); a [`PrimitiveBvh`] is
+//! built over them by the same builders and split methods as [`Bvh`],
+//! and answers closest-hit and any-hit queries under the same rules as
+//! the triangle structures (see [`PrimitiveBvh`]'s contract).
 //!
 //! # The exactness contract
 //!
@@ -77,22 +101,28 @@ mod contract;
 mod counters;
 #[cfg(feature = "embree")]
 mod embree;
+mod indexed_mesh;
 mod kind;
 mod linear;
+mod primitive;
 pub mod simd;
 mod slab;
 mod triangle;
+mod triangle_source;
 pub mod verify;
 mod wide;
 
-pub use bvh::{Bvh, BvhNode, SplitMethod, Traversal};
+pub use bvh::{Bvh, BvhNode, PrimitiveBvh, SplitMethod, Traversal};
 pub use contract::is_hittable;
 pub use counters::{Counter, NoCounter, TraversalCounters};
 #[cfg(feature = "embree")]
 pub use embree::{EmbreeBackend, EmbreeError};
+pub use indexed_mesh::{IndexedMesh, IndexedMeshError};
 pub use kind::{AccelKind, BuildError, BuildParams};
 pub use linear::LinearScan;
+pub use primitive::{Primitive, PrimitiveHit, intersect_primitive};
 pub use triangle::{Intersector, TriangleHit};
+pub use triangle_source::TriangleSource;
 pub use wide::{Bvh4, Bvh8, WideBvh};
 
 /// The math types this crate takes and returns, re-exported so that a user
@@ -121,10 +151,11 @@ pub struct Hit {
 pub struct BuildStats {
     /// Name of the variant, as [`AccelKind::name`] gives it.
     pub variant: String,
-    /// Triangles given to the build.
+    /// Triangles given to the build (primitives, for a [`PrimitiveBvh`]).
     pub triangles: usize,
     /// Triangles left out because they can never be hit (zero area, or a
-    /// NaN or infinite coordinate).
+    /// NaN or infinite coordinate); for a [`PrimitiveBvh`], primitives
+    /// whose box is empty or not finite.
     pub excluded_triangles: usize,
     /// Wall-clock time of the build, in milliseconds.
     pub build_ms: f64,

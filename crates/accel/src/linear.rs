@@ -1,10 +1,10 @@
 use std::time::Instant;
 
-use rtgi_math::{Ray, Vec3, Vec3A};
+use rtgi_math::{Ray, Vec3A};
 
 use crate::contract::{Best, HitFilter, PreparedRay, QueryKind, Structure, is_hittable, test_triangles};
 use crate::triangle::{MollerTrumbore, TriangleTest, Watertight, WatertightF64};
-use crate::{BuildStats, Counter, Hit, Intersector};
+use crate::{BuildStats, Counter, Hit, Intersector, TriangleSource};
 
 /// The reference structure: every ray is tested against every hittable
 /// triangle, in index order, O(n) per ray. Slow, simple, and the answer
@@ -20,13 +20,13 @@ pub struct LinearScan {
 }
 
 impl LinearScan {
-    /// Keeps the hittable triangles ([`crate::is_hittable`]) in input order;
-    /// the others are counted in [`BuildStats::excluded_triangles`].
-    pub fn new(triangles: &[[Vec3; 3]], intersector: Intersector) -> Self {
+    /// Keeps the hittable triangles ([`crate::is_hittable`]) of `triangles`
+    /// (a soup, an [`crate::IndexedMesh`] or any [`TriangleSource`]) in
+    /// input order; the others are counted in [`BuildStats::excluded_triangles`].
+    pub fn new(triangles: &(impl TriangleSource + ?Sized), intersector: Intersector) -> Self {
         let start = Instant::now();
-        let (kept, ids): (Vec<[Vec3A; 3]>, Vec<u32>) = triangles
-            .iter()
-            .enumerate()
+        let (kept, ids): (Vec<[Vec3A; 3]>, Vec<u32>) = (0..triangles.len())
+            .map(|i| (i, triangles.corners(i)))
             .filter(|(_, t)| is_hittable(t))
             .map(|(i, t)| (t.map(Vec3A::from), i as u32))
             .unzip();

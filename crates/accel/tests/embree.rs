@@ -309,3 +309,21 @@ fn selectable_by_name_as_a_peer() {
         random_rays(500, 5).iter().filter(|r| accel.intersect(r).is_some() == linear.intersect(r).is_some()).count();
     assert!(hits >= 499);
 }
+
+#[test]
+fn builds_from_an_indexed_mesh_as_from_its_soup() {
+    // Embree copies the mesh into its own buffers; the scene it builds is
+    // the one it builds from the soup, so the answers are the same.
+    let mesh = icosphere(3);
+    let indexed = rtgi_accel::IndexedMesh::new(&mesh.vertices, &mesh.faces).expect("valid indices");
+    let from_mesh = AccelKind::Embree.try_build(&indexed, &BuildParams::default()).expect("Embree builds");
+    let from_soup = EmbreeBackend::new(&mesh.triangles()).expect("Embree builds");
+    assert_eq!(from_mesh.build_stats().triangles, mesh.faces.len());
+    let mut rng = Rng::new(8, 1);
+    for _ in 0..500 {
+        let origin = random_point(&mut rng, 3.0);
+        let ray = Ray::new(origin, random_point(&mut rng, 0.5) - origin);
+        assert_eq!(from_mesh.intersect(&ray), from_soup.intersect(&ray), "{ray:?}");
+        assert_eq!(from_mesh.occluded(&ray), from_soup.occluded(&ray), "{ray:?}");
+    }
+}

@@ -1,19 +1,20 @@
 //! Top-down construction, shared by every split method.
 //!
-//! The builder sees only one box per primitive: it never looks at
-//! triangles. It works on an array of [`PrimRef`]s (a box and the index of
-//! its primitive) that split functions reorder in place, so every pass over
+//! The builder sees only one box (and centroid) per primitive: it never
+//! looks at triangles or user primitives. It works on an array of
+//! [`BuildRef`]s (a box, a centroid and the index of its primitive) that
+//! split functions reorder in place, so every pass over
 //! a node's primitives reads memory sequentially. A node over `n` primitives
 //! owns `2n - 1` slots of a scratch array (enough for any subtree over them),
 //! so the two subtrees of a node get disjoint halves of its slots and are
 //! built in parallel without locks. A final pass lays the used slots out
 //! compactly with siblings side by side, and measures the tree.
 
-use rtgi_math::Vec3;
+use rtgi_math::{Vec3, Vec3A};
 
 use rayon::prelude::*;
 
-use super::split::{Context, PrimRef, RangeBounds, Split, SplitMethod};
+use super::split::{BuildRef, CentredPrimRef, Context, PrimRef, RangeBounds, Split, SplitMethod};
 use super::{BvhNode, median, sah};
 use crate::BuildParams;
 use crate::boxa::BoxA;
@@ -59,8 +60,25 @@ impl Slot {
     }
 }
 
+/// Builds a tree over primitives given by their boxes, each centred in its
+/// box (triangles).
 pub(crate) fn build(boxes: &[BoxA], method: SplitMethod, params: &BuildParams) -> Tree {
-    let n = boxes.len();
+    let prims = boxes.par_iter().enumerate().map(|(i, b)| PrimRef::new(*b, i as u32)).collect();
+    build_over(prims, method, params)
+}
+
+/// Builds a tree over primitives given by their boxes and centroids.
+pub(crate) fn build_with_centroids(primitives: &[(BoxA, Vec3A)], method: SplitMethod, params: &BuildParams) -> Tree {
+    let prims = primitives
+        .par_iter()
+        .enumerate()
+        .map(|(i, (bounds, centroid))| CentredPrimRef::new(*bounds, *centroid, i as u32))
+        .collect();
+    build_over(prims, method, params)
+}
+
+fn build_over<R: BuildRef>(mut prims: Vec<R>, method: SplitMethod, params: &BuildParams) -> Tree {
+    let n = prims.len();
     if n == 0 {
         return Tree {
             nodes: Vec::new(),
@@ -77,19 +95,18 @@ pub(crate) fn build(boxes: &[BoxA], method: SplitMethod, params: &BuildParams) -
         sah_bins: params.sah_bins.clamp(2, 256),
         traversal_cost: params.traversal_cost.max(0.0),
     };
-    let mut prims: Vec<PrimRef> = boxes.par_iter().enumerate().map(|(i, b)| PrimRef::new(*b, i as u32)).collect();
     let mut slots = vec![Slot::default(); 2 * n - 1];
     let root = RangeBounds::of(&prims);
     build_node(&ctx, &mut prims, 0, &mut slots, 0, 0, root);
-    let order = prims.iter().map(PrimRef::index).collect();
+    let order = prims.iter().map(BuildRef::index).collect();
     layout(&slots, order, params.traversal_cost)
 }
 
 /// Builds the subtree over `prims` (which start at position `first` of the
 /// final order) into `slots`, whose first element is at `slot_base`.
-fn build_node(
+fn build_node<R: BuildRef>(
     ctx: &Context,
-    prims: &mut [PrimRef],
+    prims: &mut [R],
     first: u32,
     slots: &mut [Slot],
     slot_base: u32,

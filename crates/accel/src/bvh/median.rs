@@ -2,18 +2,18 @@
 
 use std::cmp::Ordering;
 
-use super::split::{PrimRef, RangeBounds, Split};
+use super::split::{BuildRef, RangeBounds, Split};
 
 /// Orders primitives by centroid along `axis`, ties by index, so that
 /// builds are deterministic.
 #[inline]
-pub(crate) fn by_centroid(axis: usize) -> impl Fn(&PrimRef, &PrimRef) -> Ordering {
+pub(crate) fn by_centroid<R: BuildRef>(axis: usize) -> impl Fn(&R, &R) -> Ordering {
     move |a, b| a.centroid2()[axis].total_cmp(&b.centroid2()[axis]).then(a.index().cmp(&b.index()))
 }
 
 /// Equal counts: the lower half of the centroids along the longest axis of
 /// the centroids' box goes left. Always splits a range of two or more.
-pub(crate) fn object_median(prims: &mut [PrimRef], range: &RangeBounds) -> Split {
+pub(crate) fn object_median<R: BuildRef>(prims: &mut [R], range: &RangeBounds) -> Split {
     let axis = range.centroids.to_aabb().longest_axis();
     let half = prims.len() / 2;
     prims.select_nth_unstable_by(half, by_centroid(axis));
@@ -27,7 +27,7 @@ pub(crate) fn object_median(prims: &mut [PrimRef], range: &RangeBounds) -> Split
 /// which always separates distinct centroids; when all centroids are equal,
 /// or rounding makes the middle equal to an end, the object median splits.
 /// Each fallback strictly shrinks both sides, so recursion ends.
-pub(crate) fn spatial_median(prims: &mut [PrimRef], range: &RangeBounds) -> Split {
+pub(crate) fn spatial_median<R: BuildRef>(prims: &mut [R], range: &RangeBounds) -> Split {
     // Centroids are kept doubled, so the node's box is doubled to compare with them.
     let doubled_bounds = range.bounds.scaled(2.0);
     for bounds in [doubled_bounds, range.centroids] {
@@ -43,7 +43,7 @@ pub(crate) fn spatial_median(prims: &mut [PrimRef], range: &RangeBounds) -> Spli
 }
 
 /// Moves the elements satisfying `goes_left` to the front; returns their count.
-fn partition(prims: &mut [PrimRef], goes_left: impl Fn(&PrimRef) -> bool) -> usize {
+fn partition<R: BuildRef>(prims: &mut [R], goes_left: impl Fn(&R) -> bool) -> usize {
     let mut left = 0;
     for i in 0..prims.len() {
         if goes_left(&prims[i]) {

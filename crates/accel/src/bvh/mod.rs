@@ -9,11 +9,13 @@
 
 mod build;
 mod median;
+mod primitives;
 mod sah;
 mod split;
 mod traverse;
 mod validate;
 
+pub use primitives::PrimitiveBvh;
 pub use split::SplitMethod;
 pub use traverse::Traversal;
 
@@ -24,7 +26,7 @@ use rtgi_math::{Aabb, Vec3, Vec3A, Vec4};
 
 use crate::boxa::BoxA;
 use crate::contract::{HitFilter, QueryKind, Structure, is_hittable};
-use crate::{BuildParams, BuildStats, Counter, Hit};
+use crate::{BuildParams, BuildStats, Counter, Hit, TriangleSource};
 
 /// A node of the flattened tree: its box, and either the index of its first
 /// child (the second follows it) or, for a leaf, the range of its triangles
@@ -115,32 +117,38 @@ pub struct Bvh {
 }
 
 impl Bvh {
-    /// Builds a hierarchy over `triangles` with the given split method.
+    /// Builds a hierarchy over `triangles` (a soup, an [`crate::IndexedMesh`]
+    /// or any [`TriangleSource`]) with the given split method.
     ///
     /// Triangles that can never be hit ([`crate::is_hittable`]) are left
     /// out of the tree and counted in [`BuildStats::excluded_triangles`].
-    pub fn new(triangles: &[[Vec3; 3]], method: SplitMethod, params: &BuildParams) -> Self {
+    pub fn new(triangles: &(impl TriangleSource + ?Sized), method: SplitMethod, params: &BuildParams) -> Self {
         let start = Instant::now();
-        let all_hittable = triangles.par_iter().all(is_hittable);
+        let count = triangles.len();
+        let all_hittable = (0..count).into_par_iter().all(|i| is_hittable(&triangles.corners(i)));
         let (boxes, ids): (Vec<BoxA>, Vec<u32>) = if all_hittable {
-            (triangles.par_iter().map(BoxA::from_triangle).collect(), (0..triangles.len() as u32).collect())
+            (
+                (0..count).into_par_iter().map(|i| BoxA::from_triangle(&triangles.corners(i))).collect(),
+                (0..count as u32).collect(),
+            )
         } else {
-            triangles
-                .par_iter()
-                .enumerate()
-                .filter(|(_, t)| is_hittable(t))
-                .map(|(i, t)| (BoxA::from_triangle(t), i as u32))
+            (0..count)
+                .into_par_iter()
+                .filter_map(|i| {
+                    let corners = triangles.corners(i);
+                    is_hittable(&corners).then(|| (BoxA::from_triangle(&corners), i as u32))
+                })
                 .unzip()
         };
         let tree = build::build(&boxes, method, params);
         let triangle_ids: Vec<u32> = tree.order.par_iter().map(|&p| ids[p as usize]).collect();
-        let leaf_triangles = triangle_ids.par_iter().map(|&i| triangles[i as usize].map(Vec3A::from)).collect();
+        let leaf_triangles = triangle_ids.par_iter().map(|&i| triangles.corners(i as usize).map(Vec3A::from)).collect();
         let build_ms = start.elapsed().as_secs_f64() * 1e3;
 
         let stats = BuildStats {
             variant: method.name().to_owned(),
-            triangles: triangles.len(),
-            excluded_triangles: triangles.len() - ids.len(),
+            triangles: count,
+            excluded_triangles: count - ids.len(),
             build_ms,
             nodes: tree.nodes.len(),
             leaves: tree.leaves,

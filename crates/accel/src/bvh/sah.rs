@@ -6,7 +6,7 @@
 use rtgi_math::Vec3A;
 
 use super::median::{by_centroid, object_median};
-use super::split::{Context, PrimRef, RangeBounds, Split};
+use super::split::{BuildRef, Context, RangeBounds, Split};
 use crate::boxa::BoxA;
 
 /// Decides between the best split found (its summed `A · N` over both
@@ -81,7 +81,7 @@ impl Binning {
 /// axis (fewer for ranges shorter than that), and splits are evaluated only
 /// at bin borders. The children's bounds are gathered while partitioning,
 /// so no extra pass measures them.
-pub(crate) fn binned(ctx: &Context, prims: &mut [PrimRef], range: &RangeBounds) -> Option<Split> {
+pub(crate) fn binned<R: BuildRef>(ctx: &Context, prims: &mut [R], range: &RangeBounds) -> Option<Split> {
     if prims.len() <= SMALL_RANGE {
         return small(ctx, prims, range);
     }
@@ -89,11 +89,11 @@ pub(crate) fn binned(ctx: &Context, prims: &mut [PrimRef], range: &RangeBounds) 
     // Bin arrays live on the stack, sized to a power of two at least the bin
     // count, so that short ranges do not initialise arrays they do not use.
     match bins.next_power_of_two() {
-        2 => binned_on_stack::<2>(ctx, prims, range, bins),
-        4 => binned_on_stack::<4>(ctx, prims, range, bins),
-        8 => binned_on_stack::<8>(ctx, prims, range, bins),
-        16 => binned_on_stack::<16>(ctx, prims, range, bins),
-        32 => binned_on_stack::<32>(ctx, prims, range, bins),
+        2 => binned_on_stack::<R, 2>(ctx, prims, range, bins),
+        4 => binned_on_stack::<R, 4>(ctx, prims, range, bins),
+        8 => binned_on_stack::<R, 8>(ctx, prims, range, bins),
+        16 => binned_on_stack::<R, 16>(ctx, prims, range, bins),
+        32 => binned_on_stack::<R, 32>(ctx, prims, range, bins),
         _ => {
             let mut storage: Vec<Vec<Bin>> = vec![vec![Bin::EMPTY; bins]; 3];
             let [x, y, z] = &mut storage[..] else { unreachable!("three axes") };
@@ -102,9 +102,9 @@ pub(crate) fn binned(ctx: &Context, prims: &mut [PrimRef], range: &RangeBounds) 
     }
 }
 
-fn binned_on_stack<const N: usize>(
+fn binned_on_stack<R: BuildRef, const N: usize>(
     ctx: &Context,
-    prims: &mut [PrimRef],
+    prims: &mut [R],
     range: &RangeBounds,
     bins: usize,
 ) -> Option<Split> {
@@ -113,9 +113,9 @@ fn binned_on_stack<const N: usize>(
     binned_core(ctx, prims, range, bins, [&mut x[..bins], &mut y[..bins], &mut z[..bins]])
 }
 
-fn binned_core(
+fn binned_core<R: BuildRef>(
     ctx: &Context,
-    prims: &mut [PrimRef],
+    prims: &mut [R],
     range: &RangeBounds,
     bins: usize,
     mut per_axis: [&mut [Bin]; 3],
@@ -128,7 +128,7 @@ fn binned_core(
     let scale = Vec3A::select(usable, Vec3A::splat(bins as f32 * (1.0 - 1e-6)) / extent, Vec3A::ZERO);
     let binning = Binning { origin, scale, last: bins as u32 - 1 };
 
-    let fill = |chunk: &[PrimRef], per_axis: &mut [&mut [Bin]; 3]| {
+    let fill = |chunk: &[R], per_axis: &mut [&mut [Bin]; 3]| {
         for prim in chunk {
             let bounds = prim.bounds();
             let slots = binning.bins(prim.centroid2());
@@ -227,9 +227,9 @@ const SMALL_RANGE: usize = 8;
 /// `sorted(axis)` gives the range sorted by centroid along `axis`, and
 /// `right_cost` is scratch space of `count` entries. Returns the summed
 /// `A · N` of both sides, the axis and the left count.
-fn best_sweep<'a>(
+fn best_sweep<'a, R: BuildRef>(
     count: usize,
-    mut sorted: impl FnMut(usize) -> &'a [PrimRef],
+    mut sorted: impl FnMut(usize) -> &'a [R],
     right_cost: &mut [f32],
 ) -> (f32, usize, usize) {
     let mut best = (f32::INFINITY, 0, 0);
@@ -259,7 +259,7 @@ fn best_sweep<'a>(
 /// sorted on the stack. Most nodes of a tree are this small, so this keeps
 /// the per-node overhead of binning (bin arrays to clear, three axes to
 /// evaluate) off the bottom levels.
-fn small(ctx: &Context, prims: &mut [PrimRef], range: &RangeBounds) -> Option<Split> {
+fn small<R: BuildRef>(ctx: &Context, prims: &mut [R], range: &RangeBounds) -> Option<Split> {
     let count = prims.len();
     debug_assert!(count <= SMALL_RANGE);
     let mut sorted = [[prims[0]; SMALL_RANGE]; 3];
@@ -279,9 +279,9 @@ fn small(ctx: &Context, prims: &mut [PrimRef], range: &RangeBounds) -> Option<Sp
 /// Full-sweep SAH: every split between neighbouring centroids on every axis
 /// is evaluated exactly. Slow (three sorts per node), and the reference for
 /// the quality of the binned build.
-pub(crate) fn sweep(ctx: &Context, prims: &mut [PrimRef], range: &RangeBounds) -> Option<Split> {
+pub(crate) fn sweep<R: BuildRef>(ctx: &Context, prims: &mut [R], range: &RangeBounds) -> Option<Split> {
     let count = prims.len();
-    let mut sorted: [Vec<PrimRef>; 3] = [prims.to_vec(), prims.to_vec(), prims.to_vec()];
+    let mut sorted: [Vec<R>; 3] = [prims.to_vec(), prims.to_vec(), prims.to_vec()];
     for (axis, order) in sorted.iter_mut().enumerate() {
         order.sort_unstable_by(by_centroid(axis));
     }

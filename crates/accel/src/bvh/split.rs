@@ -1,5 +1,6 @@
 //! What the split methods share: the primitives they reorder
-//! ([`PrimRef`]), the bounds of a range of them ([`RangeBounds`]), the
+//! ([`BuildRef`]: [`PrimRef`] for triangles, [`CentredPrimRef`] for user
+//! primitives with centroids of their own), the bounds of a range of them ([`RangeBounds`]), the
 //! split they return ([`Split`]), and the read-only inputs of a build
 //! ([`Context`]). `build.rs`, `median.rs` and `sah.rs` all import this
 //! file, and none of them imports another's types.
@@ -34,9 +35,24 @@ impl SplitMethod {
     }
 }
 
-/// A primitive as the builder sees it: its box, with the primitive's index
-/// in the fourth lane of `min` (stored with bit 30 set, so that the lane is
-/// a normal float and never slows the box arithmetic that also runs on it).
+/// A primitive as the builder sees it: its box, its centroid (doubled)
+/// and its index in the builder's input. Split methods are generic over
+/// it, so that triangles keep their compact 32-byte [`PrimRef`] and user
+/// primitives bring their own centroids ([`CentredPrimRef`]).
+pub(crate) trait BuildRef: Copy + Send + Sync + 'static {
+    fn index(&self) -> u32;
+
+    fn bounds(&self) -> BoxA;
+
+    /// Twice the centroid: the builder compares centroids only with each
+    /// other, so the halving is left out.
+    fn centroid2(&self) -> Vec3A;
+}
+
+/// A primitive whose centroid is the centre of its box (triangles): the
+/// box, with the primitive's index in the fourth lane of `min` (stored
+/// with bit 30 set, so that the lane is a normal float and never slows the
+/// box arithmetic that also runs on it).
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct PrimRef {
     min_index: Vec4,
@@ -49,22 +65,53 @@ impl PrimRef {
     pub(crate) fn new(bounds: BoxA, index: u32) -> Self {
         Self { min_index: bounds.min.extend(f32::from_bits(index | INDEX_BIAS)), max: bounds.max.extend(0.0) }
     }
+}
 
+impl BuildRef for PrimRef {
     #[inline(always)]
-    pub(crate) fn index(&self) -> u32 {
+    fn index(&self) -> u32 {
         self.min_index.w.to_bits() & !INDEX_BIAS
     }
 
     #[inline(always)]
-    pub(crate) fn bounds(&self) -> BoxA {
+    fn bounds(&self) -> BoxA {
         BoxA { min: Vec3A::from_vec4(self.min_index), max: Vec3A::from_vec4(self.max) }
     }
 
-    /// Twice the centroid: the builder compares centroids only with each
-    /// other, so the halving is left out.
     #[inline(always)]
-    pub(crate) fn centroid2(&self) -> Vec3A {
+    fn centroid2(&self) -> Vec3A {
         Vec3A::from_vec4(self.min_index + self.max)
+    }
+}
+
+/// A primitive with a centroid of its own ([`crate::Primitive::centroid`]),
+/// which need not be the centre of its box: 48 bytes.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct CentredPrimRef {
+    bounds: PrimRef,
+    centroid2: Vec3A,
+}
+
+impl CentredPrimRef {
+    pub(crate) fn new(bounds: BoxA, centroid: Vec3A, index: u32) -> Self {
+        Self { bounds: PrimRef::new(bounds, index), centroid2: centroid * 2.0 }
+    }
+}
+
+impl BuildRef for CentredPrimRef {
+    #[inline(always)]
+    fn index(&self) -> u32 {
+        self.bounds.index()
+    }
+
+    #[inline(always)]
+    fn bounds(&self) -> BoxA {
+        self.bounds.bounds()
+    }
+
+    #[inline(always)]
+    fn centroid2(&self) -> Vec3A {
+        self.centroid2
     }
 }
 
@@ -87,7 +134,7 @@ impl RangeBounds {
     pub(crate) const EMPTY: RangeBounds = RangeBounds { bounds: BoxA::EMPTY, centroids: BoxA::EMPTY };
 
     #[inline(always)]
-    pub(crate) fn add(&mut self, prim: &PrimRef) {
+    pub(crate) fn add(&mut self, prim: &impl BuildRef) {
         self.bounds = self.bounds.union(prim.bounds());
         self.centroids = self.centroids.grow(prim.centroid2());
     }
@@ -97,9 +144,9 @@ impl RangeBounds {
     }
 
     /// The bounds of a range of primitives; in parallel for long ranges.
-    pub(crate) fn of(prims: &[PrimRef]) -> Self {
+    pub(crate) fn of<R: BuildRef>(prims: &[R]) -> Self {
         const CHUNK: usize = 16 * 1024;
-        let of_chunk = |chunk: &[PrimRef]| {
+        let of_chunk = |chunk: &[R]| {
             let mut r = RangeBounds::EMPTY;
             for prim in chunk {
                 r.add(prim);
@@ -123,7 +170,7 @@ pub(crate) struct Split {
 
 impl Split {
     /// A split whose children's bounds are measured afresh.
-    pub(crate) fn measured(prims: &[PrimRef], left_count: usize) -> Split {
+    pub(crate) fn measured<R: BuildRef>(prims: &[R], left_count: usize) -> Split {
         let (left, right) = prims.split_at(left_count);
         Split { left_count, left: RangeBounds::of(left), right: RangeBounds::of(right) }
     }

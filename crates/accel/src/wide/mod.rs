@@ -20,7 +20,7 @@ use rtgi_math::{Aabb, Vec3};
 
 use crate::contract::{HitFilter, QueryKind, Structure};
 use crate::simd::triangles::TriangleBlock;
-use crate::{BuildParams, BuildStats, Bvh, Counter, Hit, Intersector, SplitMethod};
+use crate::{BuildParams, BuildStats, Bvh, Counter, Hit, Intersector, SplitMethod, TriangleSource};
 use node::{ChildRef, WideNode};
 
 /// A BVH whose nodes have up to `W` children (4 and 8 are offered as
@@ -42,10 +42,11 @@ impl<const W: usize> WideBvh<W> {
     /// Most triangles in a leaf: larger `max_leaf_size`s are lowered to this.
     pub const MAX_LEAF_SIZE: usize = ChildRef::MAX_LEAF_BLOCKS * TriangleBlock::LANES;
 
-    /// Builds a binary hierarchy with `method` and collapses it to `W`
-    /// children a node. Triangles that can never be hit are left out, as
-    /// by every structure.
-    pub fn new(triangles: &[[Vec3; 3]], method: SplitMethod, params: &BuildParams) -> Self {
+    /// Builds a binary hierarchy over `triangles` (a soup, an
+    /// [`crate::IndexedMesh`] or any [`TriangleSource`]) with `method` and
+    /// collapses it to `W` children a node. Triangles that can never be hit
+    /// are left out, as by every structure.
+    pub fn new(triangles: &(impl TriangleSource + ?Sized), method: SplitMethod, params: &BuildParams) -> Self {
         let start = Instant::now();
         let params = BuildParams { max_leaf_size: params.max_leaf_size.min(Self::MAX_LEAF_SIZE), ..params.clone() };
         let binary = Bvh::new(triangles, method, &params);
