@@ -110,17 +110,23 @@ impl<'a> SceneFeatures<'a> {
     /// Tiles of sixteen rays; see [`RayKind::Camera`].
     fn camera_rays(&self, count: usize, rng: &mut Rng) -> Vec<ProbeRay> {
         let mut rays = Vec::with_capacity(count);
-        while rays.len() < count {
+        let mut attempts = 0;
+        while rays.len() < count && attempts < 20 * count {
+            attempts += 1;
             let origin = self.origin(rng);
             let (_, t) = self.random_triangle(rng);
             let (u, v) = (rng.next_f32(), rng.next_f32());
             let (u, v) = if u + v > 1.0 { (1.0 - u, 1.0 - v) } else { (u, v) };
             let centre = t[0] + u * (t[1] - t[0]) + v * (t[2] - t[0]);
+            // Scaled by its largest component before normalising: in scenes
+            // of size 1e-30 the squared length underflows to zero (and this
+            // loop once never ended there).
             let axis = centre - origin;
-            if axis.length_squared().partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
+            let largest = axis.abs().max_element();
+            if !(largest > 0.0 && largest.is_finite()) {
                 continue;
             }
-            let frame = rtgi_math::Frame::from_z(axis.normalize());
+            let frame = rtgi_math::Frame::from_z((axis / largest).normalize());
             let spacing = 0.004 * self.bounds.extent().max_element();
             for j in 0..4 {
                 for i in 0..4 {
@@ -329,5 +335,29 @@ impl Surrounded {
         // Hash maps iterate in a random order; rays must not.
         vertices.sort_by_key(|v| key(v.0));
         Self { edges, vertices }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_ray_kind_is_made_for_scenes_at_extreme_scales() {
+        // At 1e-30 the camera rays' axis once had a squared length of zero
+        // for every try, and making them never ended.
+        for scale in [1e-30f32, 1e-20, 1.0, 1e20, 1e30] {
+            let triangles = [
+                [Vec3::ZERO, Vec3::X * scale, Vec3::Y * scale],
+                [Vec3::X * scale, Vec3::new(1.0, 1.0, 0.0) * scale, Vec3::Y * scale],
+            ];
+            for &kind in RayKind::ALL {
+                // Every kind ends; camera rays, which need nothing but a
+                // triangle, are made at every scale.
+                let rays = kind.rays(&triangles, 64, 7);
+                assert!(kind != RayKind::Camera || rays.len() == 64, "{kind:?} at {scale}: {}", rays.len());
+                assert!(rays.iter().all(|r| r.ray.origin.is_finite() && r.ray.direction.is_finite()), "{kind:?}");
+            }
+        }
     }
 }
