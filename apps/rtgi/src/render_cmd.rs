@@ -131,7 +131,7 @@ pub(crate) fn render_image(args: &RenderArgs) -> Result<Rendered> {
         let p = light.position;
         say!(
             "  note: the camera is enclosed by the scene (no sky reaches it) and nothing emits light, so a lamp \
-             at {:.3},{:.3},{:.3} shines down on the room in view; --light or --environment chooses others",
+             at {:.3},{:.3},{:.3} hangs over the room in view; --light or --environment chooses others",
             p.x,
             p.y,
             p.z
