@@ -39,6 +39,33 @@ pub(crate) struct Tree {
     pub(crate) sah_cost: f32,
 }
 
+impl Tree {
+    /// The statistics of a build that made this tree: `variant` names it,
+    /// `inputs` primitives were given and `excluded` left out, it began at
+    /// `start`, and its leaves keep `leaf_bytes` beside the nodes.
+    pub(crate) fn stats(
+        &self,
+        variant: String,
+        inputs: usize,
+        excluded: usize,
+        start: std::time::Instant,
+        leaf_bytes: usize,
+    ) -> crate::BuildStats {
+        crate::BuildStats {
+            variant,
+            triangles: inputs,
+            excluded_triangles: excluded,
+            build_ms: start.elapsed().as_secs_f64() * 1e3,
+            nodes: self.nodes.len(),
+            leaves: self.leaves,
+            depth: self.depth,
+            leaf_size_histogram: self.leaf_size_histogram.clone(),
+            sah_cost: self.sah_cost,
+            memory_bytes: std::mem::size_of_val(self.nodes.as_slice()) + leaf_bytes,
+        }
+    }
+}
+
 /// A node before layout, 32 bytes: leaves have `count > 0` and their
 /// primitives start at `link`; an interior node's left child is in the next
 /// slot and its right child in slot `link`.

@@ -143,22 +143,8 @@ impl Bvh {
         let tree = build::build(&boxes, method, params);
         let triangle_ids: Vec<u32> = tree.order.par_iter().map(|&p| ids[p as usize]).collect();
         let leaf_triangles = triangle_ids.par_iter().map(|&i| triangles.corners(i as usize).map(Vec3A::from)).collect();
-        let build_ms = start.elapsed().as_secs_f64() * 1e3;
-
-        let stats = BuildStats {
-            variant: method.name().to_owned(),
-            triangles: count,
-            excluded_triangles: count - ids.len(),
-            build_ms,
-            nodes: tree.nodes.len(),
-            leaves: tree.leaves,
-            depth: tree.depth,
-            leaf_size_histogram: tree.leaf_size_histogram,
-            sah_cost: tree.sah_cost,
-            memory_bytes: std::mem::size_of_val(tree.nodes.as_slice())
-                + std::mem::size_of::<[Vec3A; 3]>() * triangle_ids.len()
-                + std::mem::size_of_val(triangle_ids.as_slice()),
-        };
+        let leaf_bytes = (std::mem::size_of::<[Vec3A; 3]>() + std::mem::size_of::<u32>()) * triangle_ids.len();
+        let stats = tree.stats(method.name().to_owned(), count, count - ids.len(), start, leaf_bytes);
         Self {
             nodes: tree.nodes,
             triangles: leaf_triangles,

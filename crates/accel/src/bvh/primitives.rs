@@ -91,20 +91,9 @@ impl<P: Primitive> PrimitiveBvh<P> {
         let tree = build::build_with_centroids(&inputs, method, params);
         let (leaf_ids, leaf_bounds): (Vec<u32>, Vec<BoxA>) =
             tree.order.iter().map(|&p| (ids[p as usize], inputs[p as usize].0)).unzip();
-        let stats = BuildStats {
-            variant: format!("primitive-{}", method.name()),
-            triangles: primitives.len(),
-            excluded_triangles: primitives.len() - ids.len(),
-            build_ms: start.elapsed().as_secs_f64() * 1e3,
-            nodes: tree.nodes.len(),
-            leaves: tree.leaves,
-            depth: tree.depth,
-            leaf_size_histogram: tree.leaf_size_histogram,
-            sah_cost: tree.sah_cost,
-            memory_bytes: std::mem::size_of_val(tree.nodes.as_slice())
-                + std::mem::size_of_val(leaf_ids.as_slice())
-                + std::mem::size_of_val(leaf_bounds.as_slice()),
-        };
+        let leaf_bytes = std::mem::size_of_val(leaf_ids.as_slice()) + std::mem::size_of_val(leaf_bounds.as_slice());
+        let variant = format!("primitive-{}", method.name());
+        let stats = tree.stats(variant, primitives.len(), primitives.len() - ids.len(), start, leaf_bytes);
         Self { primitives, nodes: tree.nodes, leaf_ids, leaf_bounds, stats }
     }
 
