@@ -1,8 +1,8 @@
 //! The machine an experiment ran on, recorded beside its measurements.
 
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
-#[derive(Clone, Debug, PartialEq, Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 /// The machine an experiment ran on, recorded with its numbers.
 pub struct Machine {
     /// The CPU's model name, as the operating system reports it.
