@@ -10,8 +10,8 @@ use rtgi_math::Ray;
 use rtgi_render::RenderSettings;
 
 use crate::reference::Reference;
-use crate::report::{ImageError, Point};
-use crate::stats::Timing;
+use crate::report::Point;
+use crate::stats::{SeedErrors, Timing};
 use crate::{Options, Subject};
 
 /// Renders `subject` with `settings` on the subject's structure; returns the image and the time in ms.
@@ -26,36 +26,22 @@ pub(crate) fn render_with(subject: &Subject, accel: &dyn Accel, settings: &Rende
 }
 
 /// Renders `options.repeats` times with seeds 0, 1, 2... and measures the
-/// time and the error against `reference`.
+/// time and the error against `reference`: RMSE, relative MSE, the split
+/// into squared bias and variance over the seeds, and (in the point's
+/// values) the efficiency `1 / (MSE · seconds)`.
 pub(crate) fn measure(subject: &Subject, settings: &RenderSettings, options: &Options, reference: &Reference) -> Point {
     let mut times = Vec::new();
-    let (mut mse, mut relative_mse, mut mean) = (0.0, 0.0, 0.0);
-    let (mut rmse_min, mut rmse_max) = (f64::INFINITY, 0.0f64);
-    let repeats = options.repeats.max(1);
-    for repeat in 0..repeats {
+    let mut errors = SeedErrors::new(&reference.image, reference.info.noise_rmse);
+    for repeat in 0..options.repeats.max(1) {
         let (image, ms) = render(subject, &RenderSettings { seed: repeat as u64, ..settings.clone() });
         times.push(ms);
-        let d = rtgi_image::compare(&image, &reference.image).expect("the reference has the render's size");
-        mse += d.rmse * d.rmse;
-        relative_mse += d.relative_mse;
-        mean += d.mean;
-        rmse_min = rmse_min.min(d.rmse);
-        rmse_max = rmse_max.max(d.rmse);
+        errors.add(&image);
     }
-    let n = repeats as f64;
-    let reference_mean = reference.image.pixels().iter().map(|p| p.to_array().iter().sum::<f32>() as f64).sum::<f64>()
-        / (reference.image.pixels().len() * 3).max(1) as f64;
     let mut point = Point::new(settings.samples_per_pixel as f64, settings.samples_per_pixel.to_string());
-    point.time = Some(Timing::of(&times));
-    point.error = Some(ImageError {
-        rmse: (mse / n).sqrt(),
-        rmse_min,
-        rmse_max,
-        relative_mse: relative_mse / n,
-        mean: mean / n,
-        reference_mean,
-    });
-    point
+    let (time, error) = (Timing::of(&times), errors.error());
+    point.time = Some(time);
+    point.error = Some(error);
+    point.with("efficiency", error.efficiency(time.median_ms))
 }
 
 /// Builds `kind` over the subject's triangles `repeats` times; returns the last structure and the timing.

@@ -1,10 +1,12 @@
 //! The statistics of the experiments: timings as median with min and max,
-//! and power laws fitted on log-log axes.
+//! power laws fitted on log-log axes with their standard errors, and the
+//! error of renders over several seeds split into bias and variance.
 
-use serde::Serialize;
+use rtgi_image::HdrImage;
+use serde::{Deserialize, Serialize};
 
 /// Repeated timings of one measurement, in milliseconds.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Timing {
     /// Median of the runs, in milliseconds.
     pub median_ms: f64,
@@ -31,17 +33,177 @@ impl Timing {
             runs: sorted.len(),
         }
     }
+
+    /// Whether this timing and `other` are told apart by the measurement:
+    /// their min–max ranges do not overlap. Within the spread, neither is faster.
+    pub fn resolved_from(&self, other: &Timing) -> bool {
+        self.max_ms < other.min_ms || other.max_ms < self.min_ms
+    }
+}
+
+/// How far renders of one configuration are from the reference, over all
+/// pixels and channels of linear radiance and over the seeds they were
+/// rendered with.
+///
+/// The mean squared error of one render splits into the squared bias of its
+/// estimator and its variance: per pixel, over seeds, `E[(X − R)²] = (E[X] −
+/// R)² + Var X`. With `n` seeds, the variance is estimated by the seeds'
+/// sample variance `s²`, and the squared bias by `(mean − R)² − s²/n −
+/// σ_R²`, which removes what the mean's own noise (`s²/n`) and the
+/// reference's noise (`σ_R²`) add to it; it can come out slightly negative
+/// when there is no bias. A bias below [`ImageError::bias_resolution`] is not resolved.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ImageError {
+    /// Root mean square error: `sqrt` of the mean squared error over the
+    /// seeds (each render with its own seed).
+    pub rmse: f64,
+    /// The smallest RMSE of one render.
+    pub rmse_min: f64,
+    /// The largest RMSE of one render.
+    pub rmse_max: f64,
+    /// Mean of `(test − reference)² / (reference² + 0.01)` over the renders:
+    /// dark pixels count as much as bright ones.
+    pub relative_mse: f64,
+    /// Mean radiance of the renders, against the reference's: where they
+    /// differ, energy is missing (or added), not only noise.
+    pub mean: f64,
+    /// Mean radiance of the reference.
+    pub reference_mean: f64,
+    /// Squared bias, averaged over pixels and channels (see the type's documentation).
+    pub bias2: f64,
+    /// Variance of one render, averaged over pixels and channels.
+    pub variance: f64,
+    /// How large `bias2` must be to be told apart from noise: the mean's
+    /// variance and the reference's noise that were subtracted from it.
+    pub bias_resolution: f64,
+    /// Renders (seeds) behind these figures.
+    pub seeds: usize,
+}
+
+impl ImageError {
+    /// The mean squared error of one render.
+    pub fn mse(&self) -> f64 {
+        self.rmse * self.rmse
+    }
+
+    /// Whether the bias is told apart from the noise.
+    pub fn bias_resolved(&self) -> bool {
+        self.seeds > 1 && self.bias2 > self.bias_resolution
+    }
+
+    /// Efficiency, `1 / (MSE · seconds)`: a configuration twice as
+    /// efficient reaches the same error in half the time (for unbiased estimators).
+    pub fn efficiency(&self, time_ms: f64) -> f64 {
+        1.0 / (self.mse() * time_ms * 1e-3).max(1e-300)
+    }
+}
+
+/// Renders of one configuration with different seeds, gathered pixel by
+/// pixel against a reference, for [`ImageError`].
+#[derive(Debug)]
+pub struct SeedErrors<'a> {
+    reference: &'a HdrImage,
+    reference_noise_rmse: f64,
+    sum: Vec<f64>,
+    sum_squares: Vec<f64>,
+    mse: Vec<f64>,
+    relative_mse: f64,
+    mean: f64,
+}
+
+impl<'a> SeedErrors<'a> {
+    /// Gathers against `reference`, whose own RMSE against the truth is `reference_noise_rmse`.
+    pub fn new(reference: &'a HdrImage, reference_noise_rmse: f64) -> SeedErrors<'a> {
+        let n = reference.pixels().len() * 3;
+        SeedErrors {
+            reference,
+            reference_noise_rmse,
+            sum: vec![0.0; n],
+            sum_squares: vec![0.0; n],
+            mse: Vec::new(),
+            relative_mse: 0.0,
+            mean: 0.0,
+        }
+    }
+
+    /// Adds one render; panics unless it has the reference's size.
+    pub fn add(&mut self, image: &HdrImage) {
+        let d = rtgi_image::compare(image, self.reference).expect("the render has the reference's size");
+        self.mse.push(d.rmse * d.rmse);
+        self.relative_mse += d.relative_mse;
+        self.mean += d.mean;
+        let values = image.pixels().iter().flat_map(|p| p.to_array());
+        for ((sum, squares), value) in self.sum.iter_mut().zip(&mut self.sum_squares).zip(values) {
+            *sum += value as f64;
+            *squares += value as f64 * value as f64;
+        }
+    }
+
+    /// The figures of the renders added so far; panics if there were none.
+    pub fn error(&self) -> ImageError {
+        let seeds = self.mse.len();
+        assert!(seeds > 0, "at least one render");
+        let n = seeds as f64;
+        // Per pixel, the bias term (mean − R)² − s²/n and the variance,
+        // summed over its channels.
+        let mut terms = Vec::with_capacity(self.reference.pixels().len());
+        let mut variance = 0.0;
+        for (pixel, r) in self.reference.pixels().iter().enumerate() {
+            let mut term = 0.0;
+            for (channel, r) in r.to_array().into_iter().enumerate() {
+                let i = pixel * 3 + channel;
+                let mean = self.sum[i] / n;
+                let sample_variance =
+                    if seeds > 1 { ((self.sum_squares[i] - n * mean * mean) / (n - 1.0)).max(0.0) } else { 0.0 };
+                variance += sample_variance;
+                term += (mean - r as f64).powi(2) - sample_variance / n;
+            }
+            terms.push(term / 3.0);
+        }
+        let count = self.sum.len().max(1) as f64;
+        let pixels = terms.len().max(1) as f64;
+        let noise2 = self.reference_noise_rmse * self.reference_noise_rmse;
+        let mean_term = terms.iter().sum::<f64>() / pixels;
+        let (bias2, variance) = (mean_term - noise2, variance / count);
+        // Under no bias the terms scatter about σ_R²; three standard errors
+        // of their mean, estimated from the terms themselves (renders have
+        // heavy tails, so no Gaussian rule of thumb), are what a bias must
+        // exceed. The channels of a pixel are correlated, so pixels, not
+        // channels, are the independent terms.
+        let scatter = terms.iter().map(|t| (t - mean_term).powi(2)).sum::<f64>() / (pixels - 1.0).max(1.0);
+        let reference_mean =
+            self.reference.pixels().iter().flat_map(|p| p.to_array()).map(f64::from).sum::<f64>() / count;
+        ImageError {
+            rmse: (self.mse.iter().sum::<f64>() / n).sqrt(),
+            rmse_min: self.mse.iter().copied().fold(f64::INFINITY, f64::min).sqrt(),
+            rmse_max: self.mse.iter().copied().fold(0.0, f64::max).sqrt(),
+            relative_mse: self.relative_mse / n,
+            mean: self.mean / n,
+            reference_mean,
+            bias2,
+            variance,
+            bias_resolution: if seeds > 1 { 3.0 * (scatter / pixels).sqrt() } else { f64::MAX },
+            seeds,
+        }
+    }
 }
 
 /// `y = a · x^exponent`, fitted by least squares to `(ln x, ln y)`.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct PowerLaw {
     /// The fitted exponent: the slope on log-log axes.
     pub exponent: f64,
+    /// The exponent's standard error from the fit's residuals (0 for two
+    /// points, which any line passes through).
+    pub standard_error: f64,
     /// `a` above: the fitted value at `x = 1`.
     pub scale: f64,
     /// Points the fit used (those with positive, finite `x` and `y`).
     pub points: usize,
+    /// The smallest `x` fitted.
+    pub x_min: f64,
+    /// The largest `x` fitted.
+    pub x_max: f64,
 }
 
 impl PowerLaw {
@@ -65,7 +227,12 @@ impl PowerLaw {
             return None;
         }
         let exponent = sxy / sxx;
-        Some(PowerLaw { exponent, scale: (mean_y - exponent * mean_x).exp(), points: logs.len() })
+        let intercept = mean_y - exponent * mean_x;
+        let residuals: f64 = logs.iter().map(|p| (p.1 - intercept - exponent * p.0).powi(2)).sum();
+        let standard_error = if logs.len() > 2 { (residuals / (n - 2.0) / sxx).sqrt() } else { 0.0 };
+        let used = points.iter().filter(|(x, y)| *x > 0.0 && *y > 0.0 && x.is_finite() && y.is_finite());
+        let (x_min, x_max) = used.fold((f64::INFINITY, 0.0f64), |(lo, hi), (x, _)| (lo.min(*x), hi.max(*x)));
+        Some(PowerLaw { exponent, standard_error, scale: intercept.exp(), points: logs.len(), x_min, x_max })
     }
 
     /// The fitted value `a · x^exponent` at `x`.
@@ -94,6 +261,40 @@ mod tests {
         let fit = PowerLaw::fit(&with_junk).unwrap();
         assert!((fit.exponent + 0.5).abs() < 1e-12 && (fit.scale - 3.0).abs() < 1e-12, "{fit:?}");
         assert_eq!(fit.points, 5);
+        assert!(fit.standard_error < 1e-12 && (fit.x_min, fit.x_max) == (1.0, 16.0), "{fit:?}");
         assert!(PowerLaw::fit(&[(2.0, 1.0), (2.0, 3.0)]).is_none());
+    }
+
+    #[test]
+    fn the_standard_error_grows_with_the_scatter() {
+        let scattered = [(1.0, 1.0), (2.0, 0.9), (4.0, 0.4), (8.0, 0.45), (16.0, 0.2)];
+        let fit = PowerLaw::fit(&scattered).unwrap();
+        // The same least squares in Python's floats: slope −0.5644, standard error 0.1165.
+        assert!((fit.exponent + 0.5644).abs() < 1e-4 && (fit.standard_error - 0.1165).abs() < 1e-4, "{fit:?}");
+    }
+
+    fn image(values: &[f32]) -> HdrImage {
+        let pixels = values.iter().map(|&v| rtgi_math::Vec3::splat(v)).collect();
+        HdrImage::from_pixels(values.len() as u32, 1, pixels).unwrap()
+    }
+
+    #[test]
+    fn splits_the_error_into_bias_and_variance() {
+        // Seeds scattered ±1 around the truth + 0.5: bias² 0.25, variance 4/3 (the sample variance of ±1 over 4 seeds).
+        let reference = image(&[2.0; 64]);
+        let mut errors = SeedErrors::new(&reference, 0.0);
+        for offset in [-1.0, 1.0, -1.0, 1.0] {
+            errors.add(&image(&[2.5 + offset; 64]));
+        }
+        let e = errors.error();
+        assert!((e.variance - 4.0 / 3.0).abs() < 1e-9 && (e.bias2 - (0.25 - 1.0 / 3.0)).abs() < 1e-9, "{e:?}");
+        assert!((e.mse() - 1.25).abs() < 1e-9, "MSE = bias² + the seeds' mean square spread: {e:?}");
+        // An unbiased estimator's bias² is within its resolution; a strongly biased one's is not.
+        assert!(!e.bias_resolved());
+        let mut biased = SeedErrors::new(&reference, 0.0);
+        for offset in [-0.1, 0.1, -0.1, 0.1] {
+            biased.add(&image(&[3.0 + offset; 64]));
+        }
+        assert!(biased.error().bias_resolved() && (biased.error().bias2 - 1.0).abs() < 0.01);
     }
 }
