@@ -30,7 +30,8 @@ fn every_knob_writes_its_table_json_and_plots() {
     let dir = scratch_dir("experiment-all");
     let run = rtgi(&["experiment", "all", "--quick", "--repeats", "2", "--out", path_str(&dir)]);
     assert!(run.success, "{run:?}");
-    for knob in ["spp", "depth", "accel", "scaling", "direct", "effects", "intersector", "precision"] {
+    let mut commits = std::collections::BTreeSet::new();
+    for knob in ["spp", "depth", "accel", "scaling", "direct", "clamp", "effects", "intersector", "precision"] {
         let folder = dir.join(knob);
         let md = std::fs::read_to_string(folder.join(format!("{knob}.md"))).expect("the table");
         assert!(md.contains(&format!("# `{knob}`")) && md.contains("|---|"), "{md}");
@@ -41,7 +42,13 @@ fn every_knob_writes_its_table_json_and_plots() {
         assert!(json["machine"]["cpu"].as_str().is_some_and(|c| !c.is_empty()), "{json}");
         assert!(json["machine"]["cores"].as_u64().is_some_and(|c| c >= 1));
         assert!(json["machine"]["threads"].as_u64().is_some_and(|c| c >= 1));
-        assert!(json["rtgi_version"].as_str().is_some());
+        // Provenance: the commit (and whether the tree was dirty), the compiler, profile and date.
+        let build = &json["build"];
+        assert!(build["commit"].as_str().is_some_and(|c| c.len() >= 7), "{json}");
+        assert!(build["rustc"].as_str().is_some_and(|c| c.starts_with("rustc")), "{build}");
+        assert!(build["profile"].as_str().is_some() && build["dirty"].is_null() || build["dirty"].is_string());
+        assert!(json["date"].as_str().is_some_and(|d| d.starts_with("20") && d.ends_with('Z')), "{}", json["date"]);
+        commits.insert(build["commit"].as_str().unwrap().to_owned());
         assert!(json["command"].as_str().is_some_and(|c| c.contains("experiment all")), "{}", json["command"]);
         assert_eq!(json["repeats"], 2);
         let series = json["series"].as_array().expect("series");
@@ -56,16 +63,26 @@ fn every_knob_writes_its_table_json_and_plots() {
                     time["max_ms"].as_f64().unwrap(),
                 );
                 assert!(min <= median && median <= max && min > 0.0, "{point}");
+                // Rendered points split their error into bias and variance and give the efficiency.
+                if let Some(error) = point["error"].as_object() {
+                    for field in ["rmse", "relative_mse", "bias2", "variance", "bias_resolution"] {
+                        assert!(error[field].as_f64().is_some_and(f64::is_finite), "{knob}: {field} in {point}");
+                    }
+                    assert_eq!(error["seeds"], 2, "{point}");
+                    assert!(point["values"]["efficiency"].as_f64().is_some_and(|e| e > 0.0), "{knob}: {point}");
+                }
             }
         }
         let plots = json["plots"].as_array().expect("plots");
         assert!(!plots.is_empty());
         for plot in plots {
-            let file = plot.as_str().expect("plot file name");
+            let file = plot["file"].as_str().expect("plot file name");
+            assert!(plot["title"].as_str().is_some_and(|t| !t.is_empty()), "{plot}");
             assert!(md.contains(&format!("]({file})")), "{knob}.md does not show {file}");
             check_svg(&folder.join(file), &[]);
         }
     }
+    assert_eq!(commits.len(), 1, "every report names the same commit: {commits:?}");
     // The curves that the knobs promise.
     check_svg(
         &dir.join("spp/spp-error.svg"),
@@ -134,6 +151,26 @@ fn every_knob_writes_its_table_json_and_plots() {
     let spp: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(dir.join("spp/spp.json")).unwrap()).unwrap();
     assert!(spp["reference"]["noise_rmse"].as_f64().is_some_and(|n| n > 0.0), "{}", spp["reference"]);
+    // The reference is checked by an independent estimator, and no bias shows between them.
+    let check = &spp["reference"]["check"];
+    assert!(check["estimator"].as_str().is_some_and(|e| e.contains("uniform")), "{check}");
+    let ratio = check["difference_rmse"].as_f64().unwrap() / check["expected_rmse"].as_f64().unwrap();
+    assert!(ratio > 0.5 && ratio < 1.5, "reference and independent estimator differ by {ratio}× their noise: {check}");
+    // Slopes are numbers with their standard errors and ranges.
+    let fits = spp["fits"].as_array().expect("fits");
+    assert!(fits.iter().any(|f| f["quantity"].as_str().is_some_and(|q| q.starts_with("RMSE against spp"))), "{fits:?}");
+    for fit in fits {
+        assert!(fit["law"]["exponent"].as_f64().is_some_and(|e| e < 0.0), "{fit}");
+        assert!(fit["law"]["standard_error"].as_f64().is_some_and(|e| e >= 0.0), "{fit}");
+        assert!(fit["law"]["x_min"].as_f64() < fit["law"]["x_max"].as_f64(), "{fit}");
+    }
+    // The clamp trades bias for variance: the harshest clamp's bias is resolved and its variance lower than no clamp's.
+    let clamp: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("clamp/clamp.json")).unwrap()).unwrap();
+    let clamp_points = clamp["series"][0]["points"].as_array().unwrap();
+    let (none, harsh) = (&clamp_points[0]["error"], &clamp_points[1]["error"]);
+    assert!(harsh["variance"].as_f64() < none["variance"].as_f64(), "{none} {harsh}");
+    assert!(harsh["bias2"].as_f64().unwrap() > harsh["bias_resolution"].as_f64().unwrap(), "{harsh}");
     let first = &spp["series"][0]["points"][0]["error"];
     assert!(first["rmse"].as_f64().is_some_and(|e| e > 0.0) && first["relative_mse"].as_f64().is_some(), "{first}");
     // More samples, less error, for every sampler.

@@ -121,16 +121,20 @@ pub(crate) struct ExperimentArgs {
 pub(crate) enum KnobChoice {
     One(rtgi_experiment::Knob),
     All,
+    Index,
 }
 
 /// The knobs' names (from [`rtgi_experiment::Knob`]'s `ValueEnum`) and `all`.
 fn knob_parser() -> impl TypedValueParser<Value = KnobChoice> {
-    let all = PossibleValue::new("all").help("Every knob in turn, one folder each");
+    let all = PossibleValue::new("all").help("Every knob in turn, one folder each, and the index");
+    let index = PossibleValue::new("index")
+        .help("Measure nothing: remake index.md in --out from the reports' JSON there (refused if they are of different code)");
     PossibleValuesParser::new(
-        rtgi_experiment::Knob::value_variants().iter().filter_map(ValueEnum::to_possible_value).chain([all]),
+        rtgi_experiment::Knob::value_variants().iter().filter_map(ValueEnum::to_possible_value).chain([all, index]),
     )
     .map(|name| match name.as_str() {
         "all" => KnobChoice::All,
+        "index" => KnobChoice::Index,
         name => KnobChoice::One(ValueEnum::from_str(name, false).expect("one of the possible values")),
     })
 }

@@ -7,13 +7,15 @@
 //! are skipped with a message), and writes `index.md` beside the results.
 
 use std::path::{Path, PathBuf};
+use std::time::Instant;
 
 use anyhow::{Result, bail};
-use rtgi_experiment::{IndexEntry, Knob, Options, Report, Subject};
+use rtgi_experiment::provenance::Build;
+use rtgi_experiment::{Knob, Machine, Options, RunRecord, Subject};
 use rtgi_render::{PixelSampler, RenderSettings};
 
 use crate::cli::{ExperimentArgs, KnobChoice};
-use crate::common::{LoadedScene, apply_lighting, choose_camera, load_scene};
+use crate::common::{LoadedScene, apply_lighting, choose_camera, load_scene, write_atomically};
 use crate::output::outln;
 
 /// The shared scenes of the report, relative to the scenes folder.
@@ -22,18 +24,43 @@ const BUNNY: &str = "bunny/stanford-bunny.obj";
 const SPONZA: &str = "sponza-dabrovic/sponza.obj";
 const CONFERENCE: &str = "conference/conference.obj";
 const HELMET: &str = "gltf/DamagedHelmet/glTF/DamagedHelmet.gltf";
+/// The project's own glossy scene (in `scenes/`, not the shared folder):
+/// glossy metals, where transport noise is of the BSDF's lobes.
+const GLOSSY: &str = "project:direct-glossy.toml";
 
 /// The scenes each knob is measured on in the report: the Cornell box
-/// (small, closed, converges), the bunny (one mesh under the sky), Sponza
-/// and the conference room (large, many materials), and the damaged helmet
-/// (textures, normal maps, emissive details: effects the box does not need).
+/// (small, closed, converges; its error at high spp is mostly the
+/// emitter's edge), the bunny (one mesh under the sky), Sponza and the
+/// conference room (large, many materials, mostly lit by light that has
+/// bounced: transport noise dominates), the project's glossy scene, and the
+/// damaged helmet (textures, normal maps, emissive details: effects the box
+/// does not need).
 fn report_scenes(knob: Knob) -> &'static [&'static str] {
     match knob {
-        Knob::Spp => &[CORNELL, BUNNY],
+        Knob::Spp => &[CORNELL, BUNNY, CONFERENCE, GLOSSY],
         Knob::Depth => &[CORNELL, SPONZA],
+        Knob::Clamp => &[CORNELL, CONFERENCE],
         Knob::Accel => &[CORNELL, BUNNY, SPONZA, CONFERENCE],
         Knob::Effects => &[CORNELL, HELMET],
         _ => &[CORNELL],
+    }
+}
+
+/// Where a report scene is: `project:NAME` in this workspace's `scenes/`,
+/// anything else in the shared scenes; and the name it is reported under.
+fn report_scene(scene: &str) -> (PathBuf, String) {
+    match scene.strip_prefix("project:") {
+        Some(name) => (Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes").join(name), format!("scenes/{name}")),
+        None => {
+            let path = scenes_folder().join(scene);
+            // Named as the shared scenes are documented, not by this machine's absolute path.
+            let name = if std::env::var_os("RTGI_SCENES").is_some() {
+                path.display().to_string()
+            } else {
+                format!("../shared/scenes/{scene}")
+            };
+            (path, name)
+        }
     }
 }
 
@@ -48,9 +75,15 @@ fn scenes_folder() -> PathBuf {
 }
 
 pub(crate) fn run(args: &ExperimentArgs) -> Result<()> {
+    let started = (Instant::now(), rtgi_experiment::provenance::utc_now());
     let knobs: Vec<Knob> = match args.knob {
         KnobChoice::One(knob) => vec![knob],
         KnobChoice::All => Knob::ALL.to_vec(),
+        KnobChoice::Index => {
+            let folder = args.out.clone().unwrap_or_else(|| PathBuf::from("experiments"));
+            let path = rtgi_experiment::write_index(&folder)?;
+            return outln!("wrote {}", path.display());
+        }
     };
     let report_mode = args.knob == KnobChoice::All && args.scene.is_none() && !args.quick;
     let out_root = args.out.clone().unwrap_or_else(|| PathBuf::from("experiments"));
@@ -84,7 +117,7 @@ pub(crate) fn run(args: &ExperimentArgs) -> Result<()> {
         }
         let scenes = report_scenes(knob);
         for scene in scenes {
-            let path = scenes_folder().join(scene);
+            let (path, name) = report_scene(scene);
             if !path.is_file() {
                 eprintln!(
                     "skipping {knob} on {}: not found (set RTGI_SCENES to the shared scenes' folder)",
@@ -94,16 +127,10 @@ pub(crate) fn run(args: &ExperimentArgs) -> Result<()> {
             }
             let stem = path.file_stem().map_or_else(|| "scene".into(), |s| s.to_string_lossy().to_lowercase());
             let folder = if scenes.len() > 1 { single_folder.join(stem) } else { single_folder.clone() };
-            // Named as the shared scenes are documented, not by this machine's absolute path.
-            let name = if std::env::var_os("RTGI_SCENES").is_some() {
-                path.display().to_string()
-            } else {
-                format!("../shared/scenes/{scene}")
-            };
             runs.push((knob, Some(path), Some(name), folder));
         }
     }
-    let mut written: Vec<(PathBuf, Report)> = Vec::new();
+
     // Every experiment asked for runs and writes its files even when the
     // reader of standard output has gone (`| head`): the first failed write
     // is kept and returned at the end, and nothing more is printed after it.
@@ -126,17 +153,19 @@ pub(crate) fn run(args: &ExperimentArgs) -> Result<()> {
             }
             Ok(())
         });
-        written.push((folder, report));
     }
     if args.knob == KnobChoice::All {
-        let entries: Vec<IndexEntry<'_>> = written
-            .iter()
-            .map(|(folder, report)| IndexEntry {
-                folder: folder.strip_prefix(&out_root).unwrap_or(folder).to_owned(),
-                report,
-            })
-            .collect();
-        let path = rtgi_experiment::write_index(&out_root, &entries, &options.command)?;
+        let record = RunRecord {
+            command: options.command.clone(),
+            build: Build::this(),
+            machine: Machine::this(options.threads),
+            started: started.1,
+            finished: rtgi_experiment::provenance::utc_now(),
+            wall_seconds: started.0.elapsed().as_secs_f64(),
+        };
+        let path = out_root.join(rtgi_experiment::RUN_RECORD);
+        write_atomically(&path, serde_json::to_string_pretty(&record)?.as_bytes())?;
+        let path = rtgi_experiment::write_index(&out_root)?;
         printed = printed.and_then(|()| outln!("wrote {}", path.display()));
     }
     printed

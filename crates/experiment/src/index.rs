@@ -1,63 +1,185 @@
 //! The index of a set of experiments (`rtgi experiment all`): every plot,
-//! under its question, with the findings measured beside it, and the
-//! command that regenerates everything.
+//! under its question, with the findings and fits measured beside it.
+//!
+//! The index is made from the reports' JSON alone ([`index_markdown`]), so
+//! that its prose cannot drift from the data: a test regenerates the
+//! committed index from the committed JSON and fails on any difference.
+//! Reports of different code (another commit, or uncommitted changes) are
+//! refused, naming them: their figures are not comparable.
 
+use std::collections::BTreeMap;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
-use crate::{ExperimentError, Report};
+use serde::{Deserialize, Serialize};
 
-/// A report and the folder it was written to, relative to the index.
-#[derive(Debug)]
-pub struct IndexEntry<'a> {
-    /// The folder of the report's files, relative to the index.
-    pub folder: PathBuf,
-    /// The report written there.
-    pub report: &'a Report,
+use crate::provenance::Build;
+use crate::{ExperimentError, Knob, Machine, Report};
+
+/// What one `rtgi experiment all` run was: its command and how long it took.
+/// Written as `run.json` beside the index.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct RunRecord {
+    /// The command, as typed.
+    pub command: String,
+    /// The program that ran it.
+    pub build: Build,
+    /// The machine it ran on.
+    pub machine: Machine,
+    /// When it started and finished, in UTC.
+    pub started: String,
+    /// When it finished.
+    pub finished: String,
+    /// Its wall time in seconds, references included.
+    pub wall_seconds: f64,
 }
 
-/// Writes `index.md` into `folder`; returns its path.
-pub fn write_index(folder: &Path, entries: &[IndexEntry<'_>], command: &str) -> Result<PathBuf, ExperimentError> {
-    let mut md = String::new();
-    let regenerate = match command.strip_prefix("rtgi ") {
-        Some(args) => format!("cargo run --release -p rtgi -- {args}"),
-        None => command.to_owned(),
+/// The name of the run record beside the index.
+pub const RUN_RECORD: &str = "run.json";
+
+/// A report read back from its JSON, with its folder relative to the index.
+#[derive(Debug)]
+pub struct IndexedReport {
+    /// The folder of the report's files, relative to the index.
+    pub folder: PathBuf,
+    /// The report, as read back (no tables; plots by file and title).
+    pub report: Report,
+}
+
+/// Reads every report below `folder` (files `KNOB.json` named after a
+/// knob, in folders not starting with a dot), ordered as `rtgi experiment
+/// all` runs the knobs, then by folder.
+pub fn read_reports(folder: &Path) -> Result<Vec<IndexedReport>, ExperimentError> {
+    let mut found = Vec::new();
+    collect(folder, folder, &mut found)?;
+    let order = |report: &Report| Knob::ALL.iter().position(|k| k.name() == report.knob).unwrap_or(usize::MAX);
+    found.sort_by(|a, b| order(&a.report).cmp(&order(&b.report)).then_with(|| a.folder.cmp(&b.folder)));
+    Ok(found)
+}
+
+fn collect(root: &Path, folder: &Path, found: &mut Vec<IndexedReport>) -> Result<(), ExperimentError> {
+    let unreadable =
+        |path: &Path, e: std::io::Error| ExperimentError::Read { path: path.to_owned(), message: e.to_string() };
+    let mut entries: Vec<PathBuf> = std::fs::read_dir(folder)
+        .map_err(|e| unreadable(folder, e))?
+        .map(|entry| entry.map(|e| e.path()).map_err(|e| unreadable(folder, e)))
+        .collect::<Result<_, _>>()?;
+    entries.sort();
+    for path in entries {
+        let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
+        if name.starts_with('.') {
+            continue;
+        }
+        if path.is_dir() {
+            collect(root, &path, found)?;
+        } else if let Some(stem) = name.strip_suffix(".json")
+            && Knob::ALL.iter().any(|k| k.name() == stem)
+        {
+            let text = std::fs::read_to_string(&path).map_err(|e| unreadable(&path, e))?;
+            let report: Report = serde_json::from_str(&text).map_err(|e| ExperimentError::Read {
+                path: path.clone(),
+                message: format!("not a report of this version of rtgi: {e}"),
+            })?;
+            let relative = folder.strip_prefix(root).unwrap_or(folder).to_owned();
+            found.push(IndexedReport { folder: relative, report });
+        }
+    }
+    Ok(())
+}
+
+/// Refuses reports of different code, naming the folders of each version.
+fn check_one_version(reports: &[IndexedReport], run: Option<&RunRecord>) -> Result<(), ExperimentError> {
+    let mut versions: BTreeMap<String, Vec<String>> = BTreeMap::new();
+    for r in reports {
+        let place = format!("{}/{}.json", r.folder.display(), r.report.knob);
+        versions.entry(r.report.build.code_version()).or_default().push(place);
+    }
+    if let Some(run) = run {
+        versions.entry(run.build.code_version()).or_default().push(RUN_RECORD.to_owned());
+    }
+    if versions.len() > 1 {
+        let listed: Vec<String> =
+            versions.iter().map(|(version, files)| format!("{version}: {}", files.join(", "))).collect();
+        return Err(ExperimentError::MixedVersions(listed.join("; ")));
+    }
+    Ok(())
+}
+
+/// The index of the reports below `folder`, as Markdown, from their JSON alone.
+pub fn index_markdown(folder: &Path) -> Result<String, ExperimentError> {
+    let reports = read_reports(folder)?;
+    let run_path = folder.join(RUN_RECORD);
+    let run: Option<RunRecord> = match std::fs::read_to_string(&run_path) {
+        Ok(text) => Some(serde_json::from_str(&text).map_err(|e| ExperimentError::Read {
+            path: run_path.clone(),
+            message: format!("not a run record: {e}"),
+        })?),
+        Err(_) => None,
     };
+    check_one_version(&reports, run.as_ref())?;
+    let mut md = String::new();
     let _ = writeln!(md, "# What accuracy costs in time\n");
-    if let Some(first) = entries.first() {
-        let m = &first.report.machine;
+    let _ = writeln!(
+        md,
+        "This page is generated from the JSON beside it (`rtgi experiment index` remakes it; a test fails when \
+         it differs). Every figure is what the command measured.\n"
+    );
+    if let Some(first) = reports.first() {
+        let _ = writeln!(md, "{}\n", first.report.provenance());
+    }
+    if let Some(run) = &run {
+        let regenerate = match run.command.strip_prefix("rtgi ") {
+            Some(args) => format!("cargo run --release -p rtgi -- {args}"),
+            None => run.command.clone(),
+        };
         let _ = writeln!(
             md,
-            "Measured on {} ({} cores, {} threads used, SIMD {}, {}) with rtgi {}. Every figure below is what \
-             the command measured; regenerate them all with\n\n```sh\n{regenerate}\n```\n",
-            m.cpu, m.cores, m.threads, m.simd, m.os, first.report.rtgi_version
+            "Regenerate everything with\n\n```sh\n{regenerate}\n```\n\nwhich took {:.0} minutes of wall time \
+             ({} to {}, references included).\n",
+            run.wall_seconds / 60.0,
+            run.started,
+            run.finished
         );
+    }
+    if let Some(first) = reports.first() {
         let _ = writeln!(
             md,
-            "Times are medians of {} runs, drawn with their min and max; errors are RMSE of linear radiance \
-             against converged references with seeds of their own, whose noise each report states.\n",
+            "Times are medians of {} runs, drawn with their min and max; errors are of linear radiance against \
+             converged references with seeds of their own, whose noise each report states. A difference inside \
+             the spread is written as not resolved.\n",
             first.report.repeats
         );
     }
     let mut knob = "";
-    for entry in entries {
-        let report = entry.report;
+    for entry in &reports {
+        let report = &entry.report;
         if report.knob != knob {
             knob = &report.knob;
             let _ = writeln!(md, "## `{}`: {}\n", report.knob, report.question);
         }
         let folder = entry.folder.to_string_lossy().replace('\\', "/");
-        let _ = writeln!(md, "### {} — [table and all figures]({folder}/{}.md)\n", report.scene, report.knob);
+        let prefix = if folder.is_empty() { String::new() } else { format!("{folder}/") };
+        let quick = if report.quick { " (quick run: reduced sizes, not for conclusions)" } else { "" };
+        let _ = writeln!(md, "### {}{quick} — [table and all figures]({prefix}{}.md)\n", report.scene, report.knob);
         for plot in &report.plots {
-            let _ = writeln!(md, "![{}]({folder}/{})\n", plot.title, plot.file);
+            let _ = writeln!(md, "![{}]({prefix}{})\n", plot.title, plot.file);
         }
         for finding in &report.findings {
             let _ = writeln!(md, "- {finding}");
         }
+        for fit in &report.fits {
+            let _ = writeln!(md, "- fit, {}: {}", fit.series, fit.describe());
+        }
         md.push('\n');
     }
+    Ok(md)
+}
+
+/// Writes `index.md` into `folder` from the reports' JSON below it; returns its path.
+pub fn write_index(folder: &Path) -> Result<PathBuf, ExperimentError> {
+    let md = index_markdown(folder)?;
     let path = folder.join("index.md");
-    std::fs::create_dir_all(folder).map_err(|source| ExperimentError::Write { path: folder.to_owned(), source })?;
-    std::fs::write(&path, md).map_err(|source| ExperimentError::Write { path: path.clone(), source })?;
+    rtgi_image::write_atomically(&path, md.as_bytes())
+        .map_err(|source| ExperimentError::Write { path: path.clone(), source })?;
     Ok(path)
 }

@@ -34,12 +34,14 @@ mod index;
 mod knobs;
 pub mod machine;
 pub mod plot;
+pub mod provenance;
 pub mod reference;
 pub mod report;
 mod runner;
 pub mod stats;
+pub mod verdict;
 
-pub use index::{IndexEntry, write_index};
+pub use index::{IndexedReport, RUN_RECORD, RunRecord, index_markdown, read_reports, write_index};
 pub use knobs::Knob;
 pub use machine::Machine;
 pub use report::{Point, Report, Series, Table};
@@ -115,6 +117,20 @@ pub enum ExperimentError {
         /// The plotting library's message.
         message: String,
     },
+    /// A report or record could not be read back.
+    #[error("{path}: {message}")]
+    Read {
+        /// The file.
+        path: PathBuf,
+        /// What was wrong with it.
+        message: String,
+    },
+    /// An index was asked to put together reports of different code.
+    #[error(
+        "the reports were measured by different code, so their figures cannot stand in one index (rerun them \
+         all from one commit): {0}"
+    )]
+    MixedVersions(String),
     /// An acceleration structure the knob needs could not be built.
     #[error("cannot build the structure: {0}")]
     Build(String),

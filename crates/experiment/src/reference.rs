@@ -7,6 +7,14 @@
 //! reference's own noise: if each half has variance `σ²` per pixel, their
 //! difference has `2σ²` and their average `σ²/2`, so the average's RMSE
 //! against the truth is about `RMSE(half₁, half₂) / 2`.
+//!
+//! A reference rendered by the estimator it judges would share its bias, and
+//! no comparison would show it. So each reference is checked against a
+//! second, independent estimator (the uniform sampler, light sampling
+//! without MIS, no Russian roulette), rendered the same way in two halves;
+//! their difference against their combined noise is reported
+//! ([`IndependentCheck`]). The cache keeps references under the code's
+//! version, so a change to the renderer renders them again.
 
 use std::path::Path;
 
@@ -14,11 +22,19 @@ use rtgi_image::HdrImage;
 use rtgi_render::RenderSettings;
 use serde::{Deserialize, Serialize};
 
-use crate::report::ReferenceInfo;
+use crate::provenance::Build;
+use crate::report::{IndependentCheck, ReferenceInfo};
 use crate::{ExperimentError, Subject};
 
 /// Seeds of the two halves: far from the small seeds (0, 1, 2, ...) of the measured renders.
 const SEEDS: [u64; 2] = [0x5eed_0000_0000_0001, 0x5eed_0000_0000_0002];
+
+/// Seeds of the independent estimator's halves.
+const CHECK_SEEDS: [u64; 2] = [0x5eed_0000_0000_0003, 0x5eed_0000_0000_0004];
+
+/// The independent estimator takes this fraction of the reference's
+/// samples: without roulette its paths run to the depth limit.
+const CHECK_FRACTION: u32 = 4;
 
 /// What the cache keeps beside each reference image.
 #[derive(Serialize, Deserialize)]
@@ -27,6 +43,8 @@ struct Meta {
     samples_per_pixel: u32,
     noise_rmse: f64,
     settings: String,
+    estimator: String,
+    check: Option<IndependentCheck>,
 }
 
 /// A reference image and what is known of it.
@@ -71,7 +89,14 @@ fn key(subject: &Subject, settings: &RenderSettings) -> String {
         }
         hash = hash.bytes(&t.material.to_le_bytes());
     }
-    let described = format!("{:?}|{:?}|{:?}|{}", scene.materials, scene.lights, subject.camera, describe(settings));
+    let described = format!(
+        "{:?}|{:?}|{:?}|{}|{}",
+        scene.materials,
+        scene.lights,
+        subject.camera,
+        describe(settings),
+        Build::this().code_version()
+    );
     hash = hash.bytes(described.as_bytes());
     format!("{:016x}", hash.0)
 }
@@ -94,8 +119,68 @@ pub(crate) fn describe(settings: &RenderSettings) -> String {
     )
 }
 
+/// The estimator's settings, in words.
+fn estimator(settings: &RenderSettings) -> String {
+    format!(
+        "{} sampler, {} direct light, roulette {}",
+        settings.sampler,
+        settings.direct_strategy,
+        if settings.russian_roulette { "on" } else { "off" }
+    )
+}
+
+/// Two renders of `settings` with `seeds`: their average and its noise (half their RMSE difference).
+fn halves(subject: &Subject, settings: &RenderSettings, seeds: [u64; 2]) -> (HdrImage, f64, [HdrImage; 2]) {
+    let [a, b] = seeds.map(|seed| crate::runner::render(subject, &RenderSettings { seed, ..settings.clone() }).0);
+    let noise = rtgi_image::compare(&a, &b).expect("same size").rmse / 2.0;
+    let pixels = a.pixels().iter().zip(b.pixels()).map(|(x, y)| (*x + *y) * 0.5).collect();
+    (HdrImage::from_pixels(settings.width, settings.height, pixels).expect("sizes agree"), noise, [a, b])
+}
+
+/// The means of `side`×`side` blocks of `image` (partial blocks at the edges are left out).
+fn blocks(image: &HdrImage, side: u32) -> HdrImage {
+    let (w, h) = ((image.width() / side).max(1), (image.height() / side).max(1));
+    let side = side.min(image.width()).min(image.height()).max(1);
+    let pixels = (0..w * h)
+        .map(|i| {
+            let (bx, by) = (i % w, i / w);
+            let mut sum = rtgi_math::Vec3::ZERO;
+            for y in by * side..(by + 1) * side {
+                for x in bx * side..(bx + 1) * side {
+                    sum += image.pixels()[(y * image.width() + x) as usize];
+                }
+            }
+            sum / (side * side) as f32
+        })
+        .collect();
+    HdrImage::from_pixels(w, h, pixels).expect("sizes agree")
+}
+
+/// Compares the reference (its halves) with the independent estimator's (its halves).
+fn check(
+    reference: ([&HdrImage; 2], &HdrImage, f64),
+    independent: ([&HdrImage; 2], &HdrImage, f64),
+    estimator: String,
+    samples_per_pixel: u32,
+) -> IndependentCheck {
+    let rmse = |a: &HdrImage, b: &HdrImage| rtgi_image::compare(a, b).expect("same size").rmse;
+    let block_noise = |[a, b]: [&HdrImage; 2]| rmse(&blocks(a, 8), &blocks(b, 8)) / 2.0;
+    let (ref_halves, ref_image, ref_noise) = reference;
+    let (ind_halves, ind_image, ind_noise) = independent;
+    IndependentCheck {
+        estimator,
+        samples_per_pixel,
+        noise_rmse: ind_noise,
+        difference_rmse: rmse(ref_image, ind_image),
+        expected_rmse: ref_noise.hypot(ind_noise),
+        block_difference_rmse: rmse(&blocks(ref_image, 8), &blocks(ind_image, 8)),
+        block_expected_rmse: block_noise(ref_halves).hypot(block_noise(ind_halves)),
+    }
+}
+
 /// The reference for `settings` at `samples_per_pixel`, from `cache` if it
-/// holds one, otherwise rendered (stratified, MIS, Russian roulette) and stored there.
+/// holds one of this code, otherwise rendered (stratified, MIS, Russian
+/// roulette), checked against the independent estimator, and stored there.
 pub(crate) fn reference(
     subject: &Subject,
     settings: &RenderSettings,
@@ -112,9 +197,12 @@ pub(crate) fn reference(
     let paths = cache.map(|folder| (folder.join(format!("{key}.exr")), folder.join(format!("{key}.json"))));
     let info = |meta: &Meta, cached| ReferenceInfo {
         samples_per_pixel: meta.samples_per_pixel,
+        estimator: meta.estimator.clone(),
         seeds: SEEDS,
         noise_rmse: meta.noise_rmse,
+        check: meta.check.clone(),
         settings: meta.settings.clone(),
+        code_version: Build::this().code_version(),
         cached,
     };
     if let Some((image_path, meta_path)) = &paths
@@ -127,18 +215,33 @@ pub(crate) fn reference(
         return Ok(Reference { info: info(&meta, true), image });
     }
     progress(&format!("rendering a reference of {} spp ({})", settings.samples_per_pixel * 2, describe(&settings)));
-    let halves: Vec<HdrImage> = SEEDS
-        .iter()
-        .map(|&seed| crate::runner::render(subject, &RenderSettings { seed, ..settings.clone() }).0)
-        .collect();
-    let noise = rtgi_image::compare(&halves[0], &halves[1]).expect("same size").rmse / 2.0;
-    let pixels = halves[0].pixels().iter().zip(halves[1].pixels()).map(|(a, b)| (*a + *b) * 0.5).collect();
-    let image = HdrImage::from_pixels(settings.width, settings.height, pixels).expect("sizes agree");
+    let (image, noise, [a, b]) = halves(subject, &settings, SEEDS);
+    let independent = RenderSettings {
+        samples_per_pixel: (settings.samples_per_pixel / CHECK_FRACTION).max(1),
+        sampler: rtgi_render::PixelSampler::Uniform,
+        direct_strategy: rtgi_render::DirectStrategy::Light,
+        russian_roulette: false,
+        ..settings.clone()
+    };
+    progress(&format!(
+        "rendering its independent check of {} spp ({})",
+        independent.samples_per_pixel * 2,
+        estimator(&independent)
+    ));
+    let (check_image, check_noise, [c, d]) = halves(subject, &independent, CHECK_SEEDS);
+    let check = check(
+        ([&a, &b], &image, noise),
+        ([&c, &d], &check_image, check_noise),
+        estimator(&independent),
+        independent.samples_per_pixel * 2,
+    );
     let meta = Meta {
         key: key.clone(),
         samples_per_pixel: settings.samples_per_pixel * 2,
         noise_rmse: noise,
         settings: describe(&settings),
+        estimator: estimator(&settings),
+        check: Some(check),
     };
     if let Some((image_path, meta_path)) = &paths {
         store(&image, image_path, meta_path, &meta)?;

@@ -5,53 +5,91 @@ use std::collections::BTreeMap;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 use crate::ExperimentError;
 use crate::machine::Machine;
 use crate::plot::Plot;
-use crate::stats::Timing;
-
-/// How far a render is from the converged reference, over all pixels and
-/// channels of linear radiance.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
-pub struct ImageError {
-    /// Root mean square error: `sqrt` of the mean squared error over the
-    /// repeats (each repeat with its own seed), and the smallest and
-    /// largest RMSE of one repeat.
-    pub rmse: f64,
-    /// The smallest RMSE of one repeat.
-    pub rmse_min: f64,
-    /// The largest RMSE of one repeat.
-    pub rmse_max: f64,
-    /// Mean of `(test − reference)² / (reference² + 0.01)` over the repeats.
-    pub relative_mse: f64,
-    /// Mean radiance of the render, against the reference's: where they
-    /// differ, energy is missing (or added), not only noise.
-    pub mean: f64,
-    /// Mean radiance of the reference.
-    pub reference_mean: f64,
-}
+use crate::provenance::Build;
+pub use crate::stats::ImageError;
+use crate::stats::{PowerLaw, Timing};
 
 /// The converged reference an experiment measured errors against.
-#[derive(Clone, Debug, PartialEq, Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct ReferenceInfo {
     /// Samples per pixel, over both halves.
     pub samples_per_pixel: u32,
+    /// The estimator that rendered it (sampler, direct-light strategy, roulette).
+    pub estimator: String,
     /// Its seeds, independent of every measured render's.
     pub seeds: [u64; 2],
     /// The reference's own RMSE against the truth, estimated from its two
     /// independent halves: differences below it are not resolved.
     pub noise_rmse: f64,
+    /// The same image by an independent estimator, which shares none of the
+    /// reference's sampler, MIS or roulette: a bias of either shows as a
+    /// difference beyond their noise.
+    pub check: Option<IndependentCheck>,
     /// Its render settings, described as in the cache key.
     pub settings: String,
+    /// The code that rendered it (commit, `+dirty-HASH` for uncommitted
+    /// changes): the cache keeps references of this code only.
+    pub code_version: String,
     /// Whether it came from the cache on disk.
     pub cached: bool,
 }
 
+/// A reference compared with an independent estimator's image of the same scene.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct IndependentCheck {
+    /// The independent estimator.
+    pub estimator: String,
+    /// Its samples per pixel, over both halves.
+    pub samples_per_pixel: u32,
+    /// Its own noise, from its two halves as for the reference.
+    pub noise_rmse: f64,
+    /// RMSE between the two images.
+    pub difference_rmse: f64,
+    /// The RMSE their noise alone gives: `√(σ_ref² + σ_check²)`.
+    pub expected_rmse: f64,
+    /// The same comparison on the means of 8×8 blocks, where a bias over a
+    /// region stands out of noise that averaging reduces.
+    pub block_difference_rmse: f64,
+    /// What noise alone gives on the blocks, from the halves' blocks.
+    pub block_expected_rmse: f64,
+}
+
+impl IndependentCheck {
+    /// The larger of the two ratios of difference to noise: about 1 when
+    /// both estimators converge to the same image, well above where one is biased.
+    pub fn ratio(&self) -> f64 {
+        (self.difference_rmse / self.expected_rmse.max(1e-30))
+            .max(self.block_difference_rmse / self.block_expected_rmse.max(1e-30))
+    }
+
+    /// One sentence for the report.
+    pub fn describe(&self) -> String {
+        format!(
+            "an independent estimator ({}, {} spp) differs from it by RMSE {} where their noise alone gives {} \
+             (on 8×8 blocks {} against {}): {}",
+            self.estimator,
+            self.samples_per_pixel,
+            format_number(self.difference_rmse),
+            format_number(self.expected_rmse),
+            format_number(self.block_difference_rmse),
+            format_number(self.block_expected_rmse),
+            if self.ratio() < 1.5 {
+                "no bias of either is resolved".to_owned()
+            } else {
+                format!("{:.1}× their noise: one of them is biased", self.ratio())
+            }
+        )
+    }
+}
+
 /// One measurement of a series: the knob's value, the time it took and
 /// what it gave.
-#[derive(Clone, Debug, PartialEq, Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Point {
     /// The knob's value, as plotted (spp, depth, triangle count...).
     pub x: f64,
@@ -80,7 +118,7 @@ impl Point {
 
 /// Measurements under one setting of the other knobs (a sampler, a
 /// structure, a scene...).
-#[derive(Clone, Debug, PartialEq, Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Series {
     /// The setting the series is measured under, as the legend and tables name it.
     pub name: String,
@@ -89,7 +127,7 @@ pub struct Series {
 }
 
 /// A table for the Markdown file.
-#[derive(Clone, Debug, PartialEq, Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Table {
     /// The heading above the table.
     pub title: String,
@@ -99,8 +137,43 @@ pub struct Table {
     pub rows: Vec<Vec<String>>,
 }
 
+/// A power law fitted to a series, as a number with its uncertainty and
+/// the range it was fitted on.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Fit {
+    /// The series fitted.
+    pub series: String,
+    /// What was fitted against what, e.g. `RMSE against spp`.
+    pub quantity: String,
+    /// The fitted law.
+    pub law: PowerLaw,
+    /// Points of the series offered to the fit, of which `law.points` were used.
+    pub offered: usize,
+}
+
+impl Fit {
+    /// `RMSE against spp ∝ x^-0.746 ± 0.012 (9 of 9 points, 1–256)`.
+    pub fn describe(&self) -> String {
+        format!(
+            "{} ∝ x^{:.3} ± {:.3} (fitted on {} of {} points, x from {} to {})",
+            self.quantity,
+            self.law.exponent,
+            self.law.standard_error,
+            self.law.points,
+            self.offered,
+            format_number(self.law.x_min),
+            format_number(self.law.x_max)
+        )
+    }
+}
+
 /// Everything one run of one knob produced.
-#[derive(Debug, Serialize)]
+///
+/// Written as `KNOB.json` and read back by [`crate::write_index`]: the
+/// index is made from the JSON alone, so that its prose cannot drift from
+/// the data. Read back, a report has no tables, and its plots only their
+/// file names and titles (the SVGs are beside the JSON).
+#[derive(Debug, Serialize, Deserialize)]
 pub struct Report {
     /// The knob varied (`spp`, `depth`, ...).
     pub knob: String,
@@ -110,8 +183,10 @@ pub struct Report {
     pub scene: String,
     /// The machine it ran on.
     pub machine: Machine,
-    /// The version of rtgi that measured.
-    pub rtgi_version: String,
+    /// The program that measured: version, commit, compiler, profile, flags.
+    pub build: Build,
+    /// When the measurement finished, in UTC.
+    pub date: String,
     /// The command that produced the report, as typed.
     pub command: String,
     /// Timed runs behind each timing.
@@ -122,18 +197,50 @@ pub struct Report {
     pub reference: Option<ReferenceInfo>,
     /// Every measurement, one series per setting of the other knobs.
     pub series: Vec<Series>,
-    /// What the measurements show, in sentences (fitted slopes...).
+    /// Power laws fitted to the series, as numbers.
+    pub fits: Vec<Fit>,
+    /// What the measurements show, in sentences computed from them.
     pub findings: Vec<String>,
-    #[serde(skip)]
     /// Tables for the Markdown file.
+    #[serde(skip)]
     pub tables: Vec<Table>,
-    /// The plots, by file name.
-    #[serde(serialize_with = "plot_files")]
+    /// The plots: in JSON, their file names and titles.
+    #[serde(with = "plot_files")]
     pub plots: Vec<Plot>,
 }
 
-fn plot_files<S: serde::Serializer>(plots: &[Plot], serializer: S) -> Result<S::Ok, S::Error> {
-    serializer.collect_seq(plots.iter().map(|p| &p.file))
+/// A plot in a report's JSON: its file and title.
+mod plot_files {
+    use serde::{Deserialize, Deserializer, Serialize, Serializer};
+
+    use crate::plot::{Corner, Plot};
+
+    #[derive(Serialize, Deserialize)]
+    struct PlotFile {
+        file: String,
+        title: String,
+    }
+
+    pub(super) fn serialize<S: Serializer>(plots: &[Plot], serializer: S) -> Result<S::Ok, S::Error> {
+        serializer.collect_seq(plots.iter().map(|p| PlotFile { file: p.file.clone(), title: p.title.clone() }))
+    }
+
+    pub(super) fn deserialize<'de, D: Deserializer<'de>>(deserializer: D) -> Result<Vec<Plot>, D::Error> {
+        let files = Vec::<PlotFile>::deserialize(deserializer)?;
+        Ok(files
+            .into_iter()
+            .map(|f| Plot {
+                file: f.file,
+                title: f.title,
+                x_label: String::new(),
+                y_label: String::new(),
+                log_x: false,
+                log_y: false,
+                curves: Vec::new(),
+                legend: Corner::default(),
+            })
+            .collect())
+    }
 }
 
 /// Formats milliseconds as a person reads them.
@@ -152,28 +259,66 @@ pub fn format_timing(t: &Timing) -> String {
     format!("{} ({}–{})", format_ms(t.median_ms), format_ms(t.min_ms), format_ms(t.max_ms))
 }
 
+/// The column names of [`measurement_cells`].
+pub(crate) const MEASUREMENT_HEADER: [&str; 7] =
+    ["time ms", "RMSE (min–max)", "relMSE", "bias²", "variance", "efficiency 1/(MSE·s)", "mean / reference"];
+
+/// A measurement table's header: the `leading` columns that name the
+/// configuration, then those of [`measurement_cells`].
+pub(crate) fn measurement_header(leading: &[&str]) -> Vec<String> {
+    leading.iter().chain(MEASUREMENT_HEADER.iter()).map(|s| s.to_string()).collect()
+}
+
 /// The table cells of a rendered measurement: time, RMSE with its range
-/// over the repeats, relative MSE, and mean radiance over the reference's.
-pub(crate) fn measurement_cells(point: &Point) -> [String; 4] {
+/// over the seeds, relative MSE, squared bias (or "not resolved"),
+/// variance, efficiency, and mean radiance over the reference's.
+pub(crate) fn measurement_cells(point: &Point) -> [String; 7] {
     let (time, error) = (point.time.expect("measured"), point.error.expect("measured"));
     [
         format_timing(&time),
         format!("{} ({}–{})", format_number(error.rmse), format_number(error.rmse_min), format_number(error.rmse_max)),
         format_number(error.relative_mse),
+        format_bias(&error),
+        format_number(error.variance),
+        format_number(error.efficiency(time.median_ms)),
         format!("{:.4}", error.mean / error.reference_mean.max(1e-30)),
     ]
 }
 
-/// A number in 4 significant digits, in scientific notation when small or large.
+/// The squared bias, or that it is below what the seeds resolve.
+pub fn format_bias(error: &ImageError) -> String {
+    if error.bias_resolved() {
+        format_number(error.bias2)
+    } else if error.seeds < 2 {
+        "— (1 seed)".to_owned()
+    } else {
+        format!("not resolved (< {})", format_number(error.bias_resolution))
+    }
+}
+
+/// A number in about 4 significant digits, in scientific notation when small or large.
 pub fn format_number(x: f64) -> String {
-    if x == 0.0 || (1e-3..1e5).contains(&x.abs()) {
-        format!("{:.4}", x).trim_end_matches('0').trim_end_matches('.').to_owned()
+    if x == 0.0 {
+        "0".to_owned()
+    } else if (1e-3..1e5).contains(&x.abs()) {
+        let decimals = (3 - x.abs().log10().floor() as i32).clamp(0, 6) as usize;
+        let text = format!("{x:.decimals$}");
+        if text.contains('.') { text.trim_end_matches('0').trim_end_matches('.').to_owned() } else { text }
     } else {
         format!("{x:.3e}")
     }
 }
 
 impl Report {
+    /// Fits a power law to `points` of `series` and records it; returns it
+    /// for the caller's finding or legend, `None` if it cannot be fitted.
+    pub fn fit(&mut self, series: &str, quantity: &str, offered: usize, points: &[(f64, f64)]) -> Option<Fit> {
+        let law = PowerLaw::fit(points)?;
+        let fit = Fit { series: series.to_owned(), quantity: quantity.to_owned(), law, offered };
+        self.fits.push(fit.clone());
+        Some(fit)
+    }
+
     /// Writes `KNOB.md`, `KNOB.json` and the plots into `folder` (created
     /// if needed); returns the paths written.
     pub fn write(&self, folder: &Path) -> Result<Vec<PathBuf>, ExperimentError> {
@@ -195,21 +340,33 @@ impl Report {
         Ok(written)
     }
 
+    /// Where and with what the figures were measured, in one sentence.
+    pub fn provenance(&self) -> String {
+        let (m, b) = (&self.machine, &self.build);
+        format!(
+            "Measured {} on {} ({} cores, {} threads used, SIMD {}, {}) by rtgi {} at commit {}{}, built by {} \
+             ({} profile, opt-level {}{}).",
+            self.date,
+            m.cpu,
+            m.cores,
+            m.threads,
+            m.simd,
+            m.os,
+            b.version,
+            b.commit,
+            if b.dirty.is_some() { " with uncommitted changes" } else { "" },
+            b.rustc,
+            b.profile,
+            b.opt_level,
+            if b.rustflags.is_empty() { String::new() } else { format!(", RUSTFLAGS {}", b.rustflags) }
+        )
+    }
+
     /// The report as Markdown: the question, the machine, findings, tables and plots.
     pub fn markdown(&self) -> String {
         let mut md = String::new();
         let _ = writeln!(md, "# `{}`: {}\n", self.knob, self.question);
-        let _ = writeln!(
-            md,
-            "Scene: {}. Machine: {} ({} cores, {} threads used, SIMD {}, {}). rtgi {}.\n",
-            self.scene,
-            self.machine.cpu,
-            self.machine.cores,
-            self.machine.threads,
-            self.machine.simd,
-            self.machine.os,
-            self.rtgi_version
-        );
+        let _ = writeln!(md, "Scene: {}. {}\n", self.scene, self.provenance());
         let _ = writeln!(md, "Command: `{}`\n", self.command);
         let _ = writeln!(
             md,
@@ -222,18 +379,25 @@ impl Report {
             let _ = writeln!(
                 md,
                 "Errors are RMSE and relative MSE of linear radiance over the image, against a reference of {} spp \
-                 (seeds {} and {}, independent of the measured renders) whose own noise is RMSE ≈ {}: \
-                 differences below that are not resolved.\n",
+                 ({}; seeds {} and {}, independent of the measured renders) whose own noise is RMSE ≈ {}: \
+                 differences below that are not resolved.{}\n",
                 r.samples_per_pixel,
+                r.estimator,
                 r.seeds[0],
                 r.seeds[1],
-                format_number(r.noise_rmse)
+                format_number(r.noise_rmse),
+                r.check
+                    .as_ref()
+                    .map_or(String::new(), |c| format!(" To see a bias it shares with the renders, {}.", c.describe()))
             );
         }
         for finding in &self.findings {
             let _ = writeln!(md, "- {finding}");
         }
-        if !self.findings.is_empty() {
+        for fit in &self.fits {
+            let _ = writeln!(md, "- fit, {}: {}", fit.series, fit.describe());
+        }
+        if !self.findings.is_empty() || !self.fits.is_empty() {
             md.push('\n');
         }
         for plot in &self.plots {
@@ -249,5 +413,20 @@ impl Report {
             md.push('\n');
         }
         md
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::format_number;
+
+    #[test]
+    fn numbers_have_about_four_significant_digits() {
+        assert_eq!(format_number(0.0), "0");
+        assert_eq!(format_number(30409.6859), "30410");
+        assert_eq!(format_number(1.5), "1.5");
+        assert_eq!(format_number(0.012345), "0.01235");
+        assert_eq!(format_number(-2.0), "-2");
+        assert_eq!(format_number(1.25e-7), "1.250e-7");
     }
 }

@@ -6,8 +6,9 @@ use rtgi_render::{Integrator, RenderSettings};
 
 use crate::plot::{Corner, Curve, Plot};
 use crate::reference::reference;
-use crate::report::{Report, Series, Table, format_number, format_timing};
+use crate::report::{Report, Series, Table, format_bias, measurement_cells, measurement_header};
 use crate::runner::measure;
+use crate::verdict::{Spread, compare};
 use crate::{ExperimentError, Options, Steps, Subject};
 
 /// The reference's depth: deeper than any depth measured, and deep enough
@@ -35,12 +36,14 @@ pub(super) fn run(
     let reference = reference(subject, &converged, options.reference_spp(), options.cache.as_deref(), progress)?;
     let mut table = Table {
         title: format!("{spp} spp per render"),
-        header: ["Russian roulette", "max depth", "time ms", "RMSE", "relMSE", "energy missing"]
-            .map(String::from)
-            .to_vec(),
+        header: {
+            let mut header = measurement_header(&["Russian roulette", "max depth"]);
+            header.push("energy missing".into());
+            header
+        },
         rows: Vec::new(),
     };
-    let (mut energy, mut times, mut errors) = (Vec::new(), Vec::new(), Vec::new());
+    let (mut energy, mut times, mut errors, mut tradeoff) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
     for roulette in [true, false] {
         let name = if roulette { "roulette on" } else { "roulette off" };
         let mut series = Series { name: name.to_owned(), points: Vec::new() };
@@ -53,15 +56,10 @@ pub(super) fn run(
             point.x = depth as f64;
             point.label = depth.to_string();
             point = point.with("energy_missing", missing);
-            let time = point.time.expect("measured");
-            table.rows.push(vec![
-                name.to_owned(),
-                depth.to_string(),
-                format_timing(&time),
-                format_number(error.rmse),
-                format_number(error.relative_mse),
-                format!("{:.2}%", missing * 100.0),
-            ]);
+            let mut row = vec![name.to_owned(), depth.to_string()];
+            row.extend(measurement_cells(&point));
+            row.push(format!("{:.2}%", missing * 100.0));
+            table.rows.push(row);
             series.points.push(point);
         }
         let xs = || series.points.iter().map(|p| p.x);
@@ -75,26 +73,71 @@ pub(super) fn run(
         );
         errors
             .push(Curve::new(name, xs().zip(series.points.iter().map(|p| p.error.expect("measured").rmse)).collect()));
+        tradeoff.push(
+            Curve::new(
+                name,
+                series
+                    .points
+                    .iter()
+                    .map(|p| (p.time.expect("measured").median_ms, p.error.expect("measured").rmse))
+                    .collect(),
+            )
+            .with_bars(series.points.iter().map(|p| p.error.map(|e| (e.rmse_min, e.rmse_max))).collect()),
+        );
         report.series.push(series);
     }
+    let mut findings = Vec::new();
     for series in &report.series {
         if let Some(first) = series.points.iter().find(|p| p.values["energy_missing"].abs() < 0.01) {
-            report
-                .findings
+            findings
                 .push(format!("{}: less than 1% of the energy is missing from depth {} on", series.name, first.label));
         }
+        // The error of a shallow depth is mostly bias: energy that is
+        // missing, which more samples would not bring back.
+        if let Some(first) = series.points.iter().find(|p| !p.error.expect("measured").bias_resolved()) {
+            findings.push(format!("{}: the bias is not resolved from depth {} on", series.name, first.label));
+        }
+        if let Some(shallow) = series.points.first() {
+            let e = shallow.error.expect("measured");
+            findings.push(format!(
+                "{}: at depth {}, bias² {} is {:.0}% of the MSE (energy missing {:.1}%)",
+                series.name,
+                shallow.label,
+                format_bias(&e),
+                100.0 * e.bias2.max(0.0) / e.mse().max(1e-300),
+                shallow.values["energy_missing"] * 100.0
+            ));
+        }
     }
+    report.findings.extend(findings);
     if let [on, off] = &report.series[..]
         && let (Some(a), Some(b)) = (on.points.last(), off.points.last())
     {
-        let (ta, tb) = (a.time.expect("measured").median_ms, b.time.expect("measured").median_ms);
+        let (ta, tb) = (Spread::time(&a.time.expect("measured")), Spread::time(&b.time.expect("measured")));
         report.findings.push(format!(
-            "at depth {}, Russian roulette takes {:.2}× the time of running every path to the end, at {:.2}× its RMSE",
+            "at depth {}: {}, at {:.2}× its RMSE; {}",
             a.label,
-            ta / tb,
-            a.error.expect("measured").rmse / b.error.expect("measured").rmse.max(1e-30)
+            compare("render time", "roulette on", &ta, "roulette off", &tb),
+            a.error.expect("measured").rmse / b.error.expect("measured").rmse.max(1e-30),
+            compare(
+                "efficiency 1/(MSE·time)",
+                "roulette on",
+                &Spread::efficiency(a).expect("measured"),
+                "roulette off",
+                &Spread::efficiency(b).expect("measured")
+            )
         ));
     }
+    report.plots.push(Plot {
+        file: "depth-tradeoff.svg".into(),
+        title: format!("RMSE against render time, max depth 1 to {}, {spp} spp", depths.last().expect("depths")),
+        x_label: "render time (ms, median)".into(),
+        y_label: "RMSE of linear radiance".into(),
+        log_x: true,
+        log_y: true,
+        curves: tradeoff,
+        legend: Corner::UpperRight,
+    });
     report.plots.push(Plot {
         file: "depth-energy.svg".into(),
         title: "Energy missing against max depth".into(),

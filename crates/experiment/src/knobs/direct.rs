@@ -18,8 +18,9 @@ use rtgi_scene::description::Description;
 
 use crate::plot::{Corner, Curve, Plot};
 use crate::reference::reference;
-use crate::report::{Report, Series, Table, format_ms, format_number, measurement_cells};
+use crate::report::{Report, Series, Table, format_ms, format_number, measurement_cells, measurement_header};
 use crate::runner::measure;
+use crate::verdict::{Spread, compare};
 use crate::{ExperimentError, Options, Steps, Subject};
 
 /// A scene of the experiment, as compiled in.
@@ -130,9 +131,7 @@ pub(super) fn run(
                 reference.info.samples_per_pixel,
                 format_number(noise)
             ),
-            header: ["strategy", "spp", "time ms", "RMSE (min–max)", "relMSE", "mean / reference"]
-                .map(String::from)
-                .to_vec(),
+            header: measurement_header(&["strategy", "spp"]),
             rows: Vec::new(),
         };
         let mut curves = Vec::new();
@@ -159,14 +158,32 @@ pub(super) fn run(
                 .collect();
             let bars = series.points.iter().map(|p| p.error.map(|e| (e.rmse_min, e.rmse_max))).collect();
             curves.push(Curve::new(strategy.to_string(), xy.clone()).with_bars(bars));
-            by_time.push((strategy, xy));
+            let band = |f: fn(&crate::report::ImageError) -> f64| -> Vec<(f64, f64)> {
+                series
+                    .points
+                    .iter()
+                    .map(|p| (p.time.expect("measured").median_ms, f(&p.error.expect("measured"))))
+                    .collect()
+            };
+            by_time.push((strategy, xy, band(|e| e.rmse_min), band(|e| e.rmse_max)));
             report.series.push(series);
         }
         // Equal time: the longest time every strategy reached, where each curve is read off without extrapolating.
-        let budget =
-            by_time.iter().filter_map(|(_, xy)| xy.iter().map(|p| p.0).reduce(f64::max)).fold(f64::INFINITY, f64::min);
+        let budget = by_time
+            .iter()
+            .filter_map(|(_, xy, _, _)| xy.iter().map(|p| p.0).reduce(f64::max))
+            .fold(f64::INFINITY, f64::min);
         let at_budget: Vec<(DirectStrategy, Option<f64>)> =
-            by_time.iter().map(|(strategy, xy)| (*strategy, log_log_at(xy, budget))).collect();
+            by_time.iter().map(|(strategy, xy, _, _)| (*strategy, log_log_at(xy, budget))).collect();
+        // The RMSE at the budget with the range the seeds give it.
+        let spread_at = |strategy: DirectStrategy| -> Option<Spread> {
+            let (_, xy, low, high) = by_time.iter().find(|(s, ..)| *s == strategy)?;
+            Some(Spread {
+                value: log_log_at(xy, budget)?,
+                low: log_log_at(low, budget)?,
+                high: log_log_at(high, budget)?,
+            })
+        };
         let mut ranked: Vec<(DirectStrategy, f64)> = at_budget.iter().filter_map(|(s, e)| e.map(|e| (*s, e))).collect();
         ranked.sort_by(|a, b| a.1.total_cmp(&b.1));
         let cell = |strategy: DirectStrategy| {
@@ -177,8 +194,12 @@ pub(super) fn run(
                 .iter()
                 .map(|(s, e)| format!("{s} {} ({:.2}× the error)", format_number(*e), e / best_error.max(1e-30)))
                 .collect();
+            let verdict = match (spread_at(best), spread_at(second)) {
+                (Some(b), Some(s)) => compare("RMSE", &second.to_string(), &s, &best.to_string(), &b),
+                _ => "not resolved".to_owned(),
+            };
             report.findings.push(format!(
-                "{name} ({}): at equal time ({} ms), {best} sampling wins with RMSE {}; {}{}",
+                "{name} ({}): at equal time ({} ms), {best} sampling has the lowest RMSE {}; {}; {verdict}{}",
                 direct_scene.case,
                 format_ms(budget),
                 format_number(best_error),
@@ -207,7 +228,7 @@ pub(super) fn run(
                 last.values.insert("rmse_at_equal_time".into(), *error);
             }
         }
-        let times = by_time.iter().flat_map(|(_, xy)| xy.iter().map(|p| p.0));
+        let times = by_time.iter().flat_map(|(_, xy, _, _)| xy.iter().map(|p| p.0));
         let (fastest, slowest) = times.fold((f64::INFINITY, 0.0f64), |(lo, hi), t| (lo.min(t), hi.max(t)));
         curves.push(Curve::guide("reference noise", vec![(fastest, noise), (slowest, noise)]));
         report.plots.push(Plot {

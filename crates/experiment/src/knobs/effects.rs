@@ -14,7 +14,7 @@ use rtgi_render::{EffectPlan, RenderSettings};
 
 use crate::plot::{Corner, Curve, Plot};
 use crate::reference::reference;
-use crate::report::{Point, Report, Series, Table, format_ms, format_number, format_timing};
+use crate::report::{Point, Report, Series, Table, format_bias, format_ms, format_number, format_timing};
 use crate::runner::measure;
 use crate::{ExperimentError, Options, Steps, Subject};
 
@@ -61,6 +61,10 @@ pub(super) fn run(
             "× plan's time",
             "RMSE (min–max)",
             "× plan's RMSE",
+            "relMSE",
+            "bias²",
+            "variance",
+            "efficiency 1/(MSE·s)",
             "mean / reference",
             "verdict",
         ]
@@ -77,6 +81,10 @@ pub(super) fn run(
                 format_number(planned_error.rmse_max)
             ),
             "1".to_owned(),
+            format_number(planned_error.relative_mse),
+            format_bias(&planned_error),
+            format_number(planned_error.variance),
+            format_number(planned_error.efficiency(planned_time.median_ms)),
             format!("{:.4}", energy(&planned)),
             "as planned".to_owned(),
         ]],
@@ -97,6 +105,10 @@ pub(super) fn run(
         let mut point = measure(subject, &reversal.settings, options, &reference);
         let (time, error) = (point.time.expect("measured"), point.error.expect("measured"));
         let time_ratio = time.median_ms / planned_time.median_ms.max(1e-9);
+        // A time whose range overlaps the plan's is not told apart from it.
+        let time_resolved = time.resolved_from(&planned_time);
+        let time_cell =
+            |ratio: f64| if time_resolved { format!("{ratio:.3}") } else { format!("{ratio:.3} (not resolved)") };
         let rmse_ratio = error.rmse / planned_error.rmse.max(1e-30);
         // The reference's noise is the finest difference in error the
         // experiment resolves; a change of the image's mean radiance is
@@ -107,7 +119,7 @@ pub(super) fn run(
         let resolved = rmse_change.abs() > noise || (error.mean - planned_error.mean).abs() > 3.0 * mean_standard_error;
         let verdict = match (reversal.planned, resolved) {
             (false, false) => {
-                free.push((label.clone(), time_ratio, rmse_change));
+                free.push((label.clone(), time_cell(time_ratio), rmse_change));
                 "not needed: no accuracy gained".to_owned()
             }
             (false, true) => {
@@ -121,18 +133,18 @@ pub(super) fn run(
                 "changes the image: the plan was wrong to leave it out".to_owned()
             }
             (true, true) => {
-                missed.push((label.clone(), time_ratio, rmse_ratio, energy(&point)));
+                missed.push((label.clone(), time_cell(time_ratio), rmse_ratio, energy(&point)));
                 format!("needed: RMSE ×{rmse_ratio:.2}, mean {:+.1}%", energy_change * 100.0)
             }
             (true, false) => {
-                costly.push((label.clone(), time_ratio));
+                costly.push((label.clone(), time_cell(time_ratio)));
                 "no change resolved at this spp".to_owned()
             }
         };
         table.rows.push(vec![
             label.clone(),
             format_timing(&time),
-            format!("{time_ratio:.3}"),
+            time_cell(time_ratio),
             format!(
                 "{} ({}–{})",
                 format_number(error.rmse),
@@ -140,6 +152,10 @@ pub(super) fn run(
                 format_number(error.rmse_max)
             ),
             format!("{rmse_ratio:.4}"),
+            format_number(error.relative_mse),
+            format_bias(&error),
+            format_number(error.variance),
+            format_number(error.efficiency(time.median_ms)),
             format!("{:.4}", energy(&point)),
             verdict,
         ]);
@@ -173,7 +189,7 @@ pub(super) fn run(
         format_number(planned_error.rmse)
     ));
     if !free.is_empty() {
-        let times: Vec<String> = free.iter().map(|(l, t, _)| format!("{l} {t:.2}×")).collect();
+        let times: Vec<String> = free.iter().map(|(l, t, _)| format!("{l} {t}×")).collect();
         let largest = free.iter().map(|(_, _, change)| change.abs()).fold(0.0, f64::max);
         let change = if largest == 0.0 {
             "the RMSE is the same to the last bit (the same paths are traced)".to_owned()
@@ -189,14 +205,14 @@ pub(super) fn run(
     }
     for (label, time_ratio, rmse_ratio, energy_ratio) in &missed {
         report.findings.push(format!(
-            "{label}: {time_ratio:.2}× the time, {rmse_ratio:.2}× the RMSE, mean radiance {:.1}% of the reference's: \
+            "{label}: {time_ratio}× the time, {rmse_ratio:.2}× the RMSE, mean radiance {:.1}% of the reference's: \
              the scene calls for it",
             energy_ratio * 100.0
         ));
     }
     for (label, time_ratio) in &costly {
         report.findings.push(format!(
-            "{label}: {time_ratio:.2}× the time, and neither the RMSE nor the mean radiance changes beyond their \
+            "{label}: {time_ratio}× the time, and neither the RMSE nor the mean radiance changes beyond their \
              noise at {spp} spp"
         ));
     }

@@ -1,10 +1,12 @@
 //! The knobs: one file each, each answering one question a user of the
 //! course asks about what accuracy costs.
 
+use crate::provenance::Build;
 use crate::report::Report;
 use crate::{ExperimentError, Machine, Options, Subject};
 
 mod accel;
+mod clamp;
 mod depth;
 mod direct;
 mod effects;
@@ -27,6 +29,8 @@ pub enum Knob {
     Scaling,
     /// Light, BSDF and MIS sampling of direct light, on scenes built for each.
     Direct,
+    /// The indirect-light clamp: bias traded for variance.
+    Clamp,
     /// Each decision of the effects planner reversed.
     Effects,
     /// The ray/triangle tests: time, and failures on the hard cases of `rtgi verify`.
@@ -46,6 +50,7 @@ impl Knob {
         Knob::Accel,
         Knob::Scaling,
         Knob::Direct,
+        Knob::Clamp,
         Knob::Effects,
         Knob::Intersector,
         Knob::Precision,
@@ -59,6 +64,7 @@ impl Knob {
             Knob::Accel => "accel",
             Knob::Scaling => "scaling",
             Knob::Direct => "direct",
+            Knob::Clamp => "clamp",
             Knob::Effects => "effects",
             Knob::Intersector => "intersector",
             Knob::Precision => "precision",
@@ -81,6 +87,7 @@ impl Knob {
             Knob::Direct => {
                 "which sampling of direct light (light, BSDF or MIS) gives the least error in equal time, and where?"
             }
+            Knob::Clamp => "how much bias does clamping indirect light add for the variance it removes?",
             Knob::Effects => {
                 "what does each effect cost, and does leaving out one the scene does not call for cost accuracy?"
             }
@@ -133,24 +140,29 @@ pub(crate) fn run(
             _ => "generated meshes".to_owned(),
         },
         machine: Machine::this(options.threads),
-        rtgi_version: env!("CARGO_PKG_VERSION").to_owned(),
+        build: Build::this(),
+        date: String::new(),
         command: options.command.clone(),
         repeats: options.repeats.max(1),
         quick: options.quick,
         reference: None,
         series: Vec::new(),
+        fits: Vec::new(),
         findings: Vec::new(),
         tables: Vec::new(),
         plots: Vec::new(),
     };
-    match knob {
+    let mut report = match knob {
         Knob::Spp => spp::run(subject, options, report, progress),
         Knob::Depth => depth::run(subject, options, report, progress),
         Knob::Accel => accel::run(subject, options, report, progress),
         Knob::Scaling => scaling::run(options, report, progress),
         Knob::Direct => direct::run(subject, options, report, progress),
+        Knob::Clamp => clamp::run(subject, options, report, progress),
         Knob::Effects => effects::run(subject, options, report, progress),
         Knob::Intersector => intersector::run(subject, options, report, progress),
         Knob::Precision => precision::run(options, report, progress),
-    }
+    }?;
+    report.date = crate::provenance::utc_now();
+    Ok(report)
 }

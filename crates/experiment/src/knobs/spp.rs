@@ -2,21 +2,27 @@
 //! log-log axes with the fitted slope beside the O(N^-1/2) line, and
 //! error against time, so that samplers are compared at equal time.
 //!
-//! The pixel samplers place only the camera ray in the pixel; the path's
-//! other random numbers are independent. So the experiment measures two
-//! integrands: the scene's own (light transport, where placement in the
-//! pixel is one dimension of many) and the camera-ray integrand alone
-//! (the `primary` integrator: edges and texture detail), where
-//! stratification shows.
+//! The spreading samplers place the camera ray in the pixel and spread the
+//! first vertex's light and BSDF numbers; deeper vertices are independent.
+//! So the experiment measures two integrands: the scene's own (light
+//! transport) and the camera-ray integrand alone (the `primary`
+//! integrator: edges and texture detail), and it is run on scenes of both
+//! kinds: the Cornell box, whose error at high counts is mostly the
+//! emitter's edge, and interiors and glossy scenes, where transport noise
+//! dominates. Fits are of RMSE, relative MSE and variance; efficiency
+//! `1/(MSE·time)` compares the samplers at 16 spp.
 
 use rtgi_render::{Integrator, PixelSampler, RenderSettings};
 
 use crate::plot::{Corner, Curve, Plot};
 use crate::reference::reference;
-use crate::report::{Report, Series, Table, format_number, measurement_cells};
+use crate::report::{Report, Series, Table, format_number, measurement_cells, measurement_header};
 use crate::runner::measure;
-use crate::stats::PowerLaw;
+use crate::verdict::{Spread, compare};
 use crate::{ExperimentError, Options, Steps, Subject};
+
+/// The count at which the samplers are compared in efficiency.
+const COMPARED_AT: f64 = 16.0;
 
 const SAMPLERS: [PixelSampler; 3] = [PixelSampler::Uniform, PixelSampler::Stratified, PixelSampler::LowDiscrepancy];
 
@@ -48,9 +54,7 @@ pub(super) fn run(
                 reference.info.samples_per_pixel,
                 format_number(noise)
             ),
-            header: ["sampler", "spp", "time ms", "RMSE (min–max)", "relMSE", "mean / reference"]
-                .map(String::from)
-                .to_vec(),
+            header: measurement_header(&["sampler", "spp"]),
             rows: Vec::new(),
         };
         for sampler in SAMPLERS {
@@ -67,16 +71,11 @@ pub(super) fn run(
             let rmse = |p: &crate::Point| p.error.expect("measured").rmse;
             let resolved: Vec<(f64, f64)> =
                 series.points.iter().filter(|p| rmse(p) > NOISE_MARGIN * noise).map(|p| (p.x, rmse(p))).collect();
-            let label = match PowerLaw::fit(&resolved) {
-                Some(fit) => {
-                    report.findings.push(format!(
-                        "{integrand}, {sampler}: RMSE ∝ spp^{:.3} (fitted on {} of {} counts whose error is above {NOISE_MARGIN}× the reference's noise)",
-                        fit.exponent,
-                        fit.points,
-                        series.points.len()
-                    ));
-                    format!("{sampler} (slope {:.2})", fit.exponent)
-                }
+            let offered = series.points.len();
+            let quantity =
+                format!("RMSE against spp (counts whose error is above {NOISE_MARGIN}× the reference's noise)");
+            let label = match report.fit(&series.name, &quantity, offered, &resolved) {
+                Some(fit) => format!("{sampler} (slope {:.2} ± {:.2})", fit.law.exponent, fit.law.standard_error),
                 None => {
                     report.findings.push(format!(
                         "{integrand}, {sampler}: too few counts above the reference's noise to fit a slope"
@@ -86,12 +85,13 @@ pub(super) fn run(
             };
             // Relative MSE weighs dark pixels as much as bright ones, so it
             // shows whether a sampler helps the whole image or only the
-            // bright edges that dominate RMSE.
-            let relative: Vec<(f64, f64)> =
-                series.points.iter().map(|p| (p.x, p.error.expect("measured").relative_mse)).collect();
-            if let Some(fit) = PowerLaw::fit(&relative) {
-                report.findings.push(format!("{integrand}, {sampler}: relative MSE ∝ spp^{:.3}", fit.exponent));
-            }
+            // bright edges that dominate RMSE; the variance is the part of
+            // the error that samples reduce.
+            let of = |f: fn(&crate::report::ImageError) -> f64| -> Vec<(f64, f64)> {
+                series.points.iter().map(|p| (p.x, f(&p.error.expect("measured")))).collect()
+            };
+            report.fit(&series.name, "relative MSE against spp", offered, &of(|e| e.relative_mse));
+            report.fit(&series.name, "variance against spp", offered, &of(|e| e.variance));
             let bars = series.points.iter().map(|p| p.error.map(|e| (e.rmse_min, e.rmse_max))).collect();
             error_curves
                 .push(Curve::new(&label, series.points.iter().map(|p| (p.x, rmse(p))).collect()).with_bars(bars));
@@ -100,6 +100,25 @@ pub(super) fn run(
                 series.points.iter().map(|p| (p.time.expect("measured").median_ms, rmse(p))).collect(),
             ));
             report.series.push(series);
+        }
+        // Efficiency at equal samples against the uniform sampler, resolved or not.
+        let at = |sampler: PixelSampler| {
+            report
+                .series
+                .iter()
+                .rev()
+                .find(|s| s.name == format!("{sampler}, {integrand}"))
+                .and_then(|s| s.points.iter().find(|p| p.x == COMPARED_AT).and_then(Spread::efficiency))
+        };
+        if let Some(uniform) = at(PixelSampler::Uniform) {
+            for &sampler in &SAMPLERS[1..] {
+                if let Some(other) = at(sampler) {
+                    report.findings.push(format!(
+                        "{integrand}, at {COMPARED_AT} spp: {}",
+                        compare("efficiency 1/(MSE·time)", &sampler.to_string(), &other, "uniform", &uniform)
+                    ));
+                }
+            }
         }
         // The O(N^-1/2) law through the first uniform point, and the reference's noise floor.
         if let Some(&(x0, y0)) = error_curves.first().and_then(|c| c.points.first()) {

@@ -1,0 +1,134 @@
+//! `clamp`: the indirect-light clamp (`--clamp`), which trades bias for
+//! variance: light a path brings in after the first bounce is limited to a
+//! maximum, so the rare bright paths that make fireflies are cut, and the
+//! energy they carried is missing. Measured at one sample count against the
+//! converged, unclamped reference, with the error split into squared bias
+//! and variance over the seeds.
+
+use rtgi_render::RenderSettings;
+
+use crate::plot::{Corner, Curve, Plot};
+use crate::reference::reference;
+use crate::report::{Point, Report, Series, Table, format_number, measurement_cells, measurement_header};
+use crate::runner::measure;
+use crate::verdict::{Spread, compare};
+use crate::{ExperimentError, Options, Steps, Subject};
+
+/// Clamps, as multiples of the reference's mean radiance (its brightest
+/// channel's), from harsh to barely touching.
+const LIMITS: [f64; 7] = [0.5, 1.0, 2.0, 4.0, 16.0, 64.0, 256.0];
+
+pub(super) fn run(
+    subject: &Subject,
+    options: &Options,
+    mut report: Report,
+    progress: &dyn Fn(&str),
+) -> Result<Report, ExperimentError> {
+    if !subject.settings.integrator.simulates_light() {
+        return Err(ExperimentError::Unsuitable(format!(
+            "the clamp experiment needs an integrator that simulates light (the subject uses '{}')",
+            subject.settings.integrator
+        )));
+    }
+    let limits: &[f64] = if options.quick { &LIMITS[1..4] } else { &LIMITS };
+    let spp = if options.quick { 4 } else { 16 };
+    let base = RenderSettings { samples_per_pixel: spp, indirect_clamp: None, ..subject.settings.clone() };
+    let mut steps = Steps::new(2 + limits.len(), progress);
+    steps.next("reference, unclamped");
+    let reference = reference(subject, &base, options.reference_spp(), options.cache.as_deref(), progress)?;
+    let mean = reference.image.pixels().iter().map(|p| p.max_element() as f64).sum::<f64>()
+        / reference.image.pixels().len().max(1) as f64;
+    let mut table = Table {
+        title: format!(
+            "{spp} spp per render, clamps as multiples of the reference's mean radiance {}",
+            format_number(mean)
+        ),
+        header: measurement_header(&["clamp", "limit"]),
+        rows: Vec::new(),
+    };
+    steps.next("unclamped");
+    let unclamped = measure(subject, &base, options, &reference);
+    let mut points: Vec<(String, f64, Point)> = vec![("none".to_owned(), f64::INFINITY, unclamped)];
+    for &factor in limits {
+        let limit = (factor * mean) as f32;
+        steps.next(&format!("clamp at {factor}× the mean ({limit})"));
+        let settings = RenderSettings { indirect_clamp: Some(limit), ..base.clone() };
+        points.push((format!("{factor}× mean"), limit as f64, measure(subject, &settings, options, &reference)));
+    }
+    let mut series = Series { name: "indirect clamp".to_owned(), points: Vec::new() };
+    let (mut bias_curve, mut variance_curve, mut tradeoff) = (Vec::new(), Vec::new(), Vec::new());
+    for (label, limit, point) in &points {
+        let mut row = vec![label.clone(), if limit.is_finite() { format_number(*limit) } else { "–".to_owned() }];
+        row.extend(measurement_cells(point));
+        table.rows.push(row);
+        let (time, error) = (point.time.expect("measured"), point.error.expect("measured"));
+        if limit.is_finite() {
+            bias_curve.push((*limit, error.bias2.max(1e-30)));
+            variance_curve.push((*limit, error.variance));
+        }
+        tradeoff.push((label.clone(), time, error));
+        let mut point = point.clone();
+        point.x = if limit.is_finite() { *limit } else { 0.0 };
+        point.label = label.clone();
+        series.points.push(point.with("limit", if limit.is_finite() { *limit } else { -1.0 }));
+    }
+    // The clamp with the least MSE against no clamp, in efficiency.
+    let (none, clamped) = series.points.split_first().expect("the unclamped point");
+    if let Some(best) =
+        clamped.iter().min_by(|a, b| a.error.expect("measured").mse().total_cmp(&b.error.expect("measured").mse()))
+    {
+        let e = best.error.expect("measured");
+        report.findings.push(format!(
+            "at {spp} spp the clamp at {} has the least MSE: bias² {}, variance {} against the unclamped {} and {}; {}",
+            best.label,
+            crate::report::format_bias(&e),
+            format_number(e.variance),
+            crate::report::format_bias(&none.error.expect("measured")),
+            format_number(none.error.expect("measured").variance),
+            compare(
+                "efficiency 1/(MSE·time)",
+                &format!("the clamp at {}", best.label),
+                &Spread::efficiency(best).expect("measured"),
+                "no clamp",
+                &Spread::efficiency(none).expect("measured")
+            )
+        ));
+    }
+    if let Some(first) = clamped.iter().rev().find(|p| p.error.expect("measured").bias_resolved()) {
+        report.findings.push(format!(
+            "the clamp's bias is resolved from {} down (the mean radiance is then {:.2}% of the reference's)",
+            first.label,
+            100.0 * first.error.expect("measured").mean / first.error.expect("measured").reference_mean.max(1e-30)
+        ));
+    }
+    report.series.push(series);
+    report.plots.push(Plot {
+        file: "clamp-bias-variance.svg".into(),
+        title: format!("Squared bias and variance against the clamp, {spp} spp"),
+        x_label: "clamp (radiance of the brightest channel)".into(),
+        y_label: "per pixel and channel".into(),
+        log_x: true,
+        log_y: true,
+        curves: vec![Curve::new("bias²", bias_curve), Curve::new("variance", variance_curve)],
+        legend: Corner::LowerLeft,
+    });
+    report.plots.push(Plot {
+        file: "clamp-tradeoff.svg".into(),
+        title: format!("RMSE against render time for each clamp, {spp} spp"),
+        x_label: "render time (ms, median)".into(),
+        y_label: "RMSE of linear radiance".into(),
+        log_x: true,
+        log_y: true,
+        curves: tradeoff
+            .iter()
+            .map(|(label, time, error)| {
+                Curve::new(label, vec![(time.median_ms, error.rmse)])
+                    .with_bars(vec![Some((error.rmse_min, error.rmse_max))])
+            })
+            .collect(),
+        legend: Corner::UpperRight,
+    });
+    report.tables.push(table);
+    report.reference = Some(reference.info);
+    Ok(report)
+}
