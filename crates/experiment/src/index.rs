@@ -175,6 +175,30 @@ pub fn index_markdown(folder: &Path) -> Result<String, ExperimentError> {
     Ok(md)
 }
 
+/// The marker lines around the summary that the README carries.
+pub const SUMMARY_MARKERS: [&str; 2] = [
+    "<!-- generated from docs/experiments/*.json by the experiment_index test; RTGI_BLESS=1 rewrites it -->",
+    "<!-- end of the generated summary -->",
+];
+
+/// A short summary of the reports below `folder` for the README, from their
+/// JSON alone: each report's first finding, under its knob and scene.
+pub fn summary_markdown(folder: &Path) -> Result<String, ExperimentError> {
+    let reports = read_reports(folder)?;
+    check_one_version(&reports, None)?;
+    let mut md = String::new();
+    if let Some(first) = reports.first() {
+        let _ = writeln!(md, "{}
+", first.report.provenance());
+    }
+    for entry in &reports {
+        if let Some(finding) = entry.report.findings.first() {
+            let _ = writeln!(md, "- **`{}`**, {}: {finding}", entry.report.knob, entry.report.scene);
+        }
+    }
+    Ok(md)
+}
+
 /// Writes `index.md` into `folder` from the reports' JSON below it; returns its path.
 pub fn write_index(folder: &Path) -> Result<PathBuf, ExperimentError> {
     let md = index_markdown(folder)?;

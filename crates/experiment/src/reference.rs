@@ -26,6 +26,13 @@ use crate::provenance::Build;
 use crate::report::{IndependentCheck, ReferenceInfo};
 use crate::{ExperimentError, Subject};
 
+/// The depth of every path-traced reference: deeper than any depth
+/// measured, and deep enough that what a path brings back after it is below
+/// the reference's noise. So every configuration of every knob on a scene
+/// is measured against the same converged image, and a shallow default
+/// depth shows as the bias it is; the knobs share the cached reference.
+pub(crate) const CONVERGED_DEPTH: u32 = 64;
+
 /// Seeds of the two halves: far from the small seeds (0, 1, 2, ...) of the measured renders.
 const SEEDS: [u64; 2] = [0x5eed_0000_0000_0001, 0x5eed_0000_0000_0002];
 
@@ -180,7 +187,8 @@ fn check(
 
 /// The reference for `settings` at `samples_per_pixel`, from `cache` if it
 /// holds one of this code, otherwise rendered (stratified, MIS, Russian
-/// roulette), checked against the independent estimator, and stored there.
+/// roulette, paths to [`CONVERGED_DEPTH`]), checked against the independent
+/// estimator, and stored there.
 pub(crate) fn reference(
     subject: &Subject,
     settings: &RenderSettings,
@@ -193,6 +201,9 @@ pub(crate) fn reference(
     settings.sampler = rtgi_render::PixelSampler::Stratified;
     settings.direct_strategy = rtgi_render::DirectStrategy::Mis;
     settings.russian_roulette = true;
+    if settings.integrator == rtgi_render::Integrator::Path {
+        settings.max_depth = settings.max_depth.max(CONVERGED_DEPTH);
+    }
     let key = format!("{}-{}", key(subject, &settings), settings.samples_per_pixel * 2);
     let paths = cache.map(|folder| (folder.join(format!("{key}.exr")), folder.join(format!("{key}.json"))));
     let info = |meta: &Meta, cached| ReferenceInfo {
