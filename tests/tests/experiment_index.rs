@@ -1,0 +1,102 @@
+//! The committed report (`docs/experiments`) says only what its JSON holds:
+//! `index.md` and the README's summary are regenerated from the JSON and
+//! must equal what is committed, byte for byte. Edit a figure by hand and
+//! this test fails; rerun the experiments and regenerate instead:
+//!
+//! ```sh
+//! cargo run --release -p rtgi -- experiment all --out docs/experiments
+//! RTGI_BLESS=1 cargo test -p rtgi-tests --test experiment_index   # the README's summary
+//! ```
+
+use std::path::{Path, PathBuf};
+
+use rtgi_experiment::{SUMMARY_MARKERS, index_markdown, summary_markdown};
+use rtgi_tests::{scratch_dir, workspace_root};
+
+fn docs() -> PathBuf {
+    workspace_root().join("docs/experiments")
+}
+
+/// The README's generated block, between the markers.
+fn readme_block(readme: &str) -> Option<(usize, usize)> {
+    let start = readme.find(SUMMARY_MARKERS[0])? + SUMMARY_MARKERS[0].len();
+    let end = start + readme[start..].find(SUMMARY_MARKERS[1])?;
+    Some((start, end))
+}
+
+#[test]
+fn the_committed_index_is_its_json() {
+    let generated = index_markdown(&docs()).unwrap_or_else(|e| panic!("{e}"));
+    let committed = std::fs::read_to_string(docs().join("index.md")).expect("docs/experiments/index.md");
+    if generated != committed {
+        let line = generated.lines().zip(committed.lines()).position(|(a, b)| a != b);
+        panic!(
+            "docs/experiments/index.md differs from what its JSON gives (first at line {}): regenerate it with \
+             'rtgi experiment index --out docs/experiments', never by hand",
+            line.map_or("the end".to_owned(), |l| (l + 1).to_string())
+        );
+    }
+}
+
+#[test]
+fn the_readme_summary_is_the_json() {
+    let readme_path = workspace_root().join("README.md");
+    let readme = std::fs::read_to_string(&readme_path).expect("README.md");
+    let (start, end) = readme_block(&readme).expect("the README has the generated summary's markers");
+    let generated = format!("\n{}", summary_markdown(&docs()).unwrap_or_else(|e| panic!("{e}")));
+    if std::env::var_os("RTGI_BLESS").is_some() {
+        let updated = format!("{}{generated}{}", &readme[..start], &readme[end..]);
+        std::fs::write(&readme_path, updated).expect("README.md written");
+        return;
+    }
+    assert!(
+        readme[start..end] == generated,
+        "the README's summary of the experiments differs from docs/experiments/*.json; rewrite it with \
+         RTGI_BLESS=1 cargo test -p rtgi-tests --test experiment_index"
+    );
+}
+
+/// Copies the committed reports into a scratch folder.
+fn copy_reports(to: &Path) {
+    fn copy(from: &Path, to: &Path) {
+        std::fs::create_dir_all(to).unwrap();
+        for entry in std::fs::read_dir(from).unwrap() {
+            let path = entry.unwrap().path();
+            let name = path.file_name().unwrap();
+            if path.is_dir() && !name.to_string_lossy().starts_with('.') {
+                copy(&path, &to.join(name));
+            } else if path.extension().is_some_and(|e| e == "json") {
+                std::fs::copy(&path, to.join(name)).unwrap();
+            }
+        }
+    }
+    copy(&docs(), to);
+}
+
+#[test]
+fn a_figure_edited_by_hand_is_caught() {
+    let dir = scratch_dir("experiment-index-edited");
+    copy_reports(&dir);
+    let generated = index_markdown(&dir).unwrap();
+    // Change the first digit of the first finding, as a hand edit would.
+    let finding = generated.lines().position(|l| l.starts_with("- ")).expect("findings");
+    let mut lines: Vec<String> = generated.lines().map(String::from).collect();
+    let digit = lines[finding].find(|c: char| c.is_ascii_digit()).expect("a figure in the finding");
+    let replaced = if &lines[finding][digit..digit + 1] == "7" { "8" } else { "7" };
+    lines[finding].replace_range(digit..digit + 1, replaced);
+    let edited = lines.join("\n") + "\n";
+    assert_ne!(edited, index_markdown(&dir).unwrap(), "the regenerated index differs from the edited one");
+}
+
+#[test]
+fn reports_of_different_code_are_refused_by_name() {
+    let dir = scratch_dir("experiment-index-mixed");
+    copy_reports(&dir);
+    let victim = dir.join("scaling/scaling.json");
+    let mut json: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&victim).unwrap()).unwrap();
+    json["build"]["commit"] = "0123456789abcdef0123456789abcdef01234567".into();
+    std::fs::write(&victim, serde_json::to_string(&json).unwrap()).unwrap();
+    let error = index_markdown(&dir).expect_err("mixed commits are refused").to_string();
+    assert!(error.contains("0123456789abcdef") && error.contains("scaling/scaling.json"), "{error}");
+    assert!(error.contains("different code"), "{error}");
+}
