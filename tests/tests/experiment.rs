@@ -164,13 +164,14 @@ fn every_knob_writes_its_table_json_and_plots() {
         assert!(fit["law"]["standard_error"].as_f64().is_some_and(|e| e >= 0.0), "{fit}");
         assert!(fit["law"]["x_min"].as_f64() < fit["law"]["x_max"].as_f64(), "{fit}");
     }
-    // The clamp trades bias for variance: the harshest clamp's bias is resolved and its variance lower than no clamp's.
+    // The clamp trades bias for variance: the harshest clamp loses energy and has less variance than no
+    // clamp. (At 32², 4 spp and 2 seeds the per-pixel bias² is not resolved; the mean shows the bias.)
     let clamp: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(dir.join("clamp/clamp.json")).unwrap()).unwrap();
     let clamp_points = clamp["series"][0]["points"].as_array().unwrap();
     let (none, harsh) = (&clamp_points[0]["error"], &clamp_points[1]["error"]);
     assert!(harsh["variance"].as_f64() < none["variance"].as_f64(), "{none} {harsh}");
-    assert!(harsh["bias2"].as_f64().unwrap() > harsh["bias_resolution"].as_f64().unwrap(), "{harsh}");
+    assert!(harsh["mean"].as_f64().unwrap() < 0.9 * harsh["reference_mean"].as_f64().unwrap(), "{harsh}");
     let first = &spp["series"][0]["points"][0]["error"];
     assert!(first["rmse"].as_f64().is_some_and(|e| e > 0.0) && first["relative_mse"].as_f64().is_some(), "{first}");
     // More samples, less error, for every sampler.

@@ -188,8 +188,12 @@ pub fn summary_markdown(folder: &Path) -> Result<String, ExperimentError> {
     check_one_version(&reports, None)?;
     let mut md = String::new();
     if let Some(first) = reports.first() {
-        let _ = writeln!(md, "{}
-", first.report.provenance());
+        let _ = writeln!(
+            md,
+            "{}
+",
+            first.report.provenance()
+        );
     }
     for entry in &reports {
         if let Some(finding) = entry.report.findings.first() {

@@ -16,7 +16,7 @@ use crate::{ExperimentError, Options, Steps, Subject};
 
 /// Clamps, as multiples of the reference's mean radiance (its brightest
 /// channel's), from harsh to barely touching.
-const LIMITS: [f64; 7] = [0.5, 1.0, 2.0, 4.0, 16.0, 64.0, 256.0];
+const LIMITS: [f64; 8] = [0.25, 0.5, 1.0, 2.0, 4.0, 16.0, 64.0, 256.0];
 
 pub(super) fn run(
     subject: &Subject,
@@ -30,7 +30,7 @@ pub(super) fn run(
             subject.settings.integrator
         )));
     }
-    let limits: &[f64] = if options.quick { &LIMITS[1..4] } else { &LIMITS };
+    let limits: &[f64] = if options.quick { &[0.25, 1.0, 4.0] } else { &LIMITS };
     let spp = if options.quick { 4 } else { 16 };
     let base = RenderSettings { samples_per_pixel: spp, indirect_clamp: None, ..subject.settings.clone() };
     let mut steps = Steps::new(2 + limits.len(), progress);

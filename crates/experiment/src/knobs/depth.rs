@@ -11,7 +11,6 @@ use crate::runner::measure;
 use crate::verdict::{Spread, compare};
 use crate::{ExperimentError, Options, Steps, Subject};
 
-
 pub(super) fn run(
     subject: &Subject,
     options: &Options,
