@@ -27,19 +27,22 @@ const HELMET: &str = "gltf/DamagedHelmet/glTF/DamagedHelmet.gltf";
 /// The project's own glossy scene (in `scenes/`, not the shared folder):
 /// glossy metals, where transport noise is of the BSDF's lobes.
 const GLOSSY: &str = "project:direct-glossy.toml";
+/// The project's closed room lit only by light bounced off its ceiling:
+/// transport noise, with no emitter in view.
+const ROOM: &str = "project:indirect-room.toml";
 
 /// The scenes each knob is measured on in the report: the Cornell box
 /// (small, closed, converges; its error at high spp is mostly the
 /// emitter's edge), the bunny (one mesh under the sky), Sponza and the
-/// conference room (large, many materials, mostly lit by light that has
-/// bounced: transport noise dominates), the project's glossy scene, and the
-/// damaged helmet (textures, normal maps, emissive details: effects the box
-/// does not need).
+/// conference room (large, many materials), the project's indirectly lit
+/// room and glossy scene (where transport noise dominates: cheap enough to
+/// converge), and the damaged helmet (textures, normal maps, emissive
+/// details: effects the box does not need).
 fn report_scenes(knob: Knob) -> &'static [&'static str] {
     match knob {
-        Knob::Spp => &[CORNELL, BUNNY, CONFERENCE, GLOSSY],
+        Knob::Spp => &[CORNELL, BUNNY, ROOM, GLOSSY],
         Knob::Depth => &[CORNELL, SPONZA],
-        Knob::Clamp => &[CORNELL, CONFERENCE],
+        Knob::Clamp => &[CORNELL, ROOM],
         Knob::Accel => &[CORNELL, BUNNY, SPONZA, CONFERENCE],
         Knob::Effects => &[CORNELL, HELMET],
         _ => &[CORNELL],

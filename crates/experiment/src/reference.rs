@@ -41,7 +41,7 @@ const CHECK_SEEDS: [u64; 2] = [0x5eed_0000_0000_0003, 0x5eed_0000_0000_0004];
 
 /// The independent estimator takes this fraction of the reference's
 /// samples: without roulette its paths run to the depth limit.
-const CHECK_FRACTION: u32 = 4;
+const CHECK_FRACTION: u32 = 8;
 
 /// What the cache keeps beside each reference image.
 #[derive(Serialize, Deserialize)]

@@ -87,6 +87,11 @@ impl IndependentCheck {
     }
 }
 
+/// The name of a point's value that marks it as measured against a
+/// reference other than its report's (a different integrand): such points
+/// are left out of the scene's Pareto front.
+pub const OWN_REFERENCE: &str = "own_reference";
+
 /// One measurement of a series: the knob's value, the time it took and
 /// what it gave.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]

@@ -62,7 +62,12 @@ pub(super) fn run(
             for &spp in &counts {
                 steps.next(&format!("{integrand}: {sampler} at {spp} spp"));
                 let settings = RenderSettings { sampler, samples_per_pixel: spp, ..base.clone() };
-                let point = measure(subject, &settings, options, &reference);
+                let mut point = measure(subject, &settings, options, &reference);
+                if integrator != subject.settings.integrator {
+                    // Measured against the camera-ray integrand's own reference:
+                    // not comparable with the scene's other configurations.
+                    point = point.with(crate::report::OWN_REFERENCE, 1.0);
+                }
                 let mut row = vec![sampler.to_string(), spp.to_string()];
                 row.extend(measurement_cells(&point));
                 table.rows.push(row);
