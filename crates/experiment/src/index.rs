@@ -13,6 +13,8 @@ use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
 
+use crate::pareto;
+use crate::plot::Plot;
 use crate::provenance::Build;
 use crate::{ExperimentError, Knob, Machine, Report};
 
@@ -105,6 +107,41 @@ fn check_one_version(reports: &[IndexedReport], run: Option<&RunRecord>) -> Resu
     Ok(())
 }
 
+/// The folder of the per-scene Pareto plots, inside the index's folder.
+pub(crate) const PARETO_FOLDER: &str = "pareto";
+
+/// A file name for a scene's plot: its file's stem, lower case, or the
+/// built-in scene's name with dashes.
+fn scene_slug(scene: &str) -> String {
+    let name = scene.split(" (").next().unwrap_or(scene);
+    let stem = Path::new(name).file_stem().map_or_else(|| name.to_owned(), |s| s.to_string_lossy().into_owned());
+    stem.to_lowercase().chars().map(|c| if c.is_ascii_alphanumeric() { c } else { '-' }).collect()
+}
+
+/// Each scene's Pareto plot (`pareto/SCENE.svg`) with its configurations,
+/// for the scenes whose reports measured rendered configurations.
+fn pareto_plots(reports: &[IndexedReport]) -> Vec<(String, Plot, usize)> {
+    let mut scenes: Vec<&str> = Vec::new();
+    for r in reports {
+        if !scenes.contains(&r.report.scene.as_str()) {
+            scenes.push(&r.report.scene);
+        }
+    }
+    scenes
+        .into_iter()
+        .filter_map(|scene| {
+            let configurations = pareto::configurations(reports.iter().map(|r| &r.report).filter(|r| r.scene == scene));
+            let knobs: std::collections::BTreeSet<&str> = configurations.iter().map(|c| c.knob.as_str()).collect();
+            // One knob alone is already its own error-against-time plot.
+            (knobs.len() >= 2).then(|| {
+                let file = format!("{PARETO_FOLDER}/{}.svg", scene_slug(scene));
+                let count = configurations.len();
+                (scene.to_owned(), pareto::plot(&file, &configurations), count)
+            })
+        })
+        .collect()
+}
+
 /// The index of the reports below `folder`, as Markdown, from their JSON alone.
 pub fn index_markdown(folder: &Path) -> Result<String, ExperimentError> {
     let reports = read_reports(folder)?;
@@ -149,6 +186,19 @@ pub fn index_markdown(folder: &Path) -> Result<String, ExperimentError> {
              the spread is written as not resolved.\n",
             first.report.repeats
         );
+    }
+    let paretos = pareto_plots(&reports);
+    if !paretos.is_empty() {
+        let _ = writeln!(
+            md,
+            "## The trade-off on one plot, per scene\n\nEvery configuration of every knob measured on the scene \
+             against the same converged reference, RMSE against time, with the Pareto front: the configurations \
+             that no other beats in both.\n"
+        );
+        for (scene, plot, count) in &paretos {
+            let on = plot.curves.last().map_or(String::new(), |front| front.label.clone());
+            let _ = writeln!(md, "### {scene}: {count} configurations, {on}\n\n![{}]({})\n", plot.title, plot.file);
+        }
     }
     let mut knob = "";
     for entry in &reports {
@@ -203,9 +253,23 @@ pub fn summary_markdown(folder: &Path) -> Result<String, ExperimentError> {
     Ok(md)
 }
 
-/// Writes `index.md` into `folder` from the reports' JSON below it; returns its path.
+/// Writes `index.md` and the Pareto plots into `folder` from the reports'
+/// JSON below it; returns the index's path.
 pub fn write_index(folder: &Path) -> Result<PathBuf, ExperimentError> {
     let md = index_markdown(folder)?;
+    let reports = read_reports(folder)?;
+    if let Some(first) = reports.first() {
+        for (scene, plot, _) in pareto_plots(&reports) {
+            let path = folder.join(&plot.file);
+            if let Some(parent) = path.parent() {
+                std::fs::create_dir_all(parent)
+                    .map_err(|source| ExperimentError::Write { path: parent.to_owned(), source })?;
+            }
+            let svg = plot.to_svg(&scene, &first.report.machine)?;
+            rtgi_image::write_atomically(&path, svg.as_bytes())
+                .map_err(|source| ExperimentError::Write { path: path.clone(), source })?;
+        }
+    }
     let path = folder.join("index.md");
     rtgi_image::write_atomically(&path, md.as_bytes())
         .map_err(|source| ExperimentError::Write { path: path.clone(), source })?;

@@ -3,6 +3,7 @@
 
 use plotters::coord::ranged1d::ValueFormatter;
 use plotters::prelude::*;
+use plotters::style::text_anchor::{HPos, Pos, VPos};
 
 use crate::ExperimentError;
 use crate::machine::Machine;
@@ -18,14 +19,26 @@ pub struct Curve {
     /// Per point, the `(low, high)` of an error bar (the min and max of the
     /// repeats), or none.
     pub bars: Vec<Option<(f64, f64)>>,
+    /// Per point, the `(low, high)` of a horizontal error bar (a time's min
+    /// and max, where time is on the x axis), or none.
+    pub x_bars: Vec<Option<(f64, f64)>>,
     /// A guide (a fitted or expected law) rather than measurements: drawn dashed, without markers.
     pub guide: bool,
+    /// Markers (and bars) without a line joining them: configurations that are not a sequence.
+    pub markers_only: bool,
 }
 
 impl Curve {
     /// A curve of measurements through `points`, without error bars.
     pub fn new(label: impl Into<String>, points: Vec<(f64, f64)>) -> Curve {
-        Curve { label: label.into(), bars: vec![None; points.len()], points, guide: false }
+        Curve {
+            label: label.into(),
+            bars: vec![None; points.len()],
+            x_bars: vec![None; points.len()],
+            points,
+            guide: false,
+            markers_only: false,
+        }
     }
 
     /// The curve with an error bar per point; panics unless there is one per point.
@@ -33,6 +46,21 @@ impl Curve {
         assert_eq!(bars.len(), self.points.len(), "one bar per point");
         self.bars = bars;
         self
+    }
+
+    /// The curve with a horizontal error bar per point; panics unless there is one per point.
+    pub fn with_x_bars(mut self, bars: Vec<Option<(f64, f64)>>) -> Curve {
+        assert_eq!(bars.len(), self.points.len(), "one bar per point");
+        self.x_bars = bars;
+        self
+    }
+
+    /// A curve of error against time with spread in both directions: each
+    /// point is `(time, error)` with the time's min–max and the error's min–max.
+    pub fn error_against_time(label: impl Into<String>, points: &[(crate::stats::Timing, f64, f64, f64)]) -> Curve {
+        Curve::new(label, points.iter().map(|(t, e, _, _)| (t.median_ms, *e)).collect())
+            .with_bars(points.iter().map(|(_, _, lo, hi)| Some((*lo, *hi))).collect())
+            .with_x_bars(points.iter().map(|(t, _, _, _)| Some((t.min_ms, t.max_ms))).collect())
     }
 
     /// A guide (a fitted or expected law) through `points`, drawn dashed.
@@ -78,6 +106,46 @@ pub enum Corner {
 
 const SIZE: (u32, u32) = (760, 500);
 
+/// The title's font size and line height, and how many characters fit a
+/// line of the canvas's width at that size (about 0.55 em a character).
+const TITLE_FONT: u32 = 17;
+const TITLE_LINE_HEIGHT: u32 = 22;
+const TITLE_CHARS_PER_LINE: usize = 78;
+
+/// `text` broken at spaces into lines of at most `width` characters (a
+/// longer word gets a line of its own).
+fn wrap(text: &str, width: usize) -> Vec<String> {
+    let mut lines: Vec<String> = Vec::new();
+    for word in text.split_whitespace() {
+        match lines.last_mut() {
+            Some(line) if line.chars().count() + 1 + word.chars().count() <= width => {
+                line.push(' ');
+                line.push_str(word);
+            }
+            _ => lines.push(word.to_owned()),
+        }
+    }
+    lines
+}
+
+/// Labelled ticks for a log axis from `lo` to `hi`: powers of ten, then 1,
+/// 2 and 5 times them, then every integer mantissa, whichever first gives
+/// at least three ticks inside the range.
+fn log_ticks(lo: f64, hi: f64) -> Vec<f64> {
+    let (first, last) = (lo.log10().floor() as i32, hi.log10().ceil() as i32);
+    for mantissas in [&[1.0][..], &[1.0, 2.0, 5.0], &[1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 8.0, 9.0]] {
+        let ticks: Vec<f64> = (first..=last)
+            .flat_map(|e| mantissas.iter().map(move |m| m * 10f64.powi(e)))
+            .filter(|v| *v >= lo && *v <= hi)
+            .collect();
+        if ticks.len() >= 3 {
+            return ticks;
+        }
+    }
+    // Less than a ninth of a decade: the ends and the middle, on a log scale.
+    vec![lo, (lo * hi).sqrt(), hi]
+}
+
 /// The range of `values` on an axis, padded; on a log axis only positive values count.
 fn axis_range(values: impl Iterator<Item = f64>, log: bool) -> (f64, f64) {
     let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
@@ -107,7 +175,10 @@ impl Plot {
     }
 
     fn draw(&self, svg: &mut String, scene: &str, machine: &Machine) -> Result<(), String> {
-        let xs = self.curves.iter().flat_map(|c| c.points.iter().map(|p| p.0));
+        let xs = self
+            .curves
+            .iter()
+            .flat_map(|c| c.points.iter().map(|p| p.0).chain(c.x_bars.iter().flatten().flat_map(|&(lo, hi)| [lo, hi])));
         let ys = self
             .curves
             .iter()
@@ -124,34 +195,94 @@ impl Plot {
             _ => scene.split(" (").next().unwrap_or(scene).to_owned(),
         };
         let caption = format!("{}, {scene} ({})", self.title, machine.short());
-        let mut builder = ChartBuilder::on(&root);
-        builder.caption(caption, ("sans-serif", 18)).margin(14).x_label_area_size(44).y_label_area_size(70);
-        // The four combinations of linear and log axes are different types.
+        // A title never runs off the canvas: it is wrapped into lines that fit.
+        let lines = wrap(&caption, TITLE_CHARS_PER_LINE);
+        let (title_area, chart_area) = root.split_vertically(TITLE_LINE_HEIGHT * lines.len() as u32 + 10);
+        for (i, line) in lines.iter().enumerate() {
+            title_area
+                .draw(&Text::new(
+                    line.clone(),
+                    (SIZE.0 as i32 / 2, 8 + (i as u32 * TITLE_LINE_HEIGHT) as i32),
+                    TextStyle::from(("sans-serif", TITLE_FONT).into_font()).pos(Pos::new(HPos::Center, VPos::Top)),
+                ))
+                .map_err(|e| e.to_string())?;
+        }
+        let mut builder = ChartBuilder::on(&chart_area);
+        builder.margin(14).x_label_area_size(44).y_label_area_size(70);
+        let legend = self.legend_corner(x_range, y_range);
+        // The four combinations of linear and log axes are different types;
+        // log axes carry their own key points, so a range of less than a
+        // decade still has several labelled ticks.
+        let log = |(lo, hi): (f64, f64)| (lo..hi).log_scale().with_key_points(log_ticks(lo, hi));
         match (self.log_x, self.log_y) {
             (false, false) => self.fill(
                 builder.build_cartesian_2d(x_range.0..x_range.1, y_range.0..y_range.1).map_err(|e| e.to_string())?,
+                legend,
             ),
             (true, false) => self.fill(
-                builder
-                    .build_cartesian_2d((x_range.0..x_range.1).log_scale(), y_range.0..y_range.1)
-                    .map_err(|e| e.to_string())?,
+                builder.build_cartesian_2d(log(x_range), y_range.0..y_range.1).map_err(|e| e.to_string())?,
+                legend,
             ),
             (false, true) => self.fill(
-                builder
-                    .build_cartesian_2d(x_range.0..x_range.1, (y_range.0..y_range.1).log_scale())
-                    .map_err(|e| e.to_string())?,
+                builder.build_cartesian_2d(x_range.0..x_range.1, log(y_range)).map_err(|e| e.to_string())?,
+                legend,
             ),
-            (true, true) => self.fill(
-                builder
-                    .build_cartesian_2d((x_range.0..x_range.1).log_scale(), (y_range.0..y_range.1).log_scale())
-                    .map_err(|e| e.to_string())?,
-            ),
+            (true, true) => {
+                self.fill(builder.build_cartesian_2d(log(x_range), log(y_range)).map_err(|e| e.to_string())?, legend)
+            }
         }?;
         root.present().map_err(|e| e.to_string())?;
         Ok(())
     }
 
-    fn fill<'a, X, Y>(&self, mut chart: ChartContext<'a, SVGBackend<'a>, Cartesian2d<X, Y>>) -> Result<(), String>
+    /// The corner whose legend box covers the fewest points and bars (the
+    /// plot's preferred corner on ties).
+    fn legend_corner(&self, x_range: (f64, f64), y_range: (f64, f64)) -> Corner {
+        let fraction = |v: f64, (lo, hi): (f64, f64), log: bool| {
+            if log { (v.max(1e-300).ln() - lo.ln()) / (hi.ln() - lo.ln()) } else { (v - lo) / (hi - lo) }
+        };
+        // The legend's size as a fraction of the plotting area (about 7 px a
+        // character plus the sample line, 20 px a row).
+        let (area_w, area_h) = (SIZE.0 as f64 - 100.0, SIZE.1 as f64 - 130.0);
+        let longest = self.curves.iter().map(|c| c.label.chars().count()).max().unwrap_or(0) as f64;
+        let (w, h) = ((longest * 7.0 + 50.0) / area_w, (self.curves.len() as f64 * 20.0 + 12.0) / area_h);
+        let covered = |corner: Corner| -> usize {
+            let (right, top) = match corner {
+                Corner::UpperRight => (true, true),
+                Corner::UpperLeft => (false, true),
+                Corner::LowerRight => (true, false),
+                Corner::LowerLeft => (false, false),
+            };
+            let inside = |x: f64, y: f64| {
+                let (fx, fy) = (fraction(x, x_range, self.log_x), fraction(y, y_range, self.log_y));
+                (if right { fx >= 1.0 - w } else { fx <= w }) && (if top { fy >= 1.0 - h } else { fy <= h })
+            };
+            self.curves
+                .iter()
+                .flat_map(|c| {
+                    // Points, and points along each segment (a line under the legend hides as much as a marker).
+                    let along = c.points.windows(2).flat_map(|p| {
+                        (1..8).map(move |k| {
+                            let t = k as f64 / 8.0;
+                            (p[0].0 + t * (p[1].0 - p[0].0), p[0].1 + t * (p[1].1 - p[0].1))
+                        })
+                    });
+                    c.points.iter().copied().chain(along).collect::<Vec<_>>()
+                })
+                .filter(|&(x, y)| x.is_finite() && y.is_finite() && inside(x, y))
+                .count()
+        };
+        let mut corners =
+            vec![self.legend, Corner::UpperRight, Corner::UpperLeft, Corner::LowerRight, Corner::LowerLeft];
+        corners.dedup();
+        corners.into_iter().min_by_key(|&c| covered(c)).unwrap_or(self.legend)
+    }
+
+    fn fill<'a, X, Y>(
+        &self,
+        mut chart: ChartContext<'a, SVGBackend<'a>, Cartesian2d<X, Y>>,
+        legend: Corner,
+    ) -> Result<(), String>
     where
         X: Ranged<ValueType = f64> + ValueFormatter<f64>,
         Y: Ranged<ValueType = f64> + ValueFormatter<f64>,
@@ -160,7 +291,9 @@ impl Plot {
             .configure_mesh()
             .x_desc(self.x_label.as_str())
             .y_desc(self.y_label.as_str())
-            .light_line_style(RGBColor(235, 235, 235))
+            // One light line between labelled ticks at most: denser ones drew grey bands.
+            .max_light_lines(1)
+            .light_line_style(RGBColor(242, 242, 242))
             .x_label_formatter(&|v| format_number(*v))
             .y_label_formatter(&|v| format_number(*v))
             .draw()
@@ -176,21 +309,36 @@ impl Plot {
                     .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], colour.stroke_width(1)));
                 continue;
             }
+            let markers_only = curve.markers_only;
+            let line = if markers_only { Vec::new() } else { points.clone().collect() };
             chart
-                .draw_series(LineSeries::new(points.clone(), colour.stroke_width(2)))
+                .draw_series(LineSeries::new(line, colour.stroke_width(2)))
                 .map_err(|e| e.to_string())?
                 .label(curve.label.as_str())
-                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], colour.stroke_width(2)));
+                .legend(move |(x, y)| {
+                    // A line with the curve's marker, or the marker alone for configurations.
+                    let length = if markers_only { 0 } else { 20 };
+                    EmptyElement::at((x, y))
+                        + PathElement::new(vec![(0, 0), (length, 0)], colour.stroke_width(2))
+                        + Circle::new((10, 0), 3, colour.filled())
+                });
             chart.draw_series(points.map(|p| Circle::new(p, 3, colour.filled()))).map_err(|e| e.to_string())?;
             let bars =
                 curve.points.iter().zip(&curve.bars).filter_map(|(&(x, y), bar)| bar.map(|(lo, hi)| (x, y, lo, hi)));
             chart
                 .draw_series(bars.map(|(x, y, lo, hi)| ErrorBar::new_vertical(x, lo, y, hi, colour.stroke_width(1), 8)))
                 .map_err(|e| e.to_string())?;
+            let x_bars =
+                curve.points.iter().zip(&curve.x_bars).filter_map(|(&(x, y), bar)| bar.map(|(lo, hi)| (x, y, lo, hi)));
+            chart
+                .draw_series(x_bars.map(|(_, y, lo, hi)| {
+                    ErrorBar::new_horizontal(y, lo, (lo + hi) / 2.0, hi, colour.stroke_width(1), 8)
+                }))
+                .map_err(|e| e.to_string())?;
         }
         chart
             .configure_series_labels()
-            .position(match self.legend {
+            .position(match legend {
                 Corner::UpperRight => SeriesLabelPosition::UpperRight,
                 Corner::UpperLeft => SeriesLabelPosition::UpperLeft,
                 Corner::LowerRight => SeriesLabelPosition::LowerRight,
@@ -201,5 +349,70 @@ impl Plot {
             .draw()
             .map_err(|e| e.to_string())?;
         Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn log_axes_have_at_least_three_labelled_ticks() {
+        assert_eq!(log_ticks(0.05, 200.0), vec![0.1, 1.0, 10.0, 100.0]);
+        // Less than a decade (the depth knob's RMSE): 1-2-5 mantissas, then every integer.
+        assert_eq!(log_ticks(0.011, 0.06), vec![0.02, 0.03, 0.04, 0.05, 0.06]);
+        assert!(log_ticks(0.0121, 0.0129).len() == 3);
+        for (lo, hi) in [(1e-5, 2e-5), (3.0, 7.0), (0.9, 1.1), (1.0, 1e6)] {
+            let ticks = log_ticks(lo, hi);
+            assert!(ticks.len() >= 3 && ticks.iter().all(|t| (lo..=hi).contains(t)), "{lo}..{hi}: {ticks:?}");
+        }
+    }
+
+    #[test]
+    fn long_titles_wrap_and_fit() {
+        let title = "how far are t and the barycentrics from the exact answer in single and double precision, \
+                     on near-degenerate and far-from-origin triangles";
+        let lines = wrap(title, TITLE_CHARS_PER_LINE);
+        assert!(lines.len() == 2 && lines.iter().all(|l| l.chars().count() <= TITLE_CHARS_PER_LINE), "{lines:?}");
+        assert_eq!(lines.join(" "), title.split_whitespace().collect::<Vec<_>>().join(" "));
+        // And in the SVG every line is its own text element.
+        let plot = Plot {
+            file: "t.svg".into(),
+            title: title.into(),
+            x_label: "x".into(),
+            y_label: "y".into(),
+            log_x: false,
+            log_y: false,
+            curves: vec![Curve::new("a", vec![(0.0, 1.0), (1.0, 2.0)])],
+            legend: Corner::UpperRight,
+        };
+        let machine = Machine::this(1);
+        let svg = plot.to_svg("scene", &machine).unwrap();
+        assert!(svg.contains(&lines[0]) && svg.contains("near-degenerate"), "{svg}");
+    }
+
+    #[test]
+    fn the_legend_goes_where_it_covers_the_fewest_points() {
+        // A curve that falls from the upper left to the lower right leaves the other two corners free;
+        // one rising through the lower left and upper right leaves the upper left and lower right.
+        let plot = |points: Vec<(f64, f64)>, legend| Plot {
+            file: "t.svg".into(),
+            title: "t".into(),
+            x_label: "x".into(),
+            y_label: "y".into(),
+            log_x: true,
+            log_y: true,
+            curves: vec![Curve::new("a curve", points)],
+            legend,
+        };
+        let falling = plot(vec![(1.0, 100.0), (10.0, 10.0), (100.0, 1.0)], Corner::UpperLeft);
+        let chosen = falling.legend_corner((0.8, 120.0), (0.8, 120.0));
+        assert!(matches!(chosen, Corner::UpperRight | Corner::LowerLeft), "{chosen:?}");
+        let rising = plot(vec![(1.0, 1.0), (10.0, 10.0), (100.0, 100.0)], Corner::UpperRight);
+        let chosen = rising.legend_corner((0.8, 120.0), (0.8, 120.0));
+        assert!(matches!(chosen, Corner::UpperLeft | Corner::LowerRight), "{chosen:?}");
+        // With nothing in the way, the preferred corner stays.
+        let middle = plot(vec![(9.0, 9.0), (11.0, 11.0)], Corner::LowerRight);
+        assert_eq!(middle.legend_corner((0.8, 120.0), (0.8, 120.0)), Corner::LowerRight);
     }
 }

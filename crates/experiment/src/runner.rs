@@ -44,6 +44,16 @@ pub(crate) fn measure(subject: &Subject, settings: &RenderSettings, options: &Op
     point.with("efficiency", error.efficiency(time.median_ms))
 }
 
+/// `(time, RMSE, RMSE min, RMSE max)` of each measured point of `series`, for error-against-time plots.
+pub(crate) fn time_and_error(series: &crate::Series) -> Vec<(Timing, f64, f64, f64)> {
+    series
+        .points
+        .iter()
+        .filter_map(|p| Some((p.time?, p.error?)))
+        .map(|(t, e)| (t, e.rmse, e.rmse_min, e.rmse_max))
+        .collect()
+}
+
 /// Builds `kind` over the subject's triangles `repeats` times; returns the last structure and the timing.
 pub(crate) fn build_timed(
     triangles: &[[rtgi_math::Vec3; 3]],

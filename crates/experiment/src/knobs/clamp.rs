@@ -122,8 +122,7 @@ pub(super) fn run(
         curves: tradeoff
             .iter()
             .map(|(label, time, error)| {
-                Curve::new(label, vec![(time.median_ms, error.rmse)])
-                    .with_bars(vec![Some((error.rmse_min, error.rmse_max))])
+                Curve::error_against_time(label, &[(*time, error.rmse, error.rmse_min, error.rmse_max)])
             })
             .collect(),
         legend: Corner::UpperRight,

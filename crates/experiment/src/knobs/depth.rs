@@ -69,17 +69,7 @@ pub(super) fn run(
         );
         errors
             .push(Curve::new(name, xs().zip(series.points.iter().map(|p| p.error.expect("measured").rmse)).collect()));
-        tradeoff.push(
-            Curve::new(
-                name,
-                series
-                    .points
-                    .iter()
-                    .map(|p| (p.time.expect("measured").median_ms, p.error.expect("measured").rmse))
-                    .collect(),
-            )
-            .with_bars(series.points.iter().map(|p| p.error.map(|e| (e.rmse_min, e.rmse_max))).collect()),
-        );
+        tradeoff.push(Curve::error_against_time(name, &crate::runner::time_and_error(&series)));
         report.series.push(series);
     }
     let mut findings = Vec::new();

@@ -156,8 +156,7 @@ pub(super) fn run(
                 .iter()
                 .map(|p| (p.time.expect("measured").median_ms, p.error.expect("measured").rmse))
                 .collect();
-            let bars = series.points.iter().map(|p| p.error.map(|e| (e.rmse_min, e.rmse_max))).collect();
-            curves.push(Curve::new(strategy.to_string(), xy.clone()).with_bars(bars));
+            curves.push(Curve::error_against_time(strategy.to_string(), &crate::runner::time_and_error(&series)));
             let band = |f: fn(&crate::report::ImageError) -> f64| -> Vec<(f64, f64)> {
                 series
                     .points

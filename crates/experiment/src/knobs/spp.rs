@@ -100,10 +100,7 @@ pub(super) fn run(
             let bars = series.points.iter().map(|p| p.error.map(|e| (e.rmse_min, e.rmse_max))).collect();
             error_curves
                 .push(Curve::new(&label, series.points.iter().map(|p| (p.x, rmse(p))).collect()).with_bars(bars));
-            time_curves.push(Curve::new(
-                sampler.to_string(),
-                series.points.iter().map(|p| (p.time.expect("measured").median_ms, rmse(p))).collect(),
-            ));
+            time_curves.push(Curve::error_against_time(sampler.to_string(), &crate::runner::time_and_error(&series)));
             report.series.push(series);
         }
         // Efficiency at equal samples against the uniform sampler, resolved or not.
