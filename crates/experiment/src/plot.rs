@@ -128,21 +128,36 @@ fn wrap(text: &str, width: usize) -> Vec<String> {
     lines
 }
 
+/// A tick's label: as [`format_number`] writes it, but `2e-5` rather than
+/// `2.000e-5` for small and large values.
+fn format_tick(v: f64) -> String {
+    let text = format_number(v);
+    match text.split_once('e') {
+        Some((mantissa, exponent)) if mantissa.contains('.') => {
+            format!("{}e{exponent}", mantissa.trim_end_matches('0').trim_end_matches('.'))
+        }
+        _ => text,
+    }
+}
+
 /// Labelled ticks for a log axis from `lo` to `hi`: powers of ten, then 1,
 /// 2 and 5 times them, then every integer mantissa, whichever first gives
 /// at least three ticks inside the range.
 fn log_ticks(lo: f64, hi: f64) -> Vec<f64> {
     let (first, last) = (lo.log10().floor() as i32, hi.log10().ceil() as i32);
-    for mantissas in [&[1.0][..], &[1.0, 2.0, 5.0], &[1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 8.0, 9.0]] {
+    let tenths: Vec<f64> = (10..100).map(|m| m as f64 / 10.0).collect();
+    for mantissas in [&[1.0][..], &[1.0, 2.0, 5.0], &[1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 8.0, 9.0], &tenths] {
         let ticks: Vec<f64> = (first..=last)
             .flat_map(|e| mantissas.iter().map(move |m| m * 10f64.powi(e)))
+            // Rounded as printed, so that 0.3 is 0.3 and not 0.30000000000000004.
+            .map(|v| format!("{v:.12e}").parse::<f64>().unwrap_or(v))
             .filter(|v| *v >= lo && *v <= hi)
             .collect();
         if ticks.len() >= 3 {
             return ticks;
         }
     }
-    // Less than a ninth of a decade: the ends and the middle, on a log scale.
+    // Less than a hundredth of a decade: the ends and the middle, on a log scale.
     vec![lo, (lo * hi).sqrt(), hi]
 }
 
@@ -267,7 +282,13 @@ impl Plot {
                             (p[0].0 + t * (p[1].0 - p[0].0), p[0].1 + t * (p[1].1 - p[0].1))
                         })
                     });
-                    c.points.iter().copied().chain(along).collect::<Vec<_>>()
+                    // Error bars hide under a legend too: their ends and middles.
+                    let bars = c.points.iter().zip(&c.bars).filter_map(|(&(x, _), bar)| {
+                        bar.map(|(lo, hi)| {
+                            [(x, lo), (x, hi), (x, if self.log_y { (lo * hi).sqrt() } else { (lo + hi) / 2.0 })]
+                        })
+                    });
+                    c.points.iter().copied().chain(along).chain(bars.flatten()).collect::<Vec<_>>()
                 })
                 .filter(|&(x, y)| x.is_finite() && y.is_finite() && inside(x, y))
                 .count()
@@ -294,8 +315,8 @@ impl Plot {
             // One light line between labelled ticks at most: denser ones drew grey bands.
             .max_light_lines(1)
             .light_line_style(RGBColor(242, 242, 242))
-            .x_label_formatter(&|v| format_number(*v))
-            .y_label_formatter(&|v| format_number(*v))
+            .x_label_formatter(&|v| format_tick(*v))
+            .y_label_formatter(&|v| format_tick(*v))
             .draw()
             .map_err(|e| e.to_string())?;
         for (index, curve) in self.curves.iter().enumerate() {
@@ -331,9 +352,9 @@ impl Plot {
             let x_bars =
                 curve.points.iter().zip(&curve.x_bars).filter_map(|(&(x, y), bar)| bar.map(|(lo, hi)| (x, y, lo, hi)));
             chart
-                .draw_series(x_bars.map(|(_, y, lo, hi)| {
-                    ErrorBar::new_horizontal(y, lo, (lo + hi) / 2.0, hi, colour.stroke_width(1), 8)
-                }))
+                .draw_series(
+                    x_bars.map(|(x, y, lo, hi)| ErrorBar::new_horizontal(y, lo, x, hi, colour.stroke_width(1), 8)),
+                )
                 .map_err(|e| e.to_string())?;
         }
         chart
@@ -359,13 +380,22 @@ mod tests {
     #[test]
     fn log_axes_have_at_least_three_labelled_ticks() {
         assert_eq!(log_ticks(0.05, 200.0), vec![0.1, 1.0, 10.0, 100.0]);
-        // Less than a decade (the depth knob's RMSE): 1-2-5 mantissas, then every integer.
+        // Less than a decade (the depth knob's RMSE): 1-2-5 mantissas, then every integer, then tenths.
         assert_eq!(log_ticks(0.011, 0.06), vec![0.02, 0.03, 0.04, 0.05, 0.06]);
-        assert!(log_ticks(0.0121, 0.0129).len() == 3);
+        assert_eq!(log_ticks(0.109, 0.1616), vec![0.11, 0.12, 0.13, 0.14, 0.15, 0.16]);
+        assert_eq!(log_ticks(0.01211, 0.01219).len(), 3);
         for (lo, hi) in [(1e-5, 2e-5), (3.0, 7.0), (0.9, 1.1), (1.0, 1e6)] {
             let ticks = log_ticks(lo, hi);
             assert!(ticks.len() >= 3 && ticks.iter().all(|t| (lo..=hi).contains(t)), "{lo}..{hi}: {ticks:?}");
         }
+    }
+
+    #[test]
+    fn tick_labels_are_short() {
+        assert_eq!(format_tick(1e-4), "1e-4");
+        assert_eq!(format_tick(2.5e6), "2.5e6");
+        assert_eq!(format_tick(0.02), "0.02");
+        assert_eq!(format_tick(1000.0), "1000");
     }
 
     #[test]
