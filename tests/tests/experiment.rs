@@ -83,6 +83,23 @@ fn every_knob_writes_its_table_json_and_plots() {
         }
     }
     assert_eq!(commits.len(), 1, "every report names the same commit: {commits:?}");
+    // The four equal-time panels: PNGs listed in the JSON, their captions among the findings.
+    for (knob, panel) in [
+        ("spp", "spp-equal-time.png"),
+        ("depth", "depth-equal-time.png"),
+        ("clamp", "clamp-equal-time.png"),
+        ("direct", "direct-small-light-equal-time.png"),
+    ] {
+        let json: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(dir.join(knob).join(format!("{knob}.json"))).unwrap())
+                .unwrap();
+        assert!(json["panels"].as_array().unwrap().iter().any(|p| p["file"] == panel), "{knob}: {}", json["panels"]);
+        assert!(json["findings"].to_string().contains(panel), "{knob}: no caption for {panel}");
+        let png = image::open(dir.join(knob).join(panel)).unwrap_or_else(|e| panic!("{knob}/{panel}: {e}"));
+        assert!(png.width() > png.height(), "{knob}/{panel}: a row of tiles");
+    }
+    // The scene's Pareto plot, from every knob measured on it.
+    check_svg(&dir.join("pareto/built-in-cornell-box.svg"), &["Pareto front", "spp (", "depth (", "clamp ("]);
     // The curves that the knobs promise.
     check_svg(
         &dir.join("spp/spp-error.svg"),

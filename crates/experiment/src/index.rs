@@ -214,6 +214,9 @@ pub fn index_markdown(folder: &Path) -> Result<String, ExperimentError> {
         for plot in &report.plots {
             let _ = writeln!(md, "![{}]({prefix}{})\n", plot.title, plot.file);
         }
+        for panel in &report.panels {
+            let _ = writeln!(md, "![{}]({prefix}{})\n", panel.title, panel.file);
+        }
         for finding in &report.findings {
             let _ = writeln!(md, "- {finding}");
         }

@@ -9,6 +9,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::ExperimentError;
 use crate::machine::Machine;
+use crate::panel::Panel;
 use crate::plot::Plot;
 use crate::provenance::Build;
 pub use crate::stats::ImageError;
@@ -212,6 +213,42 @@ pub struct Report {
     /// The plots: in JSON, their file names and titles.
     #[serde(with = "plot_files")]
     pub plots: Vec<Plot>,
+    /// Equal-time image panels (PNG): in JSON, their file names and titles;
+    /// their captions are findings.
+    #[serde(with = "panel_files", default)]
+    pub panels: Vec<Panel>,
+}
+
+/// A panel in a report's JSON: its file and title.
+mod panel_files {
+    use serde::{Deserialize, Deserializer, Serialize, Serializer};
+
+    use crate::panel::{Crop, Panel};
+
+    #[derive(Serialize, Deserialize)]
+    struct PanelFile {
+        file: String,
+        title: String,
+    }
+
+    pub(super) fn serialize<S: Serializer>(panels: &[Panel], serializer: S) -> Result<S::Ok, S::Error> {
+        serializer.collect_seq(panels.iter().map(|p| PanelFile { file: p.file.clone(), title: p.title.clone() }))
+    }
+
+    pub(super) fn deserialize<'de, D: Deserializer<'de>>(deserializer: D) -> Result<Vec<Panel>, D::Error> {
+        let files = Vec::<PanelFile>::deserialize(deserializer)?;
+        Ok(files
+            .into_iter()
+            .map(|f| Panel {
+                file: f.file,
+                title: f.title,
+                reference: rtgi_image::HdrImage::new(1, 1),
+                entries: Vec::new(),
+                crop: Crop { x: 0, y: 0, side: 1 },
+                scale: 0.0,
+            })
+            .collect())
+    }
 }
 
 /// A plot in a report's JSON: its file and title.
@@ -342,6 +379,11 @@ impl Report {
         let json = serde_json::to_string_pretty(self).expect("reports serialise");
         write(&format!("{}.json", self.knob), &json)?;
         write(&format!("{}.md", self.knob), &self.markdown())?;
+        for panel in &self.panels {
+            let path = folder.join(&panel.file);
+            panel.write(&path)?;
+            written.push(path);
+        }
         Ok(written)
     }
 
@@ -407,6 +449,9 @@ impl Report {
         }
         for plot in &self.plots {
             let _ = writeln!(md, "![{}]({})\n", plot.title, plot.file);
+        }
+        for panel in &self.panels {
+            let _ = writeln!(md, "![{}]({})\n", panel.title, panel.file);
         }
         for table in &self.tables {
             let _ = writeln!(md, "## {}\n", table.title);

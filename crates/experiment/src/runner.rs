@@ -44,6 +44,32 @@ pub(crate) fn measure(subject: &Subject, settings: &RenderSettings, options: &Op
     point.with("efficiency", error.efficiency(time.median_ms))
 }
 
+/// Renders each configuration once (seed 0) with as many samples per pixel
+/// as fit `budget_ms` at its measured milliseconds per sample: the entries
+/// of an equal-time panel, with the time each actually took.
+pub(crate) fn equal_time(
+    subject: &Subject,
+    reference: &Reference,
+    configurations: &[(String, RenderSettings, f64)],
+    budget_ms: f64,
+) -> Vec<crate::panel::Entry> {
+    configurations
+        .iter()
+        .map(|(label, settings, ms_per_sample)| {
+            let spp = (budget_ms / ms_per_sample.max(1e-9)).round().clamp(1.0, 65_536.0) as u32;
+            let (image, time_ms) =
+                render(subject, &RenderSettings { samples_per_pixel: spp, seed: 0, ..settings.clone() });
+            let rmse = rtgi_image::compare(&image, &reference.image).expect("same size").rmse;
+            crate::panel::Entry { label: format!("{label}, {spp} spp"), image, time_ms, rmse }
+        })
+        .collect()
+}
+
+/// A measured point's median milliseconds per sample per pixel.
+pub(crate) fn ms_per_sample(point: &Point, samples_per_pixel: u32) -> f64 {
+    point.time.expect("measured").median_ms / samples_per_pixel.max(1) as f64
+}
+
 /// `(time, RMSE, RMSE min, RMSE max)` of each measured point of `series`, for error-against-time plots.
 pub(crate) fn time_and_error(series: &crate::Series) -> Vec<(Timing, f64, f64, f64)> {
     series

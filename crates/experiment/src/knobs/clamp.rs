@@ -74,9 +74,13 @@ pub(super) fn run(
     }
     // The clamp with the least MSE against no clamp, in efficiency.
     let (none, clamped) = series.points.split_first().expect("the unclamped point");
-    if let Some(best) =
-        clamped.iter().min_by(|a, b| a.error.expect("measured").mse().total_cmp(&b.error.expect("measured").mse()))
-    {
+    let series_best = 1
+        + (0..clamped.len())
+            .min_by(|&a, &b| {
+                clamped[a].error.expect("measured").mse().total_cmp(&clamped[b].error.expect("measured").mse())
+            })
+            .unwrap_or(0);
+    if let Some(best) = clamped.get(series_best - 1) {
         let e = best.error.expect("measured");
         report.findings.push(format!(
             "at {spp} spp the clamp at {} has the least MSE: bias² {}, variance {} against the unclamped {} and {}; {}",
@@ -127,6 +131,31 @@ pub(super) fn run(
             .collect(),
         legend: Corner::UpperRight,
     });
+    // The equal-time panel: no clamp, the harshest, the best and a mild one, in the unclamped render's time.
+    let budget = points[0].2.time.expect("measured").median_ms;
+    let best = series_best;
+    let mut chosen: Vec<usize> = vec![0, 1, best, points.len() - 1];
+    chosen.dedup();
+    chosen.sort_unstable();
+    chosen.dedup();
+    let configurations: Vec<(String, RenderSettings, f64)> = chosen
+        .iter()
+        .map(|&i| {
+            let (label, limit, point) = &points[i];
+            let clamp = limit.is_finite().then_some(*limit as f32);
+            let settings = RenderSettings { indirect_clamp: clamp, ..base.clone() };
+            (format!("clamp {label}"), settings, crate::runner::ms_per_sample(point, spp))
+        })
+        .collect();
+    let entries = crate::runner::equal_time(subject, &reference, &configurations, budget);
+    let panel = crate::panel::Panel::new(
+        "clamp-equal-time.png",
+        format!("Clamps at equal time ({} ms)", crate::report::format_ms(budget)),
+        reference.image.clone(),
+        entries,
+    );
+    report.findings.push(panel.caption());
+    report.panels.push(panel);
     report.tables.push(table);
     report.reference = Some(reference.info);
     Ok(report)

@@ -154,6 +154,34 @@ pub(super) fn run(
         curves: errors,
         legend: Corner::UpperRight,
     });
+    // The equal-time panel: the deepest depth with and without roulette, and
+    // a shallow one (biased: missing energy), in the time roulette takes at the deepest.
+    let deepest = *depths.last().expect("depths");
+    let shallow = depths[depths.len().min(2) - 1];
+    if let [on, off] = &report.series[..]
+        && let (Some(deep_on), Some(deep_off), Some(shallow_on)) =
+            (on.points.last(), off.points.last(), on.points.iter().find(|p| p.x == shallow as f64))
+    {
+        let budget = deep_on.time.expect("measured").median_ms;
+        let configuration = |label: String, depth: u32, roulette: bool, point: &crate::Point| {
+            let settings = RenderSettings { max_depth: depth, russian_roulette: roulette, ..base.clone() };
+            (label, settings, crate::runner::ms_per_sample(point, spp))
+        };
+        let configurations = vec![
+            configuration(format!("depth {deepest}, roulette on"), deepest, true, deep_on),
+            configuration(format!("depth {deepest}, roulette off"), deepest, false, deep_off),
+            configuration(format!("depth {shallow}, roulette on"), shallow, true, shallow_on),
+        ];
+        let entries = crate::runner::equal_time(subject, &reference, &configurations, budget);
+        let panel = crate::panel::Panel::new(
+            "depth-equal-time.png",
+            format!("Depth and Russian roulette at equal time ({} ms)", crate::report::format_ms(budget)),
+            reference.image.clone(),
+            entries,
+        );
+        report.findings.push(panel.caption());
+        report.panels.push(panel);
+    }
     report.tables.push(table);
     report.reference = Some(reference.info);
     Ok(report)

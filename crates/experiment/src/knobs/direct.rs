@@ -240,6 +240,26 @@ pub(super) fn run(
             curves,
             legend: Corner::UpperRight,
         });
+        // The equal-time panel: each strategy given the budget at its measured time per sample.
+        let scene_series = &report.series[report.series.len() - strategies.len()..];
+        let configurations: Vec<(String, RenderSettings, f64)> = strategies
+            .iter()
+            .zip(scene_series)
+            .filter_map(|(&strategy, series)| {
+                let last = series.points.last()?;
+                let settings = RenderSettings { direct_strategy: strategy, ..scene_subject.settings.clone() };
+                Some((strategy.to_string(), settings, crate::runner::ms_per_sample(last, last.x as u32)))
+            })
+            .collect();
+        let entries = crate::runner::equal_time(&scene_subject, &reference, &configurations, budget);
+        let panel = crate::panel::Panel::new(
+            format!("direct-{name}-equal-time.png"),
+            format!("Direct light, {name}, at equal time ({} ms)", format_ms(budget)),
+            reference.image.clone(),
+            entries,
+        );
+        report.findings.push(panel.caption());
+        report.panels.push(panel);
         report.tables.push(table);
     }
     report.tables.insert(0, summary);

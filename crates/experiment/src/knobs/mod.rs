@@ -151,6 +151,7 @@ pub(crate) fn run(
         findings: Vec::new(),
         tables: Vec::new(),
         plots: Vec::new(),
+        panels: Vec::new(),
     };
     let mut report = match knob {
         Knob::Spp => spp::run(subject, options, report, progress),

@@ -40,7 +40,7 @@ pub(super) fn run(
     if subject.settings.integrator != Integrator::Primary {
         integrands.push(("camera ray only", Integrator::Primary, "-pixel"));
     }
-    let mut steps = Steps::new(integrands.len() * (1 + SAMPLERS.len() * counts.len()), progress);
+    let mut steps = Steps::new(1 + integrands.len() * (1 + SAMPLERS.len() * counts.len()), progress);
     for (integrand, integrator, suffix) in integrands {
         let base = RenderSettings { integrator, ..subject.settings.clone() };
         steps.next(&format!("{integrand}: reference"));
@@ -150,6 +150,32 @@ pub(super) fn run(
         });
         report.tables.push(table);
         if integrator == subject.settings.integrator {
+            // Equal time: every sampler given the time stratified sampling takes at the compared count.
+            let at_count = |sampler: PixelSampler| {
+                report.series.iter().rev().find(|s| s.name == format!("{sampler}, {integrand}")).and_then(|s| {
+                    s.points.iter().find(|p| p.x == COMPARED_AT.min(*counts.last().expect("counts") as f64))
+                })
+            };
+            if let Some(budget) = at_count(PixelSampler::Stratified).and_then(|p| p.time).map(|t| t.median_ms) {
+                let configurations: Vec<(String, RenderSettings, f64)> = SAMPLERS
+                    .iter()
+                    .filter_map(|&sampler| {
+                        let point = at_count(sampler)?;
+                        let settings = RenderSettings { sampler, ..base.clone() };
+                        Some((sampler.to_string(), settings, crate::runner::ms_per_sample(point, point.x as u32)))
+                    })
+                    .collect();
+                steps.next("equal-time panel");
+                let entries = crate::runner::equal_time(subject, &reference, &configurations, budget);
+                let panel = crate::panel::Panel::new(
+                    "spp-equal-time.png",
+                    format!("The samplers at equal time ({} ms)", crate::report::format_ms(budget)),
+                    reference.image.clone(),
+                    entries,
+                );
+                report.findings.push(panel.caption());
+                report.panels.push(panel);
+            }
             report.reference = Some(reference.info);
         }
     }
