@@ -104,3 +104,25 @@ fn naming_embree_without_the_feature_says_how_to_enable_it() {
     }
     assert!(!out.exists());
 }
+
+#[cfg(feature = "embree")]
+#[test]
+fn the_accel_and_scaling_experiments_measure_embree_beside_ours() {
+    let dir = scratch_dir("embree-experiments");
+    for knob in ["accel", "scaling"] {
+        let out = dir.join(knob);
+        let run = rtgi(&["experiment", knob, "--quick", "--repeats", "1", "--out", s(&out)]);
+        assert!(run.success, "{run:?}");
+        let json: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(out.join(format!("{knob}.json"))).unwrap()).unwrap();
+        let series = json["series"].as_array().unwrap();
+        let embree = series.iter().find(|s| s["name"] == "embree").unwrap_or_else(|| panic!("{knob}: no embree"));
+        for point in embree["points"].as_array().unwrap() {
+            let bytes = point["values"]["bytes_per_triangle"].as_f64().unwrap();
+            assert!(bytes > 0.0, "{knob}: Embree's memory per triangle {bytes}");
+        }
+    }
+    let accel = std::fs::read_to_string(dir.join("accel/accel.md")).unwrap();
+    assert!(accel.contains("embree (a peer, outside the exactness contract)"), "{accel}");
+    assert!(accel.contains("accel-total.svg") && accel.contains("pays for it from"), "{accel}");
+}

@@ -3,7 +3,11 @@
 //! batch API, which traces coherent rays of the wide BVHs as packets),
 //! nodes visited and triangles tested per ray, and how many answers differ
 //! from the linear scan's (zero for every structure of the contract: the
-//! structures cost time, not accuracy).
+//! structures cost time, not accuracy). The peers built in (Embree, with
+//! the `embree` feature) are measured on the same rays, outside the
+//! contract. Each structure reports its memory per triangle, build plus N
+//! rays' trace time, and the ray count from which a structure that builds
+//! slower but traces faster pays for its build.
 
 use rayon::prelude::*;
 use rtgi_accel::{Accel, AccelKind, BuildParams, Hit, TraversalCounters};
@@ -14,6 +18,7 @@ use crate::plot::{Corner, Curve, Plot};
 use crate::report::{Point, Report, Series, Table, format_ms, format_number};
 use crate::runner::{build_timed, time_rays};
 use crate::stats::Timing;
+use crate::verdict::{Spread, compare};
 use crate::{ExperimentError, Options, Steps, Subject};
 
 /// Rays the linear scan answers, evenly spaced through each batch: the
@@ -22,6 +27,9 @@ const LINEAR_TRIANGLE_TESTS: usize = 200_000_000;
 
 /// Rays whose nodes visited and triangles tested are counted, per batch.
 const COUNTED_RAYS: usize = 100_000;
+
+/// Ray counts of the build + trace totals.
+const TOTAL_RAYS: [f64; 3] = [1e3, 1e6, 1e9];
 
 /// The structures and parameters measured: each structure with its
 /// defaults, then leaf sizes of the SAH and bvh8 builds, then SAH bin counts.
@@ -32,6 +40,9 @@ fn configurations(triangles: usize, quick: bool) -> Vec<(String, AccelKind, Buil
         if kind == AccelKind::SahSweep && triangles > 200_000 {
             continue;
         }
+        list.push((kind.name().to_owned(), kind, kind.default_params()));
+    }
+    for &kind in AccelKind::PEERS {
         list.push((kind.name().to_owned(), kind, kind.default_params()));
     }
     let leaf_sizes: &[usize] = if quick { &[1, 16] } else { &[1, 2, 4, 8, 16] };
@@ -112,6 +123,8 @@ pub(super) fn run(
             "nodes/ray (camera, incoh.)",
             "triangles/ray (camera, incoh.)",
             "disagreements",
+            "bytes/triangle",
+            "build + 10⁶ incoherent rays ms",
         ]
         .map(String::from)
         .to_vec(),
@@ -121,6 +134,7 @@ pub(super) fn run(
     for (index, (name, kind, params)) in configurations.iter().enumerate() {
         steps.next(name);
         let (accel, build) = build_timed(&triangles, *kind, params, repeats)?;
+        let bytes_per_triangle = accel.build_stats().memory_bytes as f64 / triangles.len().max(1) as f64;
         let mut point = Point::new(index as f64, name.clone());
         point.time = Some(build);
         let mut cells = vec![
@@ -181,34 +195,138 @@ pub(super) fn run(
         cells.push(tests.join(", "));
         let wrong = point.values["camera_disagreements"] + point.values["incoherent_disagreements"];
         cells.push(format!("{wrong}"));
+        if kind.is_peer() {
+            // A peer's backend counts no nodes or triangle tests.
+            let len = cells.len();
+            cells[len - 3] = "–".into();
+            cells[len - 2] = "–".into();
+        }
+        // Build, then N incoherent rays one at a time on all threads.
+        let ms_per_ray = 1.0 / (point.values["incoherent_mrays"] * 1e3);
+        for n in TOTAL_RAYS {
+            point = point.with(&format!("total_ms_{n:e}"), build.median_ms + n * ms_per_ray);
+        }
+        point = point.with("bytes_per_triangle", bytes_per_triangle).with("incoherent_ms_per_ray", ms_per_ray);
+        if kind.is_peer() {
+            point = point.with("peer", 1.0);
+        }
+        cells.push(format_number(bytes_per_triangle));
+        cells.push(format_ms(build.median_ms + 1e6 * ms_per_ray));
         table.rows.push(cells);
         report.series.push(Series { name: name.clone(), points: vec![point] });
     }
+    let ours = |s: &&Series| !s.points[0].values.contains_key("peer");
     let total_wrong: f64 = report
         .series
         .iter()
+        .filter(ours)
         .flat_map(|s| &s.points)
         .map(|p| p.values["camera_disagreements"] + p.values["incoherent_disagreements"])
         .sum();
     report.findings.push(format!(
-        "{} configurations; {} answers (single-ray and batch) differ from the linear scan's in any bit",
-        report.series.len(),
+        "{} configurations of ours; {} answers (single-ray and batch) differ from the linear scan's in any bit",
+        report.series.iter().filter(ours).count(),
         total_wrong
     ));
-    if let Some(fastest) = report
-        .series
-        .iter()
-        .flat_map(|s| &s.points)
-        .max_by(|a, b| a.values["incoherent_mrays"].total_cmp(&b.values["incoherent_mrays"]))
-    {
+    for peer in report.series.iter().filter(|s| !ours(s)) {
+        let p = &peer.points[0];
+        let checked = p.values["camera_rays_checked"] + p.values["incoherent_rays_checked"];
         report.findings.push(format!(
-            "fastest on incoherent rays: {} ({:.2} Mrays/s, build {} ms)",
-            fastest.label,
-            fastest.values["incoherent_mrays"],
-            format_ms(fastest.time.expect("measured").median_ms)
+            "{} (a peer, outside the exactness contract): {} of {} answers differ from the linear scan's in some bit",
+            peer.name,
+            p.values["camera_disagreements"] + p.values["incoherent_disagreements"],
+            2.0 * checked
         ));
     }
-    let defaults: Vec<&Series> = report.series.iter().take(AccelKind::ALL.len()).collect();
+    // The fastest on incoherent rays, and whether the runner-up is told apart from it.
+    let mut by_speed: Vec<&Point> = report.series.iter().flat_map(|s| &s.points).collect();
+    by_speed.sort_by(|a, b| b.values["incoherent_mrays"].total_cmp(&a.values["incoherent_mrays"]));
+    if let [fastest, second, ..] = &by_speed[..] {
+        let spread = |p: &Point| Spread {
+            value: p.values["incoherent_mrays"],
+            low: p.values["incoherent_mrays_min"],
+            high: p.values["incoherent_mrays_max"],
+        };
+        report.findings.push(format!(
+            "incoherent rays, the two fastest: {}",
+            compare("throughput", &fastest.label, &spread(fastest), &second.label, &spread(second))
+        ));
+    }
+    // One configuration per structure with its defaults (and the peers), whatever was skipped.
+    let defaults: Vec<&Series> = report
+        .series
+        .iter()
+        .filter(|s| AccelKind::ALL.iter().chain(AccelKind::PEERS).any(|k| k.name() == s.name))
+        .collect();
+    // Build + N rays: where a structure that builds slower but traces
+    // faster than the next cheaper one pays for its build.
+    let mut by_build: Vec<&Point> = defaults.iter().map(|s| &s.points[0]).collect();
+    by_build.sort_by(|a, b| a.time.expect("measured").median_ms.total_cmp(&b.time.expect("measured").median_ms));
+    for pair in by_build.windows(2) {
+        let (cheap, dear) = (pair[0], pair[1]);
+        let (build_cheap, build_dear) =
+            (cheap.time.expect("measured").median_ms, dear.time.expect("measured").median_ms);
+        let (ray_cheap, ray_dear) = (cheap.values["incoherent_ms_per_ray"], dear.values["incoherent_ms_per_ray"]);
+        if ray_dear < ray_cheap {
+            let rays = (build_dear - build_cheap) / (ray_cheap - ray_dear);
+            report.findings.push(format!(
+                "{} builds in {} ms more than {} and pays for it from {} incoherent rays on",
+                dear.label,
+                format_ms(build_dear - build_cheap),
+                cheap.label,
+                format_number(rays.max(0.0))
+            ));
+        }
+    }
+    let totals: Vec<Curve> = defaults
+        .iter()
+        .map(|s| {
+            let p = &s.points[0];
+            let build = p.time.expect("measured").median_ms;
+            let per_ray = p.values["incoherent_ms_per_ray"];
+            let ns: Vec<f64> = (0..=18).map(|k| 10f64.powf(k as f64 * 0.5)).collect();
+            Curve::guide(s.name.clone(), ns.iter().map(|&n| (n, build + n * per_ray)).collect())
+        })
+        .collect();
+    report.plots.push(Plot {
+        file: "accel-total.svg".into(),
+        title: "Build plus trace time against the rays traced (incoherent, one at a time)".into(),
+        x_label: "incoherent rays traced".into(),
+        y_label: "build + trace time (ms)".into(),
+        log_x: true,
+        log_y: true,
+        curves: totals,
+        legend: Corner::UpperLeft,
+    });
+    // Error against time: the fraction of answers that differ from the
+    // linear scan's in any bit, against the time per incoherent ray.
+    let errors: Vec<Curve> = defaults
+        .iter()
+        .map(|s| {
+            let p = &s.points[0];
+            let checked = 2.0 * (p.values["camera_rays_checked"] + p.values["incoherent_rays_checked"]);
+            let wrong = p.values["camera_disagreements"] + p.values["incoherent_disagreements"];
+            let ns = p.values["incoherent_ms_per_ray"] * 1e6;
+            let spread = (1e3 / p.values["incoherent_mrays_max"], 1e3 / p.values["incoherent_mrays_min"]);
+            Curve::new(s.name.clone(), vec![(ns, wrong / checked.max(1.0))]).with_x_bars(vec![Some(spread)])
+        })
+        .collect();
+    let all_exact = errors.iter().all(|c| c.points[0].1 == 0.0);
+    report.plots.push(Plot {
+        file: "accel-error-time.svg".into(),
+        title: if all_exact {
+            "Answers differing from the linear scan against time per ray: 0 for every structure".into()
+        } else {
+            "Answers differing from the linear scan against time per ray".into()
+        },
+        x_label: "time per incoherent ray (ns, all threads; bars min–max)".into(),
+        y_label: "fraction of answers differing in any bit".into(),
+        log_x: true,
+        log_y: false,
+        curves: errors,
+        legend: Corner::UpperRight,
+    });
+
     let per_batch = |batch: &str| -> Vec<Curve> {
         let label = |s: &&Series| s.name.clone();
         defaults

@@ -15,7 +15,7 @@ use rtgi_math::{Ray, Rng, Vec3, uniform_sphere};
 
 use crate::plot::{Corner, Curve, Plot};
 use crate::report::{Point, Report, Series, Table, format_ms, format_number};
-use crate::stats::{PowerLaw, Timing};
+use crate::stats::Timing;
 use crate::{ExperimentError, Options, Steps};
 
 /// A unit sphere of about `count` triangles: `rows` bands of `2 rows`
@@ -78,13 +78,19 @@ pub(super) fn run(options: &Options, mut report: Report, progress: &dyn Fn(&str)
     };
     let ray_count = if options.quick { 2000 } else { 200_000 };
     let all_rays = rays(ray_count, 7);
-    let kinds = [AccelKind::Linear, AccelKind::Sah, AccelKind::Bvh8];
+    // Ours, then the peers built in (Embree with the `embree` feature), on the same rays.
+    let kinds: Vec<AccelKind> = [AccelKind::Linear, AccelKind::Sah, AccelKind::Bvh8]
+        .into_iter()
+        .chain(AccelKind::PEERS.iter().copied())
+        .collect();
     let mut steps = Steps::new(counts.len() * kinds.len(), progress);
     let mut series: Vec<Series> =
         kinds.iter().map(|k| Series { name: k.name().to_owned(), points: Vec::new() }).collect();
     let mut table = Table {
         title: "time per ray (ns, median with min and max) and build time".into(),
-        header: ["triangles", "structure", "ns per ray", "build ms", "rays timed"].map(String::from).to_vec(),
+        header: ["triangles", "structure", "ns per ray", "build ms", "bytes per triangle", "rays timed"]
+            .map(String::from)
+            .to_vec(),
         rows: Vec::new(),
     };
     for &count in &counts {
@@ -93,8 +99,11 @@ pub(super) fn run(options: &Options, mut report: Report, progress: &dyn Fn(&str)
             steps.next(&format!("{kind} over {} triangles", triangles.len()));
             let params = kind.default_params();
             let start = Instant::now();
-            let accel = kind.build(&triangles, &BuildParams { ..params });
+            let accel = kind
+                .try_build(&triangles, &BuildParams { ..params })
+                .map_err(|e| ExperimentError::Build(e.to_string()))?;
             let build_ms = start.elapsed().as_secs_f64() * 1e3;
+            let bytes_per_triangle = accel.build_stats().memory_bytes as f64 / triangles.len() as f64;
             let limit = if *kind == AccelKind::Linear {
                 (LINEAR_BUDGET / triangles.len()).clamp(64, ray_count)
             } else {
@@ -116,6 +125,7 @@ pub(super) fn run(options: &Options, mut report: Report, progress: &dyn Fn(&str)
                 .with("ns_per_ray_min", per_ray(timing.min_ms))
                 .with("ns_per_ray_max", per_ray(timing.max_ms))
                 .with("build_ms", build_ms)
+                .with("bytes_per_triangle", bytes_per_triangle)
                 .with("rays_timed", rays.len() as f64);
             point.time = Some(timing);
             table.rows.push(vec![
@@ -128,6 +138,7 @@ pub(super) fn run(options: &Options, mut report: Report, progress: &dyn Fn(&str)
                     format_number(per_ray(timing.max_ms))
                 ),
                 format_ms(build_ms),
+                format_number(bytes_per_triangle),
                 rays.len().to_string(),
             ]);
             series.points.push(point);
@@ -137,13 +148,14 @@ pub(super) fn run(options: &Options, mut report: Report, progress: &dyn Fn(&str)
     for s in &series {
         let xy: Vec<(f64, f64)> = s.points.iter().map(|p| (p.x, p.values["ns_per_ray"])).collect();
         let large: Vec<(f64, f64)> = xy.iter().copied().filter(|p| p.0 >= LARGE).collect();
-        let label = match PowerLaw::fit(&large) {
+        let quantity = format!("time per ray against triangles (meshes of {LARGE} triangles or more)");
+        let label = match report.fit(&s.name, &quantity, xy.len(), &large) {
             Some(fit) => {
                 report.findings.push(format!(
-                    "{}: time per ray ∝ n^{:.3}, fitted over the {} meshes of {LARGE} triangles or more",
-                    s.name, fit.exponent, fit.points
+                    "{}: time per ray ∝ n^{:.3} ± {:.3}, fitted over the {} meshes of {LARGE} triangles or more",
+                    s.name, fit.law.exponent, fit.law.standard_error, fit.law.points
                 ));
-                format!("{} (n^{:.2})", s.name, fit.exponent)
+                format!("{} (n^{:.2})", s.name, fit.law.exponent)
             }
             None => s.name.clone(),
         };
@@ -165,7 +177,8 @@ pub(super) fn run(options: &Options, mut report: Report, progress: &dyn Fn(&str)
             .filter(|p| p.x >= LARGE && p.x * TRIANGLE_BYTES <= CACHED_BYTES)
             .map(|p| (p.x, p.values["ns_per_ray"]))
             .collect();
-        if let Some(fit) = PowerLaw::fit(&cached) {
+        let quantity = "time per ray against triangles, linear scan, triangles in cache";
+        if let Some(fit) = report.fit("linear", quantity, linear.points.len(), &cached).map(|f| f.law) {
             report.findings.push(format!(
                 "linear: time per ray ∝ n^{:.3} over the {} meshes from {LARGE} triangles up whose triangles take at most {} MiB",
                 fit.exponent,
