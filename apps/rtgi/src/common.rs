@@ -5,9 +5,8 @@ use std::time::Instant;
 
 use anyhow::{Context, Result, bail};
 use rtgi_accel::Accel;
-use rtgi_render::{
-    DEFAULT_VERTICAL_FOV_DEGREES, EnvironmentSpec, RenderSettings, camera_blocked, default_camera, frame_scene,
-};
+use rtgi_render::RenderSettings;
+use rtgi_render::recipe::{self, CameraChoice, ChosenCamera, Lighting, Prepared};
 use rtgi_scene::{Camera, LoadOptions, Scene};
 
 use crate::cli::{CameraArgs, LightingArgs};
@@ -77,69 +76,70 @@ pub(crate) fn check_output_folder(path: &Path) -> Result<()> {
     Ok(())
 }
 
-/// The scene's first camera, or an automatic framing, with any camera
-/// options applied on top.
-pub(crate) fn choose_camera(scene: &Scene, accel: &dyn Accel, options: &CameraArgs, aspect: f32) -> Result<Camera> {
-    let chosen = match options.camera {
-        Some(index) if index >= scene.cameras.len() => {
-            bail!("--camera {index}: the scene has {} camera(s), numbered from 0", scene.cameras.len())
-        }
-        Some(index) => scene.cameras.get(index),
-        None => scene.cameras.first(),
-    };
-    let fov = match options.fov {
-        Some(degrees) if !(degrees > 0.0 && degrees < 180.0) => {
-            bail!("--fov {degrees}: the field of view must be between 0 and 180 degrees")
-        }
-        Some(degrees) => degrees.to_radians(),
-        None => chosen.map_or(DEFAULT_VERTICAL_FOV_DEGREES.to_radians(), |c| c.vertical_fov),
-    };
-    let automatic = chosen.is_none() && options.at.is_none();
-    let mut camera = match chosen {
-        Some(camera) => *camera,
-        None if options.fov.is_none() => default_camera(scene, accel, aspect),
-        None => frame_scene(scene, accel, fov, aspect),
-    };
-    camera.vertical_fov = fov;
-    if let Some(up) = options.up {
-        camera.up = up;
+impl CameraArgs {
+    /// The camera options as the recipe takes them.
+    pub(crate) fn choice(&self) -> CameraChoice {
+        CameraChoice { index: self.camera, at: self.at, look: self.look, up: self.up, fov_degrees: self.fov }
     }
-    if let Some(at) = options.at {
-        camera.position = at;
-        if options.look.is_none() {
-            camera.direction = scene.bounds().centroid() - at;
+}
+
+impl LightingArgs {
+    /// The lighting options as the recipe takes them.
+    pub(crate) fn lighting(&self) -> Lighting {
+        Lighting {
+            lights: self.lights.clone(),
+            integrator: self.integrator,
+            max_depth: self.max_depth,
+            direct_strategy: self.direct_strategy,
+            indirect_clamp: self.clamp_indirect,
+            environment: self.environment.clone(),
+            effects: self.effects.clone(),
         }
     }
-    if let Some(look) = options.look {
-        camera.direction = look - camera.position;
-    }
-    if !camera.is_valid() {
-        bail!("the camera is degenerate: it must look somewhere other than its own position, and not along --up");
-    }
-    // The automatic framing avoids such views itself; a camera from the file
-    // or the options is kept, but said to be buried.
-    if !automatic && let Some(fraction) = camera_blocked(scene, accel, &camera, aspect) {
+}
+
+/// Warns that a camera from the file or the options seems to be inside geometry.
+pub(crate) fn warn_if_blocked(chosen: &ChosenCamera) {
+    if let Some(fraction) = chosen.blocked {
         eprintln!(
             "warning: the camera seems to be inside geometry: {:.0}% of the rays through its view hit the back of a \
              surface or start against one; move it with --at (and --look)",
             100.0 * fraction
         );
     }
-    Ok(camera)
 }
 
-/// Applies the lighting options: adds the `--light`s to the scene and sets
-/// the integrator, depth, strategy, environment (reading its file) and
-/// effect overrides of `settings`.
+/// The scene's first camera, or an automatic framing, with any camera
+/// options applied on top ([`rtgi_render::recipe::choose_camera`]); warns
+/// when a given camera seems buried.
+pub(crate) fn choose_camera(scene: &Scene, accel: &dyn Accel, options: &CameraArgs, aspect: f32) -> Result<Camera> {
+    let chosen = recipe::choose_camera(scene, accel, &options.choice(), aspect)?;
+    warn_if_blocked(&chosen);
+    Ok(chosen.camera)
+}
+
+/// Applies the lighting options ([`rtgi_render::recipe::apply_lighting`]).
 pub(crate) fn apply_lighting(args: &LightingArgs, scene: &mut Scene, settings: &mut RenderSettings) -> Result<()> {
-    scene.lights.extend(args.lights.iter().cloned());
-    settings.integrator = args.integrator;
-    settings.max_depth = args.max_depth;
-    settings.direct_strategy = args.direct_strategy;
-    settings.indirect_clamp = args.clamp_indirect;
-    settings.effects = args.effects.clone();
-    settings.environment = args.environment.as_ref().map(EnvironmentSpec::load).transpose()?;
-    Ok(())
+    Ok(recipe::apply_lighting(&args.lighting(), scene, settings)?)
+}
+
+/// Everything from loaded options to a scene ready to render, as `rtgi
+/// render` prepares it: lighting applied, structure built (in `pool`),
+/// camera chosen and the lamp of an enclosed camera added. `settings` holds
+/// the size, samples, sampler and seed; the lighting options are applied to it.
+pub(crate) fn prepare_render(
+    scene: &mut Scene,
+    settings: &mut RenderSettings,
+    lighting: &LightingArgs,
+    camera: &CameraArgs,
+    accel: &crate::cli::AccelArgs,
+    pool: &rayon::ThreadPool,
+) -> Result<(Box<dyn Accel>, Prepared)> {
+    apply_lighting(lighting, scene, settings)?;
+    let built = pool.install(|| accel.build(scene))?;
+    let prepared = recipe::prepare(scene, built.as_ref(), settings, &camera.choice())?;
+    warn_if_blocked(&prepared.camera);
+    Ok((built, prepared))
 }
 
 /// Whether `a` and `b` name the same file, following links; a file that

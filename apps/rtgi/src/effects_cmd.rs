@@ -15,7 +15,7 @@ use rtgi_render::{EffectPlan, RenderSettings, render};
 use serde::Serialize;
 
 use crate::cli::BenchEffectsArgs;
-use crate::common::{LoadedScene, apply_lighting, check_output_folder, choose_camera, load_scene};
+use crate::common::{LoadedScene, check_output_folder, load_scene, prepare_render};
 use crate::output::{out, outln};
 
 #[derive(Debug, Serialize)]
@@ -50,19 +50,20 @@ pub(crate) fn run(args: &BenchEffectsArgs) -> Result<()> {
         width: args.size.width,
         height: args.size.height,
         samples_per_pixel: args.spp,
-        sampler: rtgi_render::PixelSampler::Stratified,
+        sampler: rtgi_render::recipe::default_sampler(args.spp),
         ..RenderSettings::default()
     };
-    apply_lighting(&args.lighting, &mut scene, &mut settings)?;
+    // Prepared as `rtgi render` prepares it, the lamp of an enclosed camera included.
+    let pool = args.threads.pool()?;
+    let (accel, prepared) =
+        prepare_render(&mut scene, &mut settings, &args.lighting, &args.camera, &args.accel, &pool)?;
+    let camera = prepared.camera.camera;
     let plan = EffectPlan::new(&scene, &settings);
     // The measurements and the JSON asked for go on when the reader of
     // standard output has gone (`| head`): the first failed write is kept
     // and returned at the end, and nothing more is printed after it.
     let mut printed = out!("{plan}");
 
-    let pool = args.threads.pool()?;
-    let accel = pool.install(|| args.accel.build(&scene))?;
-    let camera = choose_camera(&scene, accel.as_ref(), &args.camera, args.size.aspect())?;
     let measure = |settings: &RenderSettings| -> (f64, HdrImage) {
         let mut times = Vec::new();
         let mut image = None;

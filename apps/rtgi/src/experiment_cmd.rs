@@ -12,10 +12,10 @@ use std::time::Instant;
 use anyhow::{Result, bail};
 use rtgi_experiment::provenance::Build;
 use rtgi_experiment::{Knob, Machine, Options, RunRecord, Subject};
-use rtgi_render::{PixelSampler, RenderSettings};
+use rtgi_render::{RenderSettings, recipe};
 
 use crate::cli::{ExperimentArgs, KnobChoice};
-use crate::common::{LoadedScene, apply_lighting, choose_camera, load_scene, write_atomically};
+use crate::common::{LoadedScene, load_scene, prepare_render, write_atomically};
 use crate::output::outln;
 
 /// The shared scenes of the report, relative to the scenes folder.
@@ -139,7 +139,7 @@ pub(crate) fn run(args: &ExperimentArgs) -> Result<()> {
     // is kept and returned at the end, and nothing more is printed after it.
     let mut printed = Ok(());
     for (knob, scene, name, folder) in runs {
-        let mut subject = pool.install(|| prepare(args, scene.as_deref()))?;
+        let mut subject = pool.install(|| prepare(args, scene.as_deref(), &pool))?;
         if let Some(name) = name {
             subject.name = name;
         }
@@ -174,21 +174,74 @@ pub(crate) fn run(args: &ExperimentArgs) -> Result<()> {
     printed
 }
 
-/// Loads the scene (the built-in Cornell box when `None`), applies the
-/// lighting options, builds the structure and chooses the camera, as `rtgi render` does.
-fn prepare(args: &ExperimentArgs, scene: Option<&Path>) -> Result<Subject> {
+/// Samples per pixel of the subject's base settings: those of a default
+/// `rtgi render` of a light-transport integrator, which decide the sampler
+/// (knobs that vary the samples keep it).
+const BASE_SAMPLES: u32 = 16;
+
+/// Loads the scene (the built-in Cornell box when `None`) and prepares it
+/// exactly as `rtgi render` does ([`prepare_render`]: lighting, structure,
+/// camera, the lamp of an enclosed camera), at the experiment's size.
+fn prepare(args: &ExperimentArgs, scene: Option<&Path>, pool: &rayon::ThreadPool) -> Result<Subject> {
     let LoadedScene { mut scene, name, .. } = load_scene(scene)?;
     let side = if args.quick { 32 } else { 128 };
     let (width, height) = (args.width.unwrap_or(side), args.height.unwrap_or(side));
     let mut settings = RenderSettings {
         width,
         height,
-        samples_per_pixel: 1,
-        sampler: PixelSampler::Stratified,
+        samples_per_pixel: BASE_SAMPLES,
+        sampler: recipe::default_sampler(BASE_SAMPLES),
         ..RenderSettings::default()
     };
-    apply_lighting(&args.lighting, &mut scene, &mut settings)?;
-    let accel = args.accel.build(&scene)?;
-    let camera = choose_camera(&scene, accel.as_ref(), &args.camera, width as f32 / height as f32)?;
-    Ok(Subject { name, scene, camera, accel, settings })
+    let (accel, prepared) = prepare_render(&mut scene, &mut settings, &args.lighting, &args.camera, &args.accel, pool)?;
+    if let Some(light) = &prepared.room_light {
+        let p = light.position;
+        eprintln!(
+            "  note: the camera is enclosed and nothing emits light: a lamp hangs at {:.3},{:.3},{:.3}",
+            p.x, p.y, p.z
+        );
+    }
+    Ok(Subject { name, scene, camera: prepared.camera.camera, accel, settings })
+}
+
+#[cfg(test)]
+mod tests {
+    use clap::Parser;
+
+    use crate::cli::{Cli, Command};
+
+    /// The experiment renders what `rtgi render` renders with the same
+    /// options: the same bytes, on the built-in box and on a closed room
+    /// that needs the lamp of an enclosed camera.
+    #[test]
+    fn the_experiment_renders_the_bytes_of_rtgi_render() {
+        let room = concat!(env!("CARGO_MANIFEST_DIR"), "/../../tests/scenes/closed-room.toml");
+        for scene in [None, Some(room)] {
+            let options = ["--width", "24", "--height", "16", "--threads", "2"];
+            let dir = std::env::temp_dir().join(format!("rtgi-recipe-{}", std::process::id()));
+            std::fs::create_dir_all(&dir).unwrap();
+            let output = dir.join("render.exr");
+            let mut render_args: Vec<&str> =
+                vec!["rtgi", "render", "-o", output.to_str().unwrap(), "--spp", "4", "--seed", "3"];
+            let mut experiment_args: Vec<&str> = vec!["rtgi", "experiment", "spp"];
+            render_args.extend(scene);
+            experiment_args.extend(scene);
+            render_args.extend(options);
+            experiment_args.extend(options);
+            let Command::Render(render) = Cli::try_parse_from(&render_args).unwrap().command else { unreachable!() };
+            let Command::Experiment(experiment) = Cli::try_parse_from(&experiment_args).unwrap().command else {
+                unreachable!()
+            };
+            let pool = experiment.threads.pool().unwrap();
+            let subject = super::prepare(&experiment, scene.map(std::path::Path::new), &pool).unwrap();
+            let settings = rtgi_render::RenderSettings { samples_per_pixel: 4, seed: 3, ..subject.settings.clone() };
+            let ours = pool.install(|| rtgi_experiment::render(&subject, &settings));
+            let (rendered, _) = crate::render_cmd::render_image(&render).unwrap().image.expect("an image");
+            let _ = std::fs::remove_dir_all(&dir);
+            assert!(ours.pixels() == rendered.pixels(), "{scene:?}: the experiment renders another image");
+            if scene.is_some() {
+                assert!(subject.scene.lights.len() > 0, "the closed room gets its lamp in the experiment too");
+            }
+        }
+    }
 }

@@ -2,20 +2,14 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use anyhow::{Result, bail};
-use rtgi_image::{
-    HdrImage, Legibility, OutputFormat, ToneMap, ToneOperator, auto_exposure, check_writable, legibility,
-};
+use rtgi_image::{HdrImage, Legibility, OutputFormat, ToneMap, check_writable, legibility};
 use rtgi_render::{
-    Accumulation, ENCLOSED, EffectPlan, EnvironmentSpec, Integrator, PixelSampler, RenderIdentity, RenderSettings,
-    render, room_light, sky_visibility,
+    Accumulation, EffectPlan, EnvironmentSpec, Integrator, RenderIdentity, RenderSettings, recipe, render,
 };
-use rtgi_scene::{Camera, Light, Scene};
 
 use crate::cli::RenderArgs;
 use crate::cli::ToneArgs;
-use crate::common::{
-    LoadedScene, apply_lighting, check_output_folder, choose_camera, load_scene, refuse_inputs_as_outputs,
-};
+use crate::common::{LoadedScene, check_output_folder, load_scene, prepare_render, refuse_inputs_as_outputs};
 use crate::interrupt;
 use crate::output::{out, outln};
 use crate::progress::Progress;
@@ -105,18 +99,16 @@ pub(crate) fn render_image(args: &RenderArgs) -> Result<Rendered> {
         width,
         height,
         samples_per_pixel: spp,
-        sampler: args.sampler.unwrap_or(if spp == 1 { PixelSampler::Center } else { PixelSampler::Stratified }),
+        sampler: args.sampler.unwrap_or(recipe::default_sampler(spp)),
         seed: args.seed.value,
         background: args.background,
         ..RenderSettings::default()
     };
-    apply_lighting(&args.lighting, &mut scene, &mut settings)?;
     let (rows, samples) = job.share(settings.height, spp)?;
     let pool = args.threads.pool()?;
-
-    let accel = pool.install(|| args.accel.build(&scene))?;
-    let camera = choose_camera(&scene, accel.as_ref(), &args.camera, width as f32 / height as f32)?;
-    let room_light = light_enclosed_camera(&mut scene, accel.as_ref(), &camera, &settings);
+    let (accel, prepared) =
+        prepare_render(&mut scene, &mut settings, &args.lighting, &args.camera, &args.accel, &pool)?;
+    let (camera, room_light) = (prepared.camera.camera, prepared.room_light);
 
     // What is printed goes on standard output; a reader that goes away
     // (`| head`) does not stop the render, and the first failed write is
@@ -288,35 +280,9 @@ fn warn_if_illegible(image: &HdrImage, tone_map: &ToneMap, exposure_given: bool)
     }
 }
 
-/// For a camera that no sky can reach (a closed room) in a scene that
-/// would get the default sky and sun, adds a point light above the camera
-/// ([`room_light`]) and returns it: otherwise the image would be black.
-fn light_enclosed_camera(
-    scene: &mut Scene,
-    accel: &dyn rtgi_accel::Accel,
-    camera: &Camera,
-    settings: &RenderSettings,
-) -> Option<Light> {
-    if !EffectPlan::new(scene, settings).default_environment || sky_visibility(accel, camera.position) >= ENCLOSED {
-        return None;
-    }
-    let light = room_light(scene, accel, camera);
-    scene.lights.push(light.clone());
-    Some(light)
-}
-
-/// The exposure and tone map of an image's PNG: as the options say, else
-/// for light transport a filmic curve at an exposure chosen from the image
-/// ([`auto_exposure`]), for other integrators (albedo, normals, ...) the
-/// values as they are.
+/// The exposure and tone map of an image's PNG ([`recipe::tone_map`]).
 pub(crate) fn tone_map(args: &ToneArgs, simulates_light: bool, image: &HdrImage) -> ToneMap {
-    let operator = args.tonemap.unwrap_or(if simulates_light { ToneOperator::Aces } else { ToneOperator::Clamp });
-    let exposure = match args.exposure {
-        Some(stops) => stops,
-        None if simulates_light => auto_exposure(image),
-        None => 0.0,
-    };
-    ToneMap { exposure, operator }
+    recipe::tone_map(args.exposure, args.tonemap, simulates_light, image)
 }
 
 /// Refuses an image too large for this machine's memory before anything is

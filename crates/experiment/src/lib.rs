@@ -154,6 +154,12 @@ pub fn run(
     knobs::run(knob, subject, options, progress)
 }
 
+/// Renders `subject` with `settings` on its structure, as every experiment's
+/// measured render does: the image `rtgi render` makes of the same options.
+pub fn render(subject: &Subject, settings: &RenderSettings) -> rtgi_image::HdrImage {
+    runner::render(subject, settings).0
+}
+
 /// Counts the steps of an experiment and estimates the time left from the
 /// mean time of the steps done.
 pub(crate) struct Steps<'a> {

@@ -42,6 +42,7 @@ mod integrator;
 pub mod lights;
 pub mod probes;
 pub mod rays;
+pub mod recipe;
 mod sampler;
 mod shade;
 

@@ -1,0 +1,212 @@
+//! The way from options to a ready render, written once: the lighting
+//! options applied to the scene and settings, the sampler's default, the
+//! camera (a file's, the automatic framing, or one placed by options), the
+//! lamp an enclosed, unlit camera gets, and the tone map of the image.
+//!
+//! `rtgi render`, `rtgi experiment` and the other commands that render or
+//! frame a scene all go through here, so that an experiment measures what a
+//! render renders (a test renders both and compares their bytes).
+
+use rtgi_accel::Accel;
+use rtgi_image::{HdrImage, ToneMap, ToneOperator, auto_exposure};
+use rtgi_math::Vec3;
+use rtgi_scene::{Camera, Light, Scene};
+
+use crate::{
+    DEFAULT_VERTICAL_FOV_DEGREES, DirectStrategy, ENCLOSED, EffectOverrides, EffectPlan, EnvironmentSpec, Integrator,
+    PixelSampler, RenderSettings, camera_blocked, default_camera, frame_scene, room_light, sky_visibility,
+};
+
+/// Why a render cannot be prepared; the messages name the option.
+#[derive(Debug, thiserror::Error)]
+pub enum RecipeError {
+    /// `--camera N` beyond the file's cameras.
+    #[error("--camera {index}: the scene has {count} camera(s), numbered from 0")]
+    CameraIndex {
+        /// The index asked for.
+        index: usize,
+        /// The cameras the scene has.
+        count: usize,
+    },
+    /// A field of view outside (0°, 180°).
+    #[error("--fov {0}: the field of view must be between 0 and 180 degrees")]
+    FieldOfView(f32),
+    /// A camera that looks at its own position or along its up vector.
+    #[error("the camera is degenerate: it must look somewhere other than its own position, and not along --up")]
+    DegenerateCamera,
+    /// The environment map could not be read.
+    #[error(transparent)]
+    Environment(#[from] rtgi_image::ImageError),
+}
+
+/// Which camera: one of the file's, else the automatic framing, with any
+/// of its parts overridden.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct CameraChoice {
+    /// The file's camera of this index (default: its first, if any).
+    pub index: Option<usize>,
+    /// The camera's position; it then looks at the scene's centre unless `look` is given.
+    pub at: Option<Vec3>,
+    /// The point it looks at.
+    pub look: Option<Vec3>,
+    /// Its up direction.
+    pub up: Option<Vec3>,
+    /// Its vertical field of view, in degrees.
+    pub fov_degrees: Option<f32>,
+}
+
+/// A chosen camera, and whether it seems to be inside geometry.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ChosenCamera {
+    /// The camera.
+    pub camera: Camera,
+    /// For a camera from the file or the options: the fraction of its rays
+    /// that meet the back of a surface or start against one, when that
+    /// suggests it is inside geometry (the automatic framing avoids such views).
+    pub blocked: Option<f32>,
+}
+
+/// The scene's camera as `choice` says, for images of `aspect` (width / height).
+pub fn choose_camera(
+    scene: &Scene,
+    accel: &dyn Accel,
+    choice: &CameraChoice,
+    aspect: f32,
+) -> Result<ChosenCamera, RecipeError> {
+    let chosen = match choice.index {
+        Some(index) if index >= scene.cameras.len() => {
+            return Err(RecipeError::CameraIndex { index, count: scene.cameras.len() });
+        }
+        Some(index) => scene.cameras.get(index),
+        None => scene.cameras.first(),
+    };
+    let fov = match choice.fov_degrees {
+        Some(degrees) if !(degrees > 0.0 && degrees < 180.0) => return Err(RecipeError::FieldOfView(degrees)),
+        Some(degrees) => degrees.to_radians(),
+        None => chosen.map_or(DEFAULT_VERTICAL_FOV_DEGREES.to_radians(), |c| c.vertical_fov),
+    };
+    let automatic = chosen.is_none() && choice.at.is_none();
+    let mut camera = match chosen {
+        Some(camera) => *camera,
+        None if choice.fov_degrees.is_none() => default_camera(scene, accel, aspect),
+        None => frame_scene(scene, accel, fov, aspect),
+    };
+    camera.vertical_fov = fov;
+    if let Some(up) = choice.up {
+        camera.up = up;
+    }
+    if let Some(at) = choice.at {
+        camera.position = at;
+        if choice.look.is_none() {
+            camera.direction = scene.bounds().centroid() - at;
+        }
+    }
+    if let Some(look) = choice.look {
+        camera.direction = look - camera.position;
+    }
+    if !camera.is_valid() {
+        return Err(RecipeError::DegenerateCamera);
+    }
+    let blocked = if automatic { None } else { camera_blocked(scene, accel, &camera, aspect) };
+    Ok(ChosenCamera { camera, blocked })
+}
+
+/// The lighting options: lights added to the scene, the integrator and its
+/// settings, the environment and effect overrides.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Lighting {
+    /// Lights added to the scene's own.
+    pub lights: Vec<Light>,
+    /// The integrator.
+    pub integrator: Integrator,
+    /// The most bounces a path takes.
+    pub max_depth: u32,
+    /// How direct light is sampled.
+    pub direct_strategy: DirectStrategy,
+    /// The indirect-light clamp, if any.
+    pub indirect_clamp: Option<f32>,
+    /// The environment (a colour or a map's file), if any.
+    pub environment: Option<EnvironmentSpec>,
+    /// Effects forced on or off.
+    pub effects: EffectOverrides,
+}
+
+/// Adds `lighting`'s lights to `scene` and sets its options in `settings` (reading an environment map).
+pub fn apply_lighting(
+    lighting: &Lighting,
+    scene: &mut Scene,
+    settings: &mut RenderSettings,
+) -> Result<(), RecipeError> {
+    scene.lights.extend(lighting.lights.iter().cloned());
+    settings.integrator = lighting.integrator;
+    settings.max_depth = lighting.max_depth;
+    settings.direct_strategy = lighting.direct_strategy;
+    settings.indirect_clamp = lighting.indirect_clamp;
+    settings.effects = lighting.effects.clone();
+    settings.environment = lighting.environment.as_ref().map(EnvironmentSpec::load).transpose()?;
+    Ok(())
+}
+
+/// The sampler a render uses unless told otherwise: the pixel's centre for
+/// one sample (no noise), the stratified sampler for more.
+pub fn default_sampler(samples_per_pixel: u32) -> PixelSampler {
+    if samples_per_pixel == 1 { PixelSampler::Center } else { PixelSampler::Stratified }
+}
+
+/// For a camera that no sky can reach (a closed room) in a scene that
+/// would get the default sky and sun, adds a point light over the room in
+/// view ([`room_light`]) and returns it: otherwise the image would be black.
+pub fn light_enclosed_camera(
+    scene: &mut Scene,
+    accel: &dyn Accel,
+    camera: &Camera,
+    settings: &RenderSettings,
+) -> Option<Light> {
+    if !EffectPlan::new(scene, settings).default_environment || sky_visibility(accel, camera.position) >= ENCLOSED {
+        return None;
+    }
+    let light = room_light(scene, accel, camera);
+    scene.lights.push(light.clone());
+    Some(light)
+}
+
+/// A scene made ready to render: its camera, and the lamp added for an enclosed camera.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Prepared {
+    /// The camera chosen.
+    pub camera: ChosenCamera,
+    /// The lamp hung over the room in view, if the camera was enclosed and unlit.
+    pub room_light: Option<Light>,
+}
+
+/// Chooses the camera and adds the lamp an enclosed camera needs, as every
+/// render does, once the scene is loaded, its lighting applied and its
+/// structure built.
+pub fn prepare(
+    scene: &mut Scene,
+    accel: &dyn Accel,
+    settings: &RenderSettings,
+    choice: &CameraChoice,
+) -> Result<Prepared, RecipeError> {
+    let camera = choose_camera(scene, accel, choice, settings.width as f32 / settings.height.max(1) as f32)?;
+    let room_light = light_enclosed_camera(scene, accel, &camera.camera, settings);
+    Ok(Prepared { camera, room_light })
+}
+
+/// The tone map of an image's PNG: as given, else for light transport a
+/// filmic curve at an exposure chosen from the image ([`auto_exposure`]),
+/// for other integrators (albedo, normals, ...) the values as they are.
+pub fn tone_map(
+    exposure: Option<f32>,
+    operator: Option<ToneOperator>,
+    simulates_light: bool,
+    image: &HdrImage,
+) -> ToneMap {
+    let operator = operator.unwrap_or(if simulates_light { ToneOperator::Aces } else { ToneOperator::Clamp });
+    let exposure = match exposure {
+        Some(stops) => stops,
+        None if simulates_light => auto_exposure(image),
+        None => 0.0,
+    };
+    ToneMap { exposure, operator }
+}
