@@ -1,14 +1,13 @@
 //! `rtgi bench`: build time, tree quality and throughput of every
 //! acceleration structure on one scene, as a table and as JSON.
 
-use std::time::Instant;
-
 use anyhow::{Result, bail};
 use rayon::prelude::*;
-use rtgi_accel::{Accel, AccelKind, BuildParams, BuildStats, Intersector, Traversal, TraversalCounters};
+use rtgi_accel::{Accel, AccelKind, BuildParams, BuildStats, Intersector, Traversal};
+use rtgi_experiment::measure;
 use rtgi_math::Ray;
 use rtgi_render::probes::{closed_mesh_probe, shared_edge_probe};
-use rtgi_render::rays::{batch_throughput, primary_rays, surface_rays, throughput};
+use rtgi_render::rays::{primary_rays, surface_rays};
 use serde::Serialize;
 
 use crate::cli::BenchArgs;
@@ -174,17 +173,16 @@ fn measure_variant(
 ) -> Result<VariantReport> {
     let repeats = args.repeats as usize;
     let build_ms = |pool: &rayon::ThreadPool| -> Result<f64> {
-        let mut times: Vec<f64> = (0..repeats)
-            .map(|_| {
-                let start = Instant::now();
-                let accel = pool.install(|| kind.try_build(triangles, params))?;
-                let ms = start.elapsed().as_secs_f64() * 1e3;
-                drop(accel);
-                Ok(ms)
-            })
-            .collect::<Result<_>>()?;
-        times.sort_by(f64::total_cmp);
-        Ok(times[times.len() / 2])
+        let mut failed = None;
+        let timing = measure::time(repeats, 0, || {
+            if let Err(e) = pool.install(|| kind.try_build(triangles, params)) {
+                failed = Some(e);
+            }
+        });
+        match failed {
+            Some(e) => Err(e.into()),
+            None => Ok(timing.median_ms),
+        }
     };
     let build_ms_1_thread = build_ms(single)?;
     let build_ms_all_threads = build_ms(pool)?;
@@ -192,16 +190,12 @@ fn measure_variant(
 
     // The linear scan is timed on an evenly spaced subset of each batch.
     let subset = |rays: &[Ray]| -> Vec<Ray> {
-        if kind != AccelKind::Linear || rays.len() <= args.linear_rays as usize {
-            return rays.to_vec();
-        }
-        let stride = rays.len().div_ceil(args.linear_rays as usize);
-        rays.iter().step_by(stride).copied().collect()
+        if kind != AccelKind::Linear { rays.to_vec() } else { measure::every_nth(rays, args.linear_rays as usize) }
     };
     let batch = |rays: &[Ray], linear_mrays: Option<f64>| {
         let rays = subset(rays);
         let timed_repeats = if kind == AccelKind::Linear { repeats.min(3) } else { repeats };
-        let trace = |r: &Ray| accel.intersect(r).is_some();
+        let trace = |chunk: &[Ray]| chunk.iter().filter(|r| accel.intersect(r).is_some()).count();
         let mrays_1_thread = throughput(&rays, single, timed_repeats, trace);
         let mrays_all_threads = throughput(&rays, pool, timed_repeats, trace);
         let batch_trace = |chunk: &[Ray]| {
@@ -209,9 +203,9 @@ fn measure_variant(
             accel.intersect_batch(chunk, &mut hits);
             hits.iter().filter(|h| h.is_some()).count()
         };
-        let batch_mrays_1_thread = batch_throughput(&rays, single, timed_repeats, batch_trace);
-        let batch_mrays_all_threads = batch_throughput(&rays, pool, timed_repeats, batch_trace);
-        let (counters, hits) = count(accel.as_ref(), &rays, pool);
+        let batch_mrays_1_thread = throughput(&rays, single, timed_repeats, batch_trace);
+        let batch_mrays_all_threads = throughput(&rays, pool, timed_repeats, batch_trace);
+        let (counters, hits) = pool.install(|| measure::count(accel.as_ref(), &rays));
         let per_ray = |n: u64| n as f64 / rays.len().max(1) as f64;
         BatchReport {
             rays_timed: rays.len(),
@@ -244,22 +238,12 @@ fn measure_variant(
 }
 
 /// Traversal work and hits of a batch.
-fn count(accel: &dyn Accel, rays: &[Ray], pool: &rayon::ThreadPool) -> (TraversalCounters, u64) {
-    pool.install(|| {
-        rays.par_chunks(1024)
-            .map(|chunk| {
-                let mut counters = TraversalCounters::default();
-                let hits = chunk.iter().filter(|r| accel.intersect_counted(r, &mut counters).is_some()).count();
-                (counters, hits as u64)
-            })
-            .reduce(
-                || (TraversalCounters::default(), 0),
-                |(mut a, h), (b, g)| {
-                    a += b;
-                    (a, h + g)
-                },
-            )
-    })
+/// Million rays a second of `trace` (which answers a chunk of rays and
+/// returns its hits) over `rays` on `pool`: the median of the repeats.
+fn throughput(rays: &[Ray], pool: &rayon::ThreadPool, repeats: usize, trace: impl Fn(&[Ray]) -> usize + Sync) -> f64 {
+    let trace = &trace;
+    let timing = pool.install(|| measure::time_rays(rays, repeats, trace));
+    measure::mrays(rays.len(), &timing).0
 }
 
 fn print_table(report: &BenchReport, linear_rays: u32) -> Result<()> {
@@ -389,7 +373,7 @@ fn measure_accuracy(
             eprintln!("measuring {kind} with {intersector} and {traversal} traversal ...");
             let params = BuildParams { intersector, traversal, ..params.clone() };
             let accel = pool.install(|| kind.build(triangles, &params));
-            let trace = |r: &Ray| accel.intersect(r).is_some();
+            let trace = |chunk: &[Ray]| chunk.iter().filter(|r| accel.intersect(r).is_some()).count();
             let edges = kind.build(&edge_triangles, &params);
             let mesh = kind.build(&mesh_triangles, &params);
             let misses = |accel: &dyn Accel, rays: &[Ray]| {

@@ -7,8 +7,6 @@
 //! without it). Every render uses the same seed, so differences are the
 //! effects', not noise.
 
-use std::time::Instant;
-
 use anyhow::Result;
 use rtgi_image::{Difference, HdrImage, compare};
 use rtgi_render::{EffectPlan, RenderSettings, render};
@@ -65,16 +63,11 @@ pub(crate) fn run(args: &BenchEffectsArgs) -> Result<()> {
     let mut printed = out!("{plan}");
 
     let measure = |settings: &RenderSettings| -> (f64, HdrImage) {
-        let mut times = Vec::new();
         let mut image = None;
-        for _ in 0..args.repeats {
-            let start = Instant::now();
-            let (rendered, _) = pool.install(|| render(&scene, accel.as_ref(), &camera, settings, &|_| {}));
-            times.push(start.elapsed().as_secs_f64() * 1e3);
-            image = Some(rendered);
-        }
-        times.sort_by(f64::total_cmp);
-        (times[times.len() / 2], image.expect("at least one repeat"))
+        let timing = rtgi_experiment::measure::time(args.repeats as usize, 0, || {
+            image = Some(pool.install(|| render(&scene, accel.as_ref(), &camera, settings, &|_| {})).0);
+        });
+        (timing.median_ms, image.expect("at least one repeat"))
     };
 
     eprintln!("measuring the plan ...");

@@ -240,7 +240,7 @@ mod tests {
             let _ = std::fs::remove_dir_all(&dir);
             assert!(ours.pixels() == rendered.pixels(), "{scene:?}: the experiment renders another image");
             if scene.is_some() {
-                assert!(subject.scene.lights.len() > 0, "the closed room gets its lamp in the experiment too");
+                assert!(!subject.scene.lights.is_empty(), "the closed room gets its lamp in the experiment too");
             }
         }
     }

@@ -33,6 +33,7 @@ pub mod exact;
 mod index;
 mod knobs;
 pub mod machine;
+pub mod measure;
 pub mod panel;
 pub mod pareto;
 pub mod plot;

@@ -181,6 +181,21 @@ fn axis_range(values: impl Iterator<Item = f64>, log: bool) -> (f64, f64) {
 }
 
 impl Plot {
+    /// A log-log plot of RMSE against render time, each curve's points with
+    /// their spread in both directions ([`Curve::error_against_time`]).
+    pub fn error_against_time(file: impl Into<String>, title: impl Into<String>, curves: Vec<Curve>) -> Plot {
+        Plot {
+            file: file.into(),
+            title: title.into(),
+            x_label: "render time (ms, median; bars: min–max)".into(),
+            y_label: "RMSE of linear radiance (bars: seeds' min–max)".into(),
+            log_x: true,
+            log_y: true,
+            curves,
+            legend: Corner::UpperRight,
+        }
+    }
+
     /// The plot as an SVG document; the scene and the machine go into the title.
     pub fn to_svg(&self, scene: &str, machine: &Machine) -> Result<String, ExperimentError> {
         let mut svg = String::new();

@@ -2,11 +2,8 @@
 
 use std::time::Instant;
 
-use rayon::prelude::*;
-
 use rtgi_accel::{Accel, AccelKind};
 use rtgi_image::HdrImage;
-use rtgi_math::Ray;
 use rtgi_render::RenderSettings;
 
 use crate::reference::Reference;
@@ -65,6 +62,24 @@ pub(crate) fn equal_time(
         .collect()
 }
 
+/// Renders the configurations at equal time ([`equal_time`]) and adds their
+/// panel to `report`, its caption among the findings.
+pub(crate) fn add_equal_time_panel(
+    report: &mut crate::Report,
+    subject: &Subject,
+    reference: &Reference,
+    file: String,
+    what: &str,
+    configurations: &[(String, RenderSettings, f64)],
+    budget_ms: f64,
+) {
+    let entries = equal_time(subject, reference, configurations, budget_ms);
+    let title = format!("{what} at equal time ({} ms)", crate::report::format_ms(budget_ms));
+    let panel = crate::panel::Panel::new(file, title, reference.image.clone(), entries);
+    report.findings.push(panel.caption());
+    report.panels.push(panel);
+}
+
 /// A measured point's median milliseconds per sample per pixel.
 pub(crate) fn ms_per_sample(point: &Point, samples_per_pixel: u32) -> f64 {
     point.time.expect("measured").median_ms / samples_per_pixel.max(1) as f64
@@ -87,25 +102,14 @@ pub(crate) fn build_timed(
     params: &rtgi_accel::BuildParams,
     repeats: usize,
 ) -> Result<(Box<dyn Accel>, Timing), crate::ExperimentError> {
-    let mut times = Vec::new();
-    let mut built = None;
-    for _ in 0..repeats.max(1) {
-        let start = Instant::now();
-        let accel = kind.try_build(triangles, params).map_err(|e| crate::ExperimentError::Build(e.to_string()))?;
-        times.push(start.elapsed().as_secs_f64() * 1e3);
-        built = Some(accel);
-    }
-    Ok((built.expect("at least one build"), Timing::of(&times)))
+    let mut built = Ok(None);
+    let timing = crate::measure::time(repeats, 0, || {
+        if built.is_ok() {
+            built =
+                kind.try_build(triangles, params).map(Some).map_err(|e| crate::ExperimentError::Build(e.to_string()));
+        }
+    });
+    Ok((built?.expect("at least one build"), timing))
 }
 
-/// Times `trace` over `rays` in chunks of 1024 on all threads, `repeats` times after a warm-up.
-pub(crate) fn time_rays(rays: &[Ray], repeats: usize, trace: impl Fn(&[Ray]) -> usize + Sync) -> Timing {
-    let run = || {
-        let start = Instant::now();
-        let hits: usize = rays.par_chunks(1024).map(&trace).sum();
-        std::hint::black_box(hits);
-        start.elapsed().as_secs_f64() * 1e3
-    };
-    run();
-    Timing::of(&(0..repeats.max(1)).map(|_| run()).collect::<Vec<_>>())
-}
+pub(crate) use crate::measure::time_rays;

@@ -93,35 +93,6 @@ pub fn bounding_sphere_camera(scene: &Scene) -> Camera {
     Camera::framing(&scene.bounds(), 40f32.to_radians(), 1.0)
 }
 
-/// Million rays per second of `trace` over `rays`, on `pool`: the median
-/// of `repeats` timed runs after one untimed warm-up run. Rays go to the
-/// threads in chunks of 1024, in order; `trace` returns whether the ray hit.
-pub fn throughput(rays: &[Ray], pool: &rayon::ThreadPool, repeats: usize, trace: impl Fn(&Ray) -> bool + Sync) -> f64 {
-    batch_throughput(rays, pool, repeats, |chunk| chunk.iter().filter(|r| trace(r)).count())
-}
-
-/// Million rays a second through `trace`, which answers a chunk of up to
-/// 1024 consecutive rays (through a batch query, say) and returns its hits:
-/// the median of `repeats` runs after a warm-up, on `pool`'s threads.
-pub fn batch_throughput(
-    rays: &[Ray],
-    pool: &rayon::ThreadPool,
-    repeats: usize,
-    trace: impl Fn(&[Ray]) -> usize + Sync,
-) -> f64 {
-    use rayon::prelude::*;
-    let run = || {
-        let start = std::time::Instant::now();
-        let hits: usize = pool.install(|| rays.par_chunks(1024).map(&trace).sum());
-        std::hint::black_box(hits);
-        start.elapsed().as_secs_f64()
-    };
-    run();
-    let mut seconds: Vec<f64> = (0..repeats.max(1)).map(|_| run()).collect();
-    seconds.sort_by(f64::total_cmp);
-    rays.len() as f64 / seconds[seconds.len() / 2].max(1e-12) * 1e-6
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;

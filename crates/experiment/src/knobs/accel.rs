@@ -10,10 +10,11 @@
 //! slower but traces faster pays for its build.
 
 use rayon::prelude::*;
-use rtgi_accel::{Accel, AccelKind, BuildParams, Hit, TraversalCounters};
+use rtgi_accel::{Accel, AccelKind, BuildParams, Hit};
 use rtgi_math::Ray;
 use rtgi_render::rays::{primary_rays, surface_rays};
 
+use crate::measure::every_nth;
 use crate::plot::{Corner, Curve, Plot};
 use crate::report::{Point, Report, Series, Table, format_ms, format_number};
 use crate::runner::{build_timed, time_rays};
@@ -70,11 +71,6 @@ fn answers(accel: &dyn Accel, rays: &[Ray]) -> Vec<Option<Hit>> {
 fn disagreements(a: &[Option<Hit>], b: &[Option<Hit>]) -> usize {
     let bits = |h: &Option<Hit>| h.map(|h| (h.triangle, h.t.to_bits(), h.beta.to_bits(), h.gamma.to_bits()));
     a.iter().zip(b).filter(|(x, y)| bits(x) != bits(y)).count()
-}
-
-fn every_nth(rays: &[Ray], budget: usize) -> Vec<Ray> {
-    let stride = rays.len().div_ceil(budget.max(1)).max(1);
-    rays.iter().step_by(stride).copied().collect()
 }
 
 pub(super) fn run(
@@ -157,19 +153,7 @@ pub(super) fn run(
             let mrays = |t: &Timing| rays.len() as f64 / (t.median_ms * 1e3);
             // Evenly spaced: camera rays come in tiles, and the first ones may all be sky.
             let counted_rays = &every_nth(rays, COUNTED_RAYS);
-            let counters = counted_rays
-                .par_chunks(1024)
-                .map(|chunk| {
-                    let mut counters = TraversalCounters::default();
-                    for ray in chunk {
-                        accel.intersect_counted(ray, &mut counters);
-                    }
-                    counters
-                })
-                .reduce(TraversalCounters::default, |mut a, b| {
-                    a += b;
-                    a
-                });
+            let (counters, _) = crate::measure::count(accel.as_ref(), counted_rays);
             let counted = counted_rays.len().max(1) as f64;
             let wrong = disagreements(&answers(accel.as_ref(), subset), expected);
             let mut batch_answers = vec![None; subset.len()];

@@ -10,7 +10,7 @@ use rtgi_render::RenderSettings;
 use crate::plot::{Corner, Curve, Plot};
 use crate::reference::reference;
 use crate::report::{Point, Report, Series, Table, format_number, measurement_cells, measurement_header};
-use crate::runner::measure;
+use crate::runner::{add_equal_time_panel, measure};
 use crate::verdict::{Spread, compare};
 use crate::{ExperimentError, Options, Steps, Subject};
 
@@ -116,21 +116,14 @@ pub(super) fn run(
         curves: vec![Curve::new("bias²", bias_curve), Curve::new("variance", variance_curve)],
         legend: Corner::LowerLeft,
     });
-    report.plots.push(Plot {
-        file: "clamp-tradeoff.svg".into(),
-        title: format!("RMSE against render time for each clamp, {spp} spp"),
-        x_label: "render time (ms, median)".into(),
-        y_label: "RMSE of linear radiance".into(),
-        log_x: true,
-        log_y: true,
-        curves: tradeoff
-            .iter()
-            .map(|(label, time, error)| {
-                Curve::error_against_time(label, &[(*time, error.rmse, error.rmse_min, error.rmse_max)])
-            })
-            .collect(),
-        legend: Corner::UpperRight,
-    });
+    let title = format!("RMSE against render time for each clamp, {spp} spp");
+    let curves = tradeoff
+        .iter()
+        .map(|(label, time, error)| {
+            Curve::error_against_time(label, &[(*time, error.rmse, error.rmse_min, error.rmse_max)])
+        })
+        .collect();
+    report.plots.push(Plot::error_against_time("clamp-tradeoff.svg", title, curves));
     // The equal-time panel: no clamp, the harshest, the best and a mild one, in the unclamped render's time.
     let budget = points[0].2.time.expect("measured").median_ms;
     let best = series_best;
@@ -147,15 +140,8 @@ pub(super) fn run(
             (format!("clamp {label}"), settings, crate::runner::ms_per_sample(point, spp))
         })
         .collect();
-    let entries = crate::runner::equal_time(subject, &reference, &configurations, budget);
-    let panel = crate::panel::Panel::new(
-        "clamp-equal-time.png",
-        format!("Clamps at equal time ({} ms)", crate::report::format_ms(budget)),
-        reference.image.clone(),
-        entries,
-    );
-    report.findings.push(panel.caption());
-    report.panels.push(panel);
+    let file = "clamp-equal-time.png".to_owned();
+    add_equal_time_panel(&mut report, subject, &reference, file, "Clamps", &configurations, budget);
     report.tables.push(table);
     report.reference = Some(reference.info);
     Ok(report)

@@ -7,7 +7,7 @@ use rtgi_render::{Integrator, RenderSettings};
 use crate::plot::{Corner, Curve, Plot};
 use crate::reference::reference;
 use crate::report::{Report, Series, Table, format_bias, measurement_cells, measurement_header};
-use crate::runner::measure;
+use crate::runner::{add_equal_time_panel, measure};
 use crate::verdict::{Spread, compare};
 use crate::{ExperimentError, Options, Steps, Subject};
 
@@ -114,16 +114,8 @@ pub(super) fn run(
             )
         ));
     }
-    report.plots.push(Plot {
-        file: "depth-tradeoff.svg".into(),
-        title: format!("RMSE against render time, max depth 1 to {}, {spp} spp", depths.last().expect("depths")),
-        x_label: "render time (ms, median)".into(),
-        y_label: "RMSE of linear radiance".into(),
-        log_x: true,
-        log_y: true,
-        curves: tradeoff,
-        legend: Corner::UpperRight,
-    });
+    let title = format!("RMSE against render time, max depth 1 to {}, {spp} spp", depths.last().expect("depths"));
+    report.plots.push(Plot::error_against_time("depth-tradeoff.svg", title, tradeoff));
     report.plots.push(Plot {
         file: "depth-energy.svg".into(),
         title: "Energy missing against max depth".into(),
@@ -172,15 +164,8 @@ pub(super) fn run(
             configuration(format!("depth {deepest}, roulette off"), deepest, false, deep_off),
             configuration(format!("depth {shallow}, roulette on"), shallow, true, shallow_on),
         ];
-        let entries = crate::runner::equal_time(subject, &reference, &configurations, budget);
-        let panel = crate::panel::Panel::new(
-            "depth-equal-time.png",
-            format!("Depth and Russian roulette at equal time ({} ms)", crate::report::format_ms(budget)),
-            reference.image.clone(),
-            entries,
-        );
-        report.findings.push(panel.caption());
-        report.panels.push(panel);
+        let (file, what) = ("depth-equal-time.png".to_owned(), "Depth and Russian roulette");
+        add_equal_time_panel(&mut report, subject, &reference, file, what, &configurations, budget);
     }
     report.tables.push(table);
     report.reference = Some(reference.info);

@@ -16,10 +16,10 @@ use rtgi_render::{DirectStrategy, EffectOverrides, Integrator, RenderSettings};
 use rtgi_scene::Scene;
 use rtgi_scene::description::Description;
 
-use crate::plot::{Corner, Curve, Plot};
+use crate::plot::{Curve, Plot};
 use crate::reference::reference;
 use crate::report::{Report, Series, Table, format_ms, format_number, measurement_cells, measurement_header};
-use crate::runner::measure;
+use crate::runner::{add_equal_time_panel, measure};
 use crate::verdict::{Spread, compare};
 use crate::{ExperimentError, Options, Steps, Subject};
 
@@ -230,16 +230,11 @@ pub(super) fn run(
         let times = by_time.iter().flat_map(|(_, xy, _, _)| xy.iter().map(|p| p.0));
         let (fastest, slowest) = times.fold((f64::INFINITY, 0.0f64), |(lo, hi), t| (lo.min(t), hi.max(t)));
         curves.push(Curve::guide("reference noise", vec![(fastest, noise), (slowest, noise)]));
-        report.plots.push(Plot {
-            file: format!("direct-{name}.svg"),
-            title: format!("Direct light, {name}: RMSE against time"),
-            x_label: "render time (ms, median)".into(),
-            y_label: "RMSE of linear radiance".into(),
-            log_x: true,
-            log_y: true,
+        report.plots.push(Plot::error_against_time(
+            format!("direct-{name}.svg"),
+            format!("Direct light, {name}: RMSE against time"),
             curves,
-            legend: Corner::UpperRight,
-        });
+        ));
         // The equal-time panel: each strategy given the budget at its measured time per sample.
         let scene_series = &report.series[report.series.len() - strategies.len()..];
         let configurations: Vec<(String, RenderSettings, f64)> = strategies
@@ -251,15 +246,8 @@ pub(super) fn run(
                 Some((strategy.to_string(), settings, crate::runner::ms_per_sample(last, last.x as u32)))
             })
             .collect();
-        let entries = crate::runner::equal_time(&scene_subject, &reference, &configurations, budget);
-        let panel = crate::panel::Panel::new(
-            format!("direct-{name}-equal-time.png"),
-            format!("Direct light, {name}, at equal time ({} ms)", format_ms(budget)),
-            reference.image.clone(),
-            entries,
-        );
-        report.findings.push(panel.caption());
-        report.panels.push(panel);
+        let (file, what) = (format!("direct-{name}-equal-time.png"), format!("Direct light, {name},"));
+        add_equal_time_panel(&mut report, &scene_subject, &reference, file, &what, &configurations, budget);
         report.tables.push(table);
     }
     report.tables.insert(0, summary);

@@ -241,22 +241,15 @@ pub(super) fn run(
             }
             // The time of these rays, solid by solid: how the test's cost
             // changes (or not) with the distance.
-            let timing = {
-                let mut runs = Vec::with_capacity(repeats);
-                for _ in 0..=repeats {
-                    let start = std::time::Instant::now();
-                    let mut offset = 0;
-                    for (accel, count) in &accels {
-                        let chunk = &rays[offset..offset + count];
-                        let hits = trace_closest(accel.as_ref(), chunk);
-                        std::hint::black_box(hits);
-                        offset += count;
-                    }
-                    runs.push(start.elapsed().as_secs_f64() * 1e3);
+            let timing = crate::measure::time(repeats, 1, || {
+                let mut offset = 0;
+                for (accel, count) in &accels {
+                    let chunk = &rays[offset..offset + count];
+                    let hits = trace_closest(accel.as_ref(), chunk);
+                    std::hint::black_box(hits);
+                    offset += count;
                 }
-                // The first run warms the caches up and is not counted.
-                Timing::of(&runs[1..])
-            };
+            });
             let distance = 2f64.powi(exponent);
             let mut point = Point::new(distance, format!("2^{exponent}"))
                 .with("self_hits", self_hits as f64)

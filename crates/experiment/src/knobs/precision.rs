@@ -15,8 +15,6 @@
 //! arithmetic alone, and a ray whose exact answer lies inside the triangle
 //! but that the test reports as a miss is counted as a miss.
 
-use std::time::Instant;
-
 use rtgi_accel::{Accel, Intersector, LinearScan};
 use rtgi_math::{Frame, Ray, Rng, Vec3, uniform_sphere};
 
@@ -150,15 +148,10 @@ fn measure_errors(intersector: Intersector, cases: &[([Vec3; 3], Ray)], exact: &
 fn time_tests(intersector: Intersector, cases: &[([Vec3; 3], Ray)], repeats: usize) -> Timing {
     let triangles: Vec<[Vec3; 3]> = cases.iter().map(|c| c.0).collect();
     let scan = LinearScan::new(&triangles, intersector);
-    let run = || {
-        let start = Instant::now();
+    crate::measure::time(repeats, 1, || {
         let hits = cases.iter().filter(|(_, ray)| scan.intersect(ray).is_some()).count();
         std::hint::black_box(hits);
-        start.elapsed().as_secs_f64() * 1e3
-    };
-    run();
-    let runs: Vec<f64> = (0..repeats).map(|_| run()).collect();
-    Timing::of(&runs)
+    })
 }
 
 /// Cases per point: each ray is tested against all of them when timed.

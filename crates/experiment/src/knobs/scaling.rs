@@ -9,13 +9,11 @@
 
 use std::time::Instant;
 
-use rayon::prelude::*;
 use rtgi_accel::{AccelKind, BuildParams};
 use rtgi_math::{Ray, Rng, Vec3, uniform_sphere};
 
 use crate::plot::{Corner, Curve, Plot};
 use crate::report::{Point, Report, Series, Table, format_ms, format_number};
-use crate::stats::Timing;
 use crate::{ExperimentError, Options, Steps};
 
 /// A unit sphere of about `count` triangles: `rows` bands of `2 rows`
@@ -110,15 +108,9 @@ pub(super) fn run(options: &Options, mut report: Report, progress: &dyn Fn(&str)
                 ray_count
             };
             let rays = &all_rays[..limit];
-            let run = || {
-                let start = Instant::now();
-                let hits: usize =
-                    rays.par_chunks(256).map(|c| c.iter().filter(|r| accel.intersect(r).is_some()).count()).sum();
-                std::hint::black_box(hits);
-                start.elapsed().as_secs_f64() * 1e3
-            };
-            run();
-            let timing = Timing::of(&(0..options.repeats.max(1)).map(|_| run()).collect::<Vec<_>>());
+            let timing = crate::measure::time_rays(rays, options.repeats, |chunk| {
+                chunk.iter().filter(|r| accel.intersect(r).is_some()).count()
+            });
             let per_ray = |ms: f64| ms * 1e6 / rays.len() as f64;
             let mut point = Point::new(triangles.len() as f64, triangles.len().to_string())
                 .with("ns_per_ray", per_ray(timing.median_ms))

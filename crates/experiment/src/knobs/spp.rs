@@ -17,7 +17,7 @@ use rtgi_render::{Integrator, PixelSampler, RenderSettings};
 use crate::plot::{Corner, Curve, Plot};
 use crate::reference::reference;
 use crate::report::{Report, Series, Table, format_number, measurement_cells, measurement_header};
-use crate::runner::measure;
+use crate::runner::{add_equal_time_panel, measure};
 use crate::verdict::{Spread, compare};
 use crate::{ExperimentError, Options, Steps, Subject};
 
@@ -138,16 +138,11 @@ pub(super) fn run(
             curves: error_curves,
             legend: Corner::LowerLeft,
         });
-        report.plots.push(Plot {
-            file: format!("spp{suffix}-time.svg"),
-            title: format!("RMSE against render time, {integrand}"),
-            x_label: "render time (ms, median)".into(),
-            y_label: "RMSE of linear radiance".into(),
-            log_x: true,
-            log_y: true,
-            curves: time_curves,
-            legend: Corner::UpperRight,
-        });
+        report.plots.push(Plot::error_against_time(
+            format!("spp{suffix}-time.svg"),
+            format!("RMSE against render time, {integrand}"),
+            time_curves,
+        ));
         report.tables.push(table);
         if integrator == subject.settings.integrator {
             // Equal time: every sampler given the time stratified sampling takes at the compared count.
@@ -166,15 +161,8 @@ pub(super) fn run(
                     })
                     .collect();
                 steps.next("equal-time panel");
-                let entries = crate::runner::equal_time(subject, &reference, &configurations, budget);
-                let panel = crate::panel::Panel::new(
-                    "spp-equal-time.png",
-                    format!("The samplers at equal time ({} ms)", crate::report::format_ms(budget)),
-                    reference.image.clone(),
-                    entries,
-                );
-                report.findings.push(panel.caption());
-                report.panels.push(panel);
+                let file = "spp-equal-time.png".to_owned();
+                add_equal_time_panel(&mut report, subject, &reference, file, "The samplers", &configurations, budget);
             }
             report.reference = Some(reference.info);
         }
