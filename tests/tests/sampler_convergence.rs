@@ -32,7 +32,8 @@ use rtgi_scene::Scene;
 use rtgi_tests::{render_cornell_box, shared_scene, workspace_root};
 
 const COUNTS: [u32; 5] = [16, 32, 64, 128, 256];
-const SAMPLERS: [PixelSampler; 3] = [PixelSampler::Uniform, PixelSampler::Stratified, PixelSampler::LowDiscrepancy];
+const SAMPLERS: [PixelSampler; 4] =
+    [PixelSampler::Uniform, PixelSampler::Stratified, PixelSampler::LowDiscrepancy, PixelSampler::Sobol];
 const SEEDS: u64 = 12;
 
 fn scene_and_reference() -> Option<(Scene, HdrImage)> {

@@ -40,6 +40,18 @@ pub enum PixelSampler {
     /// pixels do not repeat the same pattern; computed in 64-bit fixed
     /// point, exact for every index.
     LowDiscrepancy,
+    /// An Owen-scrambled Sobol sequence, scrambled per pixel.
+    ///
+    /// The Sobol sequence's first two dimensions with Owen scrambling and a
+    /// shuffled index (Burley 2020, "Practical Hash-based Owen
+    /// Scrambling", through the `sobol_burley` crate), each pixel and each
+    /// pair of numbers with its own seed, so that pairs are not correlated
+    /// (padding). Every point of an Owen-scrambled sequence is uniform over
+    /// the square, so it is unbiased for every count; for powers of two the
+    /// points also fall one in each elementary interval (strata of every
+    /// shape), which is where its error falls fastest. Indices past 2^16
+    /// continue in another independently scrambled sequence.
+    Sobol,
 }
 
 /// Which sample of how many, in a pixel with its own random shift: what
@@ -62,8 +74,13 @@ const R2: [u64; 2] = [0xc13f_a9a9_02a6_328f, 0x91e1_0da5_c79e_7b1d];
 
 impl PixelSampler {
     /// Every sampler, in the order help texts list them.
-    pub const ALL: &'static [PixelSampler] =
-        &[PixelSampler::Center, PixelSampler::Uniform, PixelSampler::Stratified, PixelSampler::LowDiscrepancy];
+    pub const ALL: &'static [PixelSampler] = &[
+        PixelSampler::Center,
+        PixelSampler::Uniform,
+        PixelSampler::Stratified,
+        PixelSampler::LowDiscrepancy,
+        PixelSampler::Sobol,
+    ];
 
     /// The sampler's name on command lines and in reports (`center`, `uniform`, `stratified`, `low-discrepancy`).
     pub fn name(self) -> &'static str {
@@ -72,6 +89,7 @@ impl PixelSampler {
             PixelSampler::Uniform => "uniform",
             PixelSampler::Stratified => "stratified",
             PixelSampler::LowDiscrepancy => "low-discrepancy",
+            PixelSampler::Sobol => "sobol",
         }
     }
 
@@ -99,6 +117,7 @@ impl PixelSampler {
                 let shift = sample.pixel_shift.to_array().map(to_fixed);
                 r2_point(sample.index as u64, shift)
             }
+            PixelSampler::Sobol => sobol_point(sample.index, pixel_seed(sample.pixel_shift)),
         }
     }
 }
@@ -158,12 +177,25 @@ impl PixelSampler {
                 PixelSampler::LowDiscrepancy => {
                     r2_point(permute(index, count, seed as u32) as u64, [pattern, pattern << 24])
                 }
+                // The index shuffle and scramble of its own seed decorrelate the pair.
+                PixelSampler::Sobol => sobol_point(index, seed),
             }
         };
         // Pair 0 is the position in the pixel.
         let first = 1 + 3 * depth as u64;
         VertexNumbers { choices: pair(first), light: pair(first + 1), bsdf: pair(first + 2) }
     }
+}
+
+/// Point `i` of the Owen-scrambled Sobol sequence of `seed` (its first two
+/// dimensions); past 2^16 points, the next block of 2^16 is another
+/// sequence, independently scrambled.
+#[inline]
+fn sobol_point(i: u32, seed: u64) -> Vec2 {
+    const BLOCK: u32 = 1 << 16;
+    let seed = (seed ^ hash_u64((i / BLOCK) as u64)) as u32;
+    let i = i % BLOCK;
+    Vec2::new(sobol_burley::sample(i, 0, seed), sobol_burley::sample(i, 1, seed))
 }
 
 /// Point `i` of the R2 sequence shifted by `shift` (in 0.64 fixed point):
@@ -486,7 +518,7 @@ mod tests {
     /// only half the sub-squares of its cell.
     #[test]
     fn one_sample_of_a_pair_reaches_every_sub_square_of_the_pixel() {
-        for sampler in [PixelSampler::Stratified, PixelSampler::LowDiscrepancy] {
+        for sampler in [PixelSampler::Stratified, PixelSampler::LowDiscrepancy, PixelSampler::Sobol] {
             for count in [4u32, 6, 9, 16] {
                 let bins = (count * count) as usize;
                 let pixels = 100 * bins as u64;
@@ -517,7 +549,7 @@ mod tests {
     /// stays within 5 standard errors (0.11) of 0.
     #[test]
     fn first_vertex_pairs_are_uncorrelated_with_each_other_and_the_position() {
-        for sampler in [PixelSampler::Stratified, PixelSampler::LowDiscrepancy] {
+        for sampler in [PixelSampler::Stratified, PixelSampler::LowDiscrepancy, PixelSampler::Sobol] {
             let pairs: Vec<Vec<Vec2>> =
                 (0..=6).map(|pair| (0..PIXELS).flat_map(|pixel| points(sampler, 16, pixel, pair)).collect()).collect();
             let correlation = |a: &[f32], b: &[f32]| {
@@ -536,6 +568,33 @@ mod tests {
                         let b: Vec<f32> = pairs[j].iter().map(|p| p[axis_j]).collect();
                         let r = correlation(&a, &b);
                         assert!(r.abs() < 0.11, "{sampler}: pairs {i} and {j}, axes {axis_i}/{axis_j}: r = {r:.3}");
+                    }
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn sobol_points_fill_every_elementary_interval_for_powers_of_two() {
+        // 2^k Owen-scrambled Sobol points put one point in each of the 2^k
+        // boxes of every shape 2^a × 2^(k−a): positions and every vertex pair.
+        for k in 0..=8u32 {
+            let count = 1 << k;
+            for pixel in 0..6 {
+                let mut sets = vec![offsets(PixelSampler::Sobol, count, pixel)];
+                for pair in 1..=3 {
+                    sets.push(points(PixelSampler::Sobol, count, pixel, pair));
+                }
+                for points in sets {
+                    for a in 0..=k {
+                        let (columns, rows) = (1u32 << a, 1u32 << (k - a));
+                        let mut seen = vec![false; count as usize];
+                        for p in &points {
+                            let (x, y) = ((p.x * columns as f32) as u32, (p.y * rows as f32) as u32);
+                            let cell = (y * columns + x) as usize;
+                            assert!(!seen[cell], "{count} points, {columns}×{rows} boxes: two in box {cell}");
+                            seen[cell] = true;
+                        }
                     }
                 }
             }
@@ -637,7 +696,7 @@ mod tests {
                 total / 200.0
             };
             let uniform = error(PixelSampler::Uniform);
-            for sampler in [PixelSampler::Stratified, PixelSampler::LowDiscrepancy] {
+            for sampler in [PixelSampler::Stratified, PixelSampler::LowDiscrepancy, PixelSampler::Sobol] {
                 let e = error(sampler);
                 assert!(e < 0.5 * uniform, "{sampler}, {count} spp: {e} against uniform {uniform}");
             }

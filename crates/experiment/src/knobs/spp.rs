@@ -24,7 +24,8 @@ use crate::{ExperimentError, Options, Steps, Subject};
 /// The count at which the samplers are compared in efficiency.
 const COMPARED_AT: f64 = 16.0;
 
-const SAMPLERS: [PixelSampler; 3] = [PixelSampler::Uniform, PixelSampler::Stratified, PixelSampler::LowDiscrepancy];
+const SAMPLERS: [PixelSampler; 4] =
+    [PixelSampler::Uniform, PixelSampler::Stratified, PixelSampler::LowDiscrepancy, PixelSampler::Sobol];
 
 /// Errors within this factor of the reference's own noise are left out of the fits.
 const NOISE_MARGIN: f64 = 3.0;
