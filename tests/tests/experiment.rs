@@ -31,7 +31,19 @@ fn every_knob_writes_its_table_json_and_plots() {
     let run = rtgi(&["experiment", "all", "--quick", "--repeats", "2", "--out", path_str(&dir)]);
     assert!(run.success, "{run:?}");
     let mut commits = std::collections::BTreeSet::new();
-    for knob in ["spp", "depth", "accel", "scaling", "direct", "clamp", "effects", "intersector", "precision"] {
+    for knob in [
+        "spp",
+        "depth",
+        "accel",
+        "scaling",
+        "traversal",
+        "packets",
+        "direct",
+        "clamp",
+        "effects",
+        "intersector",
+        "precision",
+    ] {
         let folder = dir.join(knob);
         let md = std::fs::read_to_string(folder.join(format!("{knob}.md"))).expect("the table");
         assert!(md.contains(&format!("# `{knob}`")) && md.contains("|---|"), "{md}");
@@ -83,6 +95,16 @@ fn every_knob_writes_its_table_json_and_plots() {
         }
     }
     assert_eq!(commits.len(), 1, "every report names the same commit: {commits:?}");
+    // The robust traversal and the packets change no answer.
+    for (knob, series) in [("traversal", "sah, robust"), ("packets", "bvh8, camera rays")] {
+        let json: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(dir.join(knob).join(format!("{knob}.json"))).unwrap())
+                .unwrap();
+        let found = json["series"].as_array().unwrap().iter().find(|s| s["name"] == series).expect(series);
+        for point in found["points"].as_array().unwrap() {
+            assert_eq!(point["values"]["differing"], 0.0, "{knob}, {series}: {point}");
+        }
+    }
     // The four equal-time panels: PNGs listed in the JSON, their captions among the findings.
     for (knob, panel) in [
         ("spp", "spp-equal-time.png"),

@@ -45,6 +45,7 @@ fn report_scenes(knob: Knob) -> &'static [&'static str] {
         Knob::Clamp => &[CORNELL, ROOM],
         Knob::Accel => &[CORNELL, BUNNY, SPONZA, CONFERENCE],
         Knob::Effects => &[CORNELL, HELMET],
+        Knob::Traversal | Knob::Packets => &[BUNNY],
         _ => &[CORNELL],
     }
 }

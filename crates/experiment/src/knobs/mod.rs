@@ -11,9 +11,11 @@ mod depth;
 mod direct;
 mod effects;
 mod intersector;
+mod packets;
 mod precision;
 mod scaling;
 mod spp;
+mod traversal;
 
 /// Something an experiment varies.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -27,6 +29,10 @@ pub enum Knob {
     Accel,
     /// The naive O(n) search against the BVH, over triangle counts.
     Scaling,
+    /// The robust slab test of traversal against the textbook one.
+    Traversal,
+    /// Batch queries (packets of 16 coherent rays) against one ray at a time.
+    Packets,
     /// Light, BSDF and MIS sampling of direct light, on scenes built for each.
     Direct,
     /// The indirect-light clamp: bias traded for variance.
@@ -49,6 +55,8 @@ impl Knob {
         Knob::Depth,
         Knob::Accel,
         Knob::Scaling,
+        Knob::Traversal,
+        Knob::Packets,
         Knob::Direct,
         Knob::Clamp,
         Knob::Effects,
@@ -63,6 +71,8 @@ impl Knob {
             Knob::Depth => "depth",
             Knob::Accel => "accel",
             Knob::Scaling => "scaling",
+            Knob::Traversal => "traversal",
+            Knob::Packets => "packets",
             Knob::Direct => "direct",
             Knob::Clamp => "clamp",
             Knob::Effects => "effects",
@@ -83,6 +93,12 @@ impl Knob {
             }
             Knob::Scaling => {
                 "how does the time per ray grow with the triangle count, for the naive search and for the BVH?"
+            }
+            Knob::Traversal => {
+                "what does the robust slab test cost, and how many answers does the textbook one change?"
+            }
+            Knob::Packets => {
+                "what do packets of coherent rays gain over one ray at a time, and do they change any answer?"
             }
             Knob::Direct => {
                 "which sampling of direct light (light, BSDF or MIS) gives the least error in equal time, and where?"
@@ -158,6 +174,8 @@ pub(crate) fn run(
         Knob::Depth => depth::run(subject, options, report, progress),
         Knob::Accel => accel::run(subject, options, report, progress),
         Knob::Scaling => scaling::run(options, report, progress),
+        Knob::Traversal => traversal::run(subject, options, report, progress),
+        Knob::Packets => packets::run(subject, options, report, progress),
         Knob::Direct => direct::run(subject, options, report, progress),
         Knob::Clamp => clamp::run(subject, options, report, progress),
         Knob::Effects => effects::run(subject, options, report, progress),
