@@ -161,6 +161,7 @@ pub(crate) fn run(args: &ExperimentArgs) -> Result<()> {
     if args.knob == KnobChoice::All {
         let record = RunRecord {
             command: options.command.clone(),
+            features: RunRecord::features(),
             build: Build::this(),
             machine: Machine::this(options.threads),
             started: started.1,

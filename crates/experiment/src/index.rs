@@ -24,6 +24,9 @@ use crate::{ExperimentError, Knob, Machine, Report};
 pub struct RunRecord {
     /// The command, as typed.
     pub command: String,
+    /// The optional cargo features the program was built with that change
+    /// what is measured (`embree`: Embree measured beside our structures).
+    pub features: Vec<String>,
     /// The program that ran it.
     pub build: Build,
     /// The machine it ran on.
@@ -34,6 +37,13 @@ pub struct RunRecord {
     pub finished: String,
     /// Its wall time in seconds, references included.
     pub wall_seconds: f64,
+}
+
+impl RunRecord {
+    /// The measuring features this program was built with.
+    pub fn features() -> Vec<String> {
+        rtgi_accel::AccelKind::PEERS.iter().map(|k| k.name().to_owned()).collect()
+    }
 }
 
 /// The name of the run record beside the index.
@@ -165,8 +175,10 @@ pub fn index_markdown(folder: &Path) -> Result<String, ExperimentError> {
         let _ = writeln!(md, "{}\n", first.report.provenance());
     }
     if let Some(run) = &run {
+        let features =
+            if run.features.is_empty() { String::new() } else { format!(" --features {}", run.features.join(",")) };
         let regenerate = match run.command.strip_prefix("rtgi ") {
-            Some(args) => format!("cargo run --release -p rtgi -- {args}"),
+            Some(args) => format!("cargo run --release -p rtgi{features} -- {args}"),
             None => run.command.clone(),
         };
         let _ = writeln!(
