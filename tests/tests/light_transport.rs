@@ -8,28 +8,13 @@ use std::f32::consts::PI;
 use rtgi_accel::{AccelKind, BuildParams};
 use rtgi_image::HdrImage;
 use rtgi_math::{Vec2, Vec3};
-use rtgi_render::probes::icosphere;
 use rtgi_render::{
     CameraRays, DirectStrategy, Effect, EffectOverrides, EffectPlan, EffectSet, Environment, Integrator, PixelSampler,
     RenderSettings, render,
 };
 use rtgi_scene::{Camera, Light, LightKind, Material, MeshBuilder, Scene, SurfaceModel};
 
-/// A unit icosphere of one material with flat normals, its faces wound to
-/// face outwards or (for a furnace seen from inside) inwards.
-fn sphere_scene(material: Material, inward: bool) -> Scene {
-    let sphere = icosphere(3);
-    let mut scene = Scene { materials: vec![material], ..Scene::default() };
-    let mut builder = MeshBuilder::new(sphere.vertices.clone(), Vec::new(), Vec::new()).with_flat_normals();
-    for face in &sphere.faces {
-        let [a, b, c] = face.map(|i| sphere.vertices[i as usize]);
-        let outward = (b - a).cross(c - a).dot(a + b + c) > 0.0;
-        let face = if outward == inward { [face[0], face[2], face[1]] } else { *face };
-        builder.push(face, None, None, 0);
-    }
-    builder.finish_into(&mut scene);
-    scene
-}
+use rtgi_experiment::analytic::sphere_scene;
 
 fn render_scene(scene: &Scene, camera: &Camera, settings: &RenderSettings) -> HdrImage {
     let accel = AccelKind::Sah.build(&scene.triangle_positions(), &BuildParams::default());

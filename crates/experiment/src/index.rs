@@ -131,8 +131,12 @@ fn scene_slug(scene: &str) -> String {
 /// Each scene's Pareto plot (`pareto/SCENE.svg`) with its configurations,
 /// for the scenes whose reports measured rendered configurations.
 fn pareto_plots(reports: &[IndexedReport]) -> Vec<(String, Plot, usize)> {
+    // Knobs that render scenes of their own (direct, analytic) measure
+    // against several references: no one front of theirs is a scene's.
+    let on_the_scene = |r: &&IndexedReport| Knob::ALL.iter().any(|k| k.name() == r.report.knob && k.uses_scene());
+    let reports: Vec<&IndexedReport> = reports.iter().filter(on_the_scene).collect();
     let mut scenes: Vec<&str> = Vec::new();
-    for r in reports {
+    for r in &reports {
         if !scenes.contains(&r.report.scene.as_str()) {
             scenes.push(&r.report.scene);
         }
@@ -141,9 +145,9 @@ fn pareto_plots(reports: &[IndexedReport]) -> Vec<(String, Plot, usize)> {
         .into_iter()
         .filter_map(|scene| {
             let configurations = pareto::configurations(reports.iter().map(|r| &r.report).filter(|r| r.scene == scene));
-            let knobs: std::collections::BTreeSet<&str> = configurations.iter().map(|c| c.knob.as_str()).collect();
-            // One knob alone is already its own error-against-time plot.
-            (knobs.len() >= 2).then(|| {
+            // Every scene with rendered configurations, even of one knob:
+            // its front across the knob's settings is the scene's trade-off.
+            (!configurations.is_empty()).then(|| {
                 let file = format!("{PARETO_FOLDER}/{}.svg", scene_slug(scene));
                 let count = configurations.len();
                 (scene.to_owned(), pareto::plot(&file, &configurations), count)

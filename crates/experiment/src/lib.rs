@@ -29,6 +29,7 @@ use rtgi_accel::Accel;
 use rtgi_render::RenderSettings;
 use rtgi_scene::{Camera, Scene};
 
+pub mod analytic;
 pub mod exact;
 mod index;
 mod knobs;

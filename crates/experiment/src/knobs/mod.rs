@@ -6,6 +6,7 @@ use crate::report::Report;
 use crate::{ExperimentError, Machine, Options, Subject};
 
 mod accel;
+mod analytic;
 mod clamp;
 mod depth;
 mod direct;
@@ -37,6 +38,8 @@ pub enum Knob {
     Direct,
     /// The indirect-light clamp: bias traded for variance.
     Clamp,
+    /// Each estimator's bias against answers known in closed form (white furnaces).
+    Analytic,
     /// Each decision of the effects planner reversed.
     Effects,
     /// The ray/triangle tests: time, and failures on the hard cases of `rtgi verify`.
@@ -59,6 +62,7 @@ impl Knob {
         Knob::Packets,
         Knob::Direct,
         Knob::Clamp,
+        Knob::Analytic,
         Knob::Effects,
         Knob::Intersector,
         Knob::Precision,
@@ -75,6 +79,7 @@ impl Knob {
             Knob::Packets => "packets",
             Knob::Direct => "direct",
             Knob::Clamp => "clamp",
+            Knob::Analytic => "analytic",
             Knob::Effects => "effects",
             Knob::Intersector => "intersector",
             Knob::Precision => "precision",
@@ -104,6 +109,9 @@ impl Knob {
                 "which sampling of direct light (light, BSDF or MIS) gives the least error in equal time, and where?"
             }
             Knob::Clamp => "how much bias does clamping indirect light add for the variance it removes?",
+            Knob::Analytic => {
+                "is any estimator (sampler, direct-light strategy, roulette) biased against an answer known exactly?"
+            }
             Knob::Effects => {
                 "what does each effect cost, and does leaving out one the scene does not call for cost accuracy?"
             }
@@ -122,7 +130,7 @@ impl Knob {
     /// reference of it); `scaling` and `precision` make their own
     /// triangles and `direct` renders scenes of its own, at the subject's size.
     pub fn uses_scene(self) -> bool {
-        !matches!(self, Knob::Scaling | Knob::Direct | Knob::Precision)
+        !matches!(self, Knob::Scaling | Knob::Direct | Knob::Precision | Knob::Analytic)
     }
 }
 
@@ -153,6 +161,7 @@ pub(crate) fn run(
             _ if knob.uses_scene() => subject.name.clone(),
             Knob::Direct => "scenes/direct-*.toml (built in: small light, large light, glossy)".to_owned(),
             Knob::Precision => "generated triangles".to_owned(),
+            Knob::Analytic => "white furnaces (built in: closed emitting spheres)".to_owned(),
             _ => "generated meshes".to_owned(),
         },
         machine: Machine::this(options.threads),
@@ -178,6 +187,7 @@ pub(crate) fn run(
         Knob::Packets => packets::run(subject, options, report, progress),
         Knob::Direct => direct::run(subject, options, report, progress),
         Knob::Clamp => clamp::run(subject, options, report, progress),
+        Knob::Analytic => analytic::run(options, report, progress),
         Knob::Effects => effects::run(subject, options, report, progress),
         Knob::Intersector => intersector::run(subject, options, report, progress),
         Knob::Precision => precision::run(options, report, progress),

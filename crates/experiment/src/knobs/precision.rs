@@ -331,5 +331,32 @@ fn plots(report: &mut Report) {
             .collect(),
         legend: Corner::UpperRight,
     });
+    // The trade-off on one plot: each test's largest error of t on each
+    // family against its time per test (the median over the family, with
+    // the family's fastest and slowest), log-log.
+    plots.push(Plot {
+        file: "precision-error-time.svg".into(),
+        title: "Largest relative error of t against time per triangle test, per family of hard triangles".into(),
+        x_label: "ns per triangle test (median over the family; bars min–max)".into(),
+        y_label: "largest relative error of t".into(),
+        log_x: true,
+        log_y: true,
+        curves: Intersector::ALL
+            .iter()
+            .flat_map(|&i| Family::ALL.iter().map(move |&family| (i, family)))
+            .filter_map(|(i, family)| {
+                let points = series(report, i, family);
+                let mut ns: Vec<f64> = points.iter().map(|p| p.values["ns_per_test"]).collect();
+                let (fastest, slowest) =
+                    (ns.iter().copied().fold(f64::INFINITY, f64::min), ns.iter().copied().fold(0.0, f64::max));
+                let error = points.iter().map(|p| p.values["t_relative_error_max"]).fold(0.0, f64::max);
+                (error > 0.0 && !ns.is_empty()).then(|| {
+                    Curve::new(format!("{}, {}", i.name(), family.name()), vec![(median_max(&mut ns).0, error)])
+                        .with_x_bars(vec![Some((fastest, slowest))])
+                })
+            })
+            .collect(),
+        legend: Corner::UpperRight,
+    });
     report.plots.extend(plots);
 }
