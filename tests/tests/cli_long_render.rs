@@ -102,13 +102,44 @@ fn a_second_interrupt_ends_the_render_at_once() {
     // Once the first pass (one sample) is done, the render is in its long second pass.
     std::thread::sleep(Duration::from_millis(1500));
     send("INT", child.id());
-    std::thread::sleep(Duration::from_millis(50));
+    // Later than a repeat of the same request (250 ms), as a person presses it.
+    std::thread::sleep(Duration::from_millis(400));
     send("INT", child.id());
     let start = Instant::now();
     let run: Run = child.wait_with_output().unwrap().into();
     assert_eq!(run.code, Some(130), "{run:?}");
     assert!(start.elapsed() < Duration::from_secs(5), "took {:?} to stop", start.elapsed());
     assert!(!run.stderr.contains("panicked"), "{run:?}");
+}
+
+#[test]
+fn the_same_signal_delivered_twice_at_once_still_saves_the_checkpoint() {
+    // A scheduler signals every process of a job, and the job's script forwards the signal too:
+    // rtgi gets it twice within milliseconds, and must take it as one request to stop and save.
+    let dir = scratch_dir("signal-twice");
+    let (image, checkpoint) = (dir.join("image.exr"), dir.join("render.accum"));
+    let args: Vec<&str> = [
+        "render",
+        "--width",
+        "256",
+        "--height",
+        "256",
+        "--spp",
+        "4096",
+        "-o",
+        path_str(&image),
+        "--checkpoint",
+        path_str(&checkpoint),
+    ]
+    .into();
+    let child = spawn(&args);
+    std::thread::sleep(Duration::from_millis(1500));
+    send("TERM", child.id());
+    send("TERM", child.id());
+    let run: Run = child.wait_with_output().unwrap().into();
+    assert_eq!(run.code, Some(143), "{run:?}");
+    assert!(run.stdout.contains("stopped     by SIGTERM"), "{run:?}");
+    assert!(checkpoint.exists(), "no checkpoint after a doubled SIGTERM: {run:?}");
 }
 
 #[test]
@@ -172,6 +203,21 @@ fn four_sample_ranges_and_three_bands_merge_to_the_same_bytes() {
     let run = rtgi(&["merge", path_str(&parts[0]), path_str(&parts[2]), "-o", path_str(&merged)]);
     assert_eq!(run.code, Some(1));
     assert!(run.stderr.contains("no part holds samples 40..41"), "{run:?}");
+    // Without the first or the last part the rest is contiguous, but not the render: refused unless
+    // --allow-incomplete says that a partial image is what is wanted.
+    for (kept, missing) in [(&parts[1..], "samples 0..40"), (&parts[..3], "samples 150..192")] {
+        let mut merge = vec!["merge"];
+        merge.extend(kept.iter().map(|p| path_str(p)));
+        merge.extend(["-o", path_str(&merged)]);
+        std::fs::remove_file(&merged).unwrap();
+        let run = rtgi(&merge);
+        assert_eq!(run.code, Some(1), "{run:?}");
+        assert!(run.stderr.contains("incomplete") && run.stderr.contains(missing), "{missing}: {run:?}");
+        assert!(!merged.exists(), "an incomplete merge wrote {}", merged.display());
+        merge.push("--allow-incomplete");
+        let run = rtgi(&merge);
+        assert!(run.success && run.stdout.contains("incomplete"), "{run:?}");
+    }
     let other = dir.join("other.accum");
     let run = rtgi(&[
         "render",
@@ -205,7 +251,8 @@ fn resuming_with_other_options_is_refused_naming_them() {
     let mut args = render_args(&["--max-depth", "3", "--resume", path_str(&part), "-o", path_str(&image)]);
     args.extend(["--samples", "0..4"]);
     let run = rtgi(&args);
-    assert_eq!(run.code, Some(1), "{run:?}");
+    // Exit 3: a job script tells a foreign checkpoint from a failure that running again may cure.
+    assert_eq!(run.code, Some(3), "{run:?}");
     assert!(run.stderr.contains("max depth: 3 now, 8 in the file"), "{run:?}");
     assert!(!image.exists());
 }

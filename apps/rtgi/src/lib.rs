@@ -60,6 +60,10 @@ pub fn main() -> ExitCode {
                 eprintln!("rtgi: {e}");
                 return ExitCode::from(interrupt::exit_status(*signal));
             }
+            if e.downcast_ref::<render_job::ResumeOfAnotherRender>().is_some() {
+                eprintln!("error: {}", one_line(&e));
+                return ExitCode::from(render_job::ResumeOfAnotherRender::EXIT_STATUS);
+            }
             eprintln!("error: {}", one_line(&e));
             ExitCode::FAILURE
         }

@@ -4,7 +4,7 @@ use std::path::PathBuf;
 
 use anyhow::{Context, Result, bail};
 use clap::Args;
-use rtgi_render::Accumulation;
+use rtgi_render::{Accumulation, MergeFilesError};
 
 use crate::cli::ToneArgs;
 use crate::output::outln;
@@ -21,6 +21,11 @@ pub(crate) struct MergeArgs {
     #[arg(short, long)]
     pub(crate) output: PathBuf,
 
+    /// Write the result even if the parts do not hold every sample of every
+    /// pixel (a split render with parts still missing, or an .accum to merge further)
+    #[arg(long)]
+    pub(crate) allow_incomplete: bool,
+
     #[command(flatten)]
     pub(crate) tone: ToneArgs,
 }
@@ -32,9 +37,12 @@ pub(crate) fn run(args: &MergeArgs) -> Result<()> {
             bail!("-o {}: is also one of the parts; write the result to a new file", args.output.display());
         }
     }
-    let parts = args.parts.iter().map(|path| Accumulation::read(path)).collect::<Result<Vec<_>, _>>()?;
     let names: Vec<String> = args.parts.iter().map(|p| p.display().to_string()).collect();
-    let merged = Accumulation::merge(parts).map_err(|e| {
+    let merged = Accumulation::merge_files(&args.parts).map_err(|e| {
+        let e = match e {
+            MergeFilesError::File(e) => return anyhow::Error::new(e),
+            MergeFilesError::Merge(e) => e,
+        };
         // The error numbers the parts; name them.
         let mut message = e.to_string();
         message = message.replace("than part 0", &format!("than {}", names[0]));
@@ -47,6 +55,26 @@ pub(crate) fn run(args: &MergeArgs) -> Result<()> {
     })?;
     let identity = merged.identity();
     let complete = merged.is_complete();
+    if !complete && !args.allow_incomplete {
+        let (rows, samples) = (merged.rows(), merged.samples());
+        let mut missing = Vec::new();
+        if samples.start > 0 {
+            missing.push(format!("samples {:?}", 0..samples.start));
+        }
+        if samples.end < identity.samples_per_pixel {
+            missing.push(format!("samples {:?}", samples.end..identity.samples_per_pixel));
+        }
+        if rows != (0..identity.height) {
+            missing.push(format!("the rows outside {rows:?} of 0..{}", identity.height));
+        }
+        bail!(
+            "incomplete: the {} parts hold samples {samples:?} of 0..{} of every pixel of rows {rows:?}; no part \
+             holds {}. Add the missing parts, or give --allow-incomplete to write what there is",
+            args.parts.len(),
+            identity.samples_per_pixel,
+            missing.join(" or ")
+        );
+    }
     if is_accumulation(&args.output) {
         merged.write(&args.output)?;
     } else {

@@ -13,7 +13,7 @@ use crate::common::{LoadedScene, check_output_folder, load_scene, prepare_render
 use crate::interrupt;
 use crate::output::{out, outln};
 use crate::progress::Progress;
-use crate::render_job::{Ending, Renderer, StoppedBySignal, run_passes};
+use crate::render_job::{Ending, Renderer, ResumeOfAnotherRender, StoppedBySignal, run_passes};
 
 /// Extension of accumulation files: checkpoints and the parts of split renders.
 pub(crate) const ACCUMULATION_EXTENSION: &str = "accum";
@@ -140,22 +140,24 @@ pub(crate) fn render_image(args: &RenderArgs) -> Result<Rendered> {
                     .iter()
                     .map(|d| format!("{}: {} now, {} in the file", d.what, d.ours, d.theirs))
                     .collect();
-                bail!(
+                return Err(ResumeOfAnotherRender(format!(
                     "--resume {}: it is of another render ({}); resume it with the scene and options it was \
                      started with",
                     resume.display(),
                     differences.join("; ")
-                );
+                ))
+                .into());
             }
             if resumed.rows() != rows || resumed.samples().start != samples.start || resumed.samples().end > samples.end
             {
-                bail!(
+                return Err(ResumeOfAnotherRender(format!(
                     "--resume {}: it holds rows {:?} and samples {:?}, this job renders rows {rows:?} and \
                      samples {samples:?} (check --tile and --samples)",
                     resume.display(),
                     resumed.rows(),
                     resumed.samples()
-                );
+                ))
+                .into());
             }
             say!("resuming   {} at {} of {} samples per pixel", resume.display(), resumed.samples().end, samples.end);
             resumed

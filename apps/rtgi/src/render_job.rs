@@ -38,7 +38,8 @@ pub(crate) struct JobArgs {
     pub(crate) checkpoint_every: f64,
 
     /// Continue the render saved in FILE by --checkpoint; the scene and every option must be
-    /// those it was started with. The result has the bits of a render never interrupted
+    /// those it was started with (a file of another render, or of other --samples or --tile,
+    /// is refused with exit status 3). The result has the bits of a render never interrupted
     #[arg(long, value_name = "FILE")]
     pub(crate) resume: Option<PathBuf>,
 
@@ -230,6 +231,25 @@ impl std::fmt::Display for StoppedBySignal {
 }
 
 impl std::error::Error for StoppedBySignal {}
+
+/// A `--resume` file of another render, or of another share of it: the
+/// command ends with exit status [`ResumeOfAnotherRender::EXIT_STATUS`], so
+/// that a job script can tell it from a failure that running again may cure.
+#[derive(Debug)]
+pub(crate) struct ResumeOfAnotherRender(pub(crate) String);
+
+impl ResumeOfAnotherRender {
+    /// The exit status.
+    pub(crate) const EXIT_STATUS: u8 = 3;
+}
+
+impl std::fmt::Display for ResumeOfAnotherRender {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(&self.0)
+    }
+}
+
+impl std::error::Error for ResumeOfAnotherRender {}
 
 #[cfg(test)]
 mod tests {

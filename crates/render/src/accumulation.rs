@@ -223,7 +223,55 @@ impl Accumulation {
     /// one another without a gap, and every band must end up with the same
     /// samples, one contiguous range. The result has the bits a render of
     /// those rows and samples in one go would have.
+    ///
+    /// [`Accumulation::merge_files`] does the same from files, one part in
+    /// memory at a time.
     pub fn merge(parts: Vec<Accumulation>) -> Result<Accumulation, MergeError> {
+        let spans: Vec<PartSpan> = parts
+            .iter()
+            .map(|p| PartSpan { identity: p.identity.clone(), rows: p.rows(), samples: p.samples() })
+            .collect();
+        let plan = MergePlan::new(&spans)?;
+        let mut merged = plan.empty();
+        for (part, offset) in parts.iter().zip(&plan.offsets) {
+            for (sum, value) in merged.sums[*offset..].iter_mut().zip(&part.sums) {
+                add(sum, value);
+            }
+        }
+        Ok(merged)
+    }
+
+    /// Adds `value` to the sum of pixel `index` of the band (row by row).
+    pub(crate) fn add_to_pixel(&mut self, index: usize, value: &PixelSum) {
+        add(&mut self.sums[index], value);
+    }
+}
+
+/// What a part holds, as its file's header says: enough to check a merge
+/// before any sums are read.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PartSpan {
+    /// The render it is a part of.
+    pub identity: RenderIdentity,
+    /// Its band of rows.
+    pub rows: Range<u32>,
+    /// Its samples of every pixel.
+    pub samples: Range<u32>,
+}
+
+/// A checked merge: the result's span, and where each part's sums go in it.
+#[derive(Debug)]
+pub(crate) struct MergePlan {
+    identity: RenderIdentity,
+    rows: Range<u32>,
+    samples: Range<u32>,
+    /// Per part, in the order given: the index in the result's sums of the part's first pixel.
+    pub(crate) offsets: Vec<usize>,
+}
+
+impl MergePlan {
+    /// Checks that `parts` make one accumulation (see [`Accumulation::merge`]).
+    pub(crate) fn new(parts: &[PartSpan]) -> Result<MergePlan, MergeError> {
         let first = parts.first().ok_or(MergeError::Empty)?;
         let identity = first.identity.clone();
         for (index, part) in parts.iter().enumerate() {
@@ -292,16 +340,19 @@ impl Accumulation {
         }
         let rows = bands[0].0.start..bands[bands.len() - 1].0.end;
         let width = identity.width as usize;
-        let mut sums = vec![[0i128; 3]; (rows.end - rows.start) as usize * width];
-        for (band, members) in &bands {
-            let offset = (band.start - rows.start) as usize * width;
-            for &member in members {
-                for (sum, value) in sums[offset..].iter_mut().zip(&parts[member].sums) {
-                    add(sum, value);
-                }
-            }
+        let offsets = parts.iter().map(|part| (part.rows.start - rows.start) as usize * width).collect();
+        Ok(MergePlan { identity, rows, samples, offsets })
+    }
+
+    /// The result with every sum zero, for the parts to be added to.
+    pub(crate) fn empty(&self) -> Accumulation {
+        let pixels = (self.rows.end - self.rows.start) as usize * self.identity.width as usize;
+        Accumulation {
+            identity: self.identity.clone(),
+            rows: self.rows.clone(),
+            samples: self.samples.clone(),
+            sums: vec![[0; 3]; pixels],
         }
-        Ok(Accumulation { identity, rows, samples, sums })
     }
 }
 

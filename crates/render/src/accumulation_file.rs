@@ -17,7 +17,7 @@ use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
 
-use crate::accumulation::{Accumulation, PixelSum};
+use crate::accumulation::{Accumulation, MergeError, MergePlan, PartSpan, PixelSum};
 use crate::identity::{Fnv, RenderIdentity};
 
 const MAGIC: &[u8] = b"rtgi accumulation 1\n";
@@ -79,6 +79,60 @@ impl Accumulation {
 
     /// Reads an accumulation written by [`Accumulation::write`].
     pub fn read(path: &Path) -> Result<Accumulation, AccumulationFileError> {
+        let mut file = PartFile::open(path)?;
+        let pixels = file.pixels();
+        let mut sums: Vec<PixelSum> = Vec::new();
+        sums.try_reserve_exact(pixels as usize)
+            .map_err(|_| file.invalid(format!("{pixels} pixels do not fit in memory")))?;
+        file.read_sums(|_, sum| sums.push(sum))?;
+        let PartSpan { identity, rows, samples } = file.span;
+        Accumulation::from_parts(identity, rows, samples, sums)
+            .map_err(|message| AccumulationFileError::Invalid { path: path.to_owned(), message })
+    }
+
+    /// [`Accumulation::merge`] of the parts in these files, reading one
+    /// part's sums at a time: the headers are checked first, then each
+    /// file's sums are added straight into the result, so memory is the
+    /// result's, whatever the number of parts.
+    pub fn merge_files(paths: &[PathBuf]) -> Result<Accumulation, MergeFilesError> {
+        let spans = paths.iter().map(|path| PartSpan::read(path)).collect::<Result<Vec<_>, _>>()?;
+        let plan = MergePlan::new(&spans)?;
+        let mut merged = plan.empty();
+        for (path, offset) in paths.iter().zip(&plan.offsets) {
+            let mut file = PartFile::open(path)?;
+            file.read_sums(|pixel, sum| merged.add_to_pixel(offset + pixel, &sum))?;
+        }
+        Ok(merged)
+    }
+}
+
+/// Why the parts in files cannot be merged.
+#[derive(Debug, thiserror::Error)]
+pub enum MergeFilesError {
+    /// A part could not be read.
+    #[error(transparent)]
+    File(#[from] AccumulationFileError),
+    /// The parts do not make one render.
+    #[error(transparent)]
+    Merge(#[from] MergeError),
+}
+
+impl PartSpan {
+    /// What the accumulation file at `path` holds, from its header alone.
+    pub fn read(path: &Path) -> Result<PartSpan, AccumulationFileError> {
+        Ok(PartFile::open(path)?.span)
+    }
+}
+
+/// An accumulation file whose header has been read and checked, positioned at its sums.
+struct PartFile {
+    path: PathBuf,
+    input: BufReader<File>,
+    span: PartSpan,
+}
+
+impl PartFile {
+    fn open(path: &Path) -> Result<PartFile, AccumulationFileError> {
         let io = |source| AccumulationFileError::Io { path: path.to_owned(), source };
         let invalid = |message: String| AccumulationFileError::Invalid { path: path.to_owned(), message };
         let mut input = BufReader::new(File::open(path).map_err(io)?);
@@ -101,7 +155,11 @@ impl Accumulation {
         if rows.start > rows.end || rows.end > identity.height {
             return Err(invalid(format!("rows {rows:?} outside an image of height {}", identity.height)));
         }
-        let pixels = (rows.end - rows.start) as u64 * identity.width as u64;
+        if samples.start > samples.end || samples.end > identity.samples_per_pixel {
+            return Err(invalid(format!("samples {samples:?} outside 0..{}", identity.samples_per_pixel)));
+        }
+        let file = PartFile { path: path.to_owned(), input, span: PartSpan { identity, rows, samples } };
+        let pixels = file.pixels();
         // Every pixel takes at least three bytes: a file shorter than that is
         // refused before its sums are allocated.
         if let Ok(metadata) = std::fs::metadata(path)
@@ -109,27 +167,45 @@ impl Accumulation {
         {
             return Err(invalid(format!("{} bytes cannot hold {pixels} pixels", metadata.len())));
         }
-        let mut sums: Vec<PixelSum> = Vec::new();
-        sums.try_reserve_exact(pixels as usize)
-            .map_err(|_| invalid(format!("{pixels} pixels do not fit in memory")))?;
+        Ok(file)
+    }
+
+    fn pixels(&self) -> u64 {
+        let rows = &self.span.rows;
+        (rows.end - rows.start) as u64 * self.span.identity.width as u64
+    }
+
+    fn invalid(&self, message: String) -> AccumulationFileError {
+        AccumulationFileError::Invalid { path: self.path.clone(), message }
+    }
+
+    /// Reads every pixel's sums in order, giving each to `pixel` with its
+    /// index, then checks the checksum and the end of the file. An error
+    /// may come after some pixels were given.
+    fn read_sums(&mut self, mut pixel: impl FnMut(usize, PixelSum)) -> Result<(), AccumulationFileError> {
+        let pixels = self.pixels();
         let mut checksum = Fnv::new();
-        for pixel in 0..pixels {
+        for index in 0..pixels {
             let mut sum = [0i128; 3];
             for channel in &mut sum {
-                *channel = decode(&mut input, &mut checksum)
-                    .map_err(|e| invalid(format!("pixel {pixel} of {pixels}: {e}")))?;
+                *channel = decode(&mut self.input, &mut checksum)
+                    .map_err(|e| self.invalid(format!("pixel {index} of {pixels}: {e}")))?;
             }
-            sums.push(sum);
+            pixel(index as usize, sum);
         }
         let mut stored = [0u8; 8];
-        read_exact(&mut input, &mut stored).map_err(|e| invalid(format!("{e} in the checksum")))?;
+        read_exact(&mut self.input, &mut stored).map_err(|e| self.invalid(format!("{e} in the checksum")))?;
         if u64::from_le_bytes(stored) != checksum.0 {
-            return Err(invalid("the checksum does not match: the file is damaged".into()));
+            return Err(self.invalid("the checksum does not match: the file is damaged".into()));
         }
-        if input.read(&mut [0u8; 1]).map_err(io)? != 0 {
-            return Err(invalid("there are bytes after the checksum".into()));
+        let extra = self
+            .input
+            .read(&mut [0u8; 1])
+            .map_err(|source| AccumulationFileError::Io { path: self.path.clone(), source })?;
+        if extra != 0 {
+            return Err(self.invalid("there are bytes after the checksum".into()));
         }
-        Accumulation::from_parts(identity, rows, samples, sums).map_err(invalid)
+        Ok(())
     }
 }
 
@@ -220,5 +296,31 @@ mod tests {
         std::fs::write(&damaged, b"P6 not this").unwrap();
         let error = Accumulation::read(&damaged).unwrap_err().to_string();
         assert!(error.contains("not an rtgi accumulation file"), "{error}");
+    }
+
+    #[test]
+    fn merging_files_streams_to_the_bits_of_merging_in_memory() {
+        let identity = RenderIdentity::for_tests(3, 6, 12);
+        let part = |rows: Range<u32>, samples: Range<u32>, seed: i128| {
+            let pixels = (rows.end - rows.start) as i128 * 3;
+            let sums = (0..pixels).map(|i| [i * seed, -(i << 70) + seed, seed << 100]).collect();
+            Accumulation::from_parts(identity.clone(), rows, samples, sums).unwrap()
+        };
+        let parts = vec![part(3..6, 4..12, 5), part(0..3, 0..7, 1), part(3..6, 0..4, 2), part(0..3, 7..12, 3)];
+        let paths: Vec<PathBuf> = (0..parts.len()).map(|i| scratch(&format!("stream-{i}.accum"))).collect();
+        for (part, path) in parts.iter().zip(&paths) {
+            part.write(path).unwrap();
+        }
+        let streamed = Accumulation::merge_files(&paths).unwrap();
+        assert_eq!(streamed, Accumulation::merge(parts).unwrap());
+        assert!(streamed.is_complete());
+        // The headers are checked before any sums are read: an overlap is refused as in memory.
+        let overlap = Accumulation::merge_files(&[paths[0].clone(), paths[0].clone()]).unwrap_err();
+        assert!(matches!(overlap, MergeFilesError::Merge(MergeError::Overlap { .. })), "{overlap:?}");
+        // A damaged part fails the merge, naming the file.
+        let bytes = std::fs::read(&paths[2]).unwrap();
+        std::fs::write(&paths[2], &bytes[..bytes.len() - 1]).unwrap();
+        let damaged = Accumulation::merge_files(&paths).unwrap_err().to_string();
+        assert!(damaged.contains("stream-2.accum"), "{damaged}");
     }
 }

@@ -46,8 +46,8 @@ pub mod recipe;
 mod sampler;
 mod shade;
 
-pub use accumulation::{Accumulation, FIXED_POINT_BITS, MergeError, PixelSum, SAMPLE_LIMIT};
-pub use accumulation_file::AccumulationFileError;
+pub use accumulation::{Accumulation, FIXED_POINT_BITS, MergeError, PartSpan, PixelSum, SAMPLE_LIMIT};
+pub use accumulation_file::{AccumulationFileError, MergeFilesError};
 pub use camera::CameraRays;
 pub use default_lighting::{ENCLOSED, default_sky, default_sun, room_light, sky_visibility};
 pub use distribution::Distribution1D;
