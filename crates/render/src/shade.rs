@@ -104,11 +104,11 @@ pub fn alpha_accepts(scene: &Scene, triangle: u32, beta: f32, gamma: f32, u: f32
     let material = &scene.materials[triangle.material as usize];
     let alpha = || {
         let uv = || scene.interpolate(triangle, beta, gamma, |v| v.uv);
-        let texture = material.base_color_texture.map_or(1.0, |t| scene.textures[t.0 as usize].sample(uv()).w);
+        // One channel each: this runs for every candidate hit on a cut-out.
+        let texture = material.base_color_texture.map_or(1.0, |t| scene.textures[t.0 as usize].sample_channel(uv(), 3));
         let mask = material.alpha_texture.map_or(1.0, |t| {
             let mask = &scene.textures[t.0 as usize];
-            let texel = mask.sample(uv());
-            if mask.has_alpha() { texel.w } else { texel.x }
+            mask.sample_channel(uv(), if mask.has_alpha() { 3 } else { 0 })
         });
         material.opacity * texture * mask
     };

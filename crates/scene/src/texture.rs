@@ -1,3 +1,4 @@
+use std::ops::{Add, Mul};
 use std::path::Path;
 use std::sync::LazyLock;
 
@@ -66,6 +67,9 @@ pub struct Texture {
     encoding: ColorEncoding,
     /// Wrap modes along u and v.
     wrap: [Wrap; 2],
+    /// Whether any texel is less than fully opaque: asked for every
+    /// candidate hit on a cut-out surface, so found once.
+    has_alpha: bool,
 }
 
 impl std::fmt::Debug for Texture {
@@ -99,6 +103,7 @@ impl Texture {
             name: name.into(),
             width,
             height,
+            has_alpha: texels.iter().any(|t| t[3] < 255),
             texels,
             encoding,
             wrap: [Wrap::Repeat; 2],
@@ -157,6 +162,7 @@ impl Texture {
             texels: texels.collect(),
             encoding: ColorEncoding::Srgb,
             wrap: [Wrap::Repeat; 2],
+            has_alpha: false,
         }
     }
 
@@ -188,7 +194,7 @@ impl Texture {
 
     /// Whether any texel is less than fully opaque.
     pub fn has_alpha(&self) -> bool {
-        self.texels.iter().any(|t| t[3] < 255)
+        self.has_alpha
     }
 
     #[inline]
@@ -204,10 +210,29 @@ impl Texture {
         }
     }
 
+    /// One channel of [`Texture::sample`] (0 red, 1 green, 2 blue, 3
+    /// alpha), with the same bits, for lookups that need no more: the alpha
+    /// test of a cut-out runs for every candidate hit.
+    pub fn sample_channel(&self, uv: Vec2, channel: usize) -> f32 {
+        self.filtered(uv, |x, y| {
+            let byte = self.texels[(y * self.width + x) as usize][channel];
+            match self.encoding {
+                ColorEncoding::Srgb if channel < 3 => SRGB_TO_LINEAR[byte as usize],
+                ColorEncoding::Srgb | ColorEncoding::Linear => byte as f32 * (1.0 / 255.0),
+            }
+        })
+    }
+
     /// The linear value at `uv` (origin top left, one repeat per unit), bilinearly filtered.
     pub fn sample(&self, uv: Vec2) -> Vec4 {
+        self.filtered(uv, |x, y| self.texel(x, y))
+    }
+
+    /// Bilinear filtering of the values `texel(x, y)` around `uv`, with the wrap modes.
+    #[inline(always)]
+    fn filtered<T: Copy + Mul<f32, Output = T> + Add<Output = T>>(&self, uv: Vec2, texel: impl Fn(u32, u32) -> T) -> T {
         if !uv.is_finite() {
-            return self.texel(0, 0);
+            return texel(0, 0);
         }
         // Texel centres sit at half-integer positions.
         let x = uv.x * self.width as f32 - 0.5;
@@ -217,8 +242,8 @@ impl Texture {
         let [wrap_u, wrap_v] = self.wrap;
         let (xa, xb) = (wrap_u.apply(x0 as i64, self.width), wrap_u.apply(x0 as i64 + 1, self.width));
         let (ya, yb) = (wrap_v.apply(y0 as i64, self.height), wrap_v.apply(y0 as i64 + 1, self.height));
-        let top = self.texel(xa, ya) * (1.0 - fx) + self.texel(xb, ya) * fx;
-        let bottom = self.texel(xa, yb) * (1.0 - fx) + self.texel(xb, yb) * fx;
+        let top = texel(xa, ya) * (1.0 - fx) + texel(xb, ya) * fx;
+        let bottom = texel(xa, yb) * (1.0 - fx) + texel(xb, yb) * fx;
         top * (1.0 - fy) + bottom * fy
     }
 }
@@ -272,5 +297,25 @@ mod tests {
     fn wrong_sizes_are_refused() {
         assert!(Texture::from_rgba8("x", 2, 2, vec![[0; 4]; 3], ColorEncoding::Linear).is_none());
         assert!(Texture::from_rgba8("x", 0, 0, vec![], ColorEncoding::Linear).is_none());
+    }
+
+    #[test]
+    fn one_channel_has_the_bits_of_all_four() {
+        let texels =
+            (0..35).map(|i| [(i * 37 % 256) as u8, (i * 91 % 256) as u8, (i * 13 % 256) as u8, (i * 53 % 256) as u8]);
+        for encoding in [ColorEncoding::Srgb, ColorEncoding::Linear] {
+            let t = Texture::from_rgba8("t", 7, 5, texels.clone().collect(), encoding).unwrap();
+            for k in 0..200 {
+                let uv = Vec2::new(k as f32 * 0.037 - 2.0, k as f32 * 0.071 - 5.0);
+                let all = t.sample(uv);
+                for channel in 0..4 {
+                    assert_eq!(
+                        t.sample_channel(uv, channel).to_bits(),
+                        all[channel].to_bits(),
+                        "{encoding:?} {uv} {channel}"
+                    );
+                }
+            }
+        }
     }
 }
