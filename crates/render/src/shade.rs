@@ -103,12 +103,14 @@ pub fn alpha_accepts(scene: &Scene, triangle: u32, beta: f32, gamma: f32, u: f32
     let triangle = &scene.triangles[triangle as usize];
     let material = &scene.materials[triangle.material as usize];
     let alpha = || {
-        let uv = || scene.interpolate(triangle, beta, gamma, |v| v.uv);
-        // One channel each: this runs for every candidate hit on a cut-out.
-        let texture = material.base_color_texture.map_or(1.0, |t| scene.textures[t.0 as usize].sample_channel(uv(), 3));
+        // Interpolated once, and one channel read from each texture: this
+        // runs for every candidate hit on a cut-out.
+        let textured = material.base_color_texture.is_some() || material.alpha_texture.is_some();
+        let uv = if textured { scene.interpolate(triangle, beta, gamma, |v| v.uv) } else { Default::default() };
+        let texture = material.base_color_texture.map_or(1.0, |t| scene.textures[t.0 as usize].sample_channel(uv, 3));
         let mask = material.alpha_texture.map_or(1.0, |t| {
             let mask = &scene.textures[t.0 as usize];
-            mask.sample_channel(uv(), if mask.has_alpha() { 3 } else { 0 })
+            mask.sample_channel(uv, if mask.has_alpha() { 3 } else { 0 })
         });
         material.opacity * texture * mask
     };
