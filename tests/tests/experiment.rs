@@ -134,6 +134,30 @@ fn every_knob_writes_its_table_json_and_plots() {
         assert!(json["findings"].to_string().contains(panel), "{knob}: no caption for {panel}");
         let png = image::open(dir.join(knob).join(panel)).unwrap_or_else(|e| panic!("{knob}/{panel}: {e}"));
         assert!(png.width() > png.height(), "{knob}/{panel}: a row of tiles");
+        // And its labelled SVG: the PNG embedded, each column's label, the error scale; the report shows the SVG.
+        let labelled = panel.replace(".png", ".svg");
+        let svg = std::fs::read_to_string(dir.join(knob).join(&labelled)).unwrap();
+        assert!(
+            svg.contains("data:image/png;base64,") && svg.contains(">reference<") && svg.contains("RMSE "),
+            "{labelled}"
+        );
+        let md = std::fs::read_to_string(dir.join(knob).join(format!("{knob}.md"))).unwrap();
+        assert!(md.contains(&format!("]({labelled})")), "{knob}.md does not show {labelled}");
+    }
+    // Every knob has an error-against-time plot, the exact ones on log axes with their bound.
+    for (knob, plot) in [
+        ("scaling", "scaling-error-time.svg"),
+        ("analytic", "analytic-error-time-1.svg"),
+        ("accel", "accel-error-time.svg"),
+        ("traversal", "traversal.svg"),
+        ("packets", "packets.svg"),
+    ] {
+        check_svg(&dir.join(knob).join(plot), &[]);
+    }
+    check_svg(&dir.join("accel/accel-error-time.svg"), &["95% bound 3/N"]);
+    // The direct knob's scenes have fronts of their own.
+    for scene in ["small-light", "large-light", "glossy"] {
+        check_svg(&dir.join(format!("pareto/direct-knob-{scene}.svg")), &["Pareto front", "direct ("]);
     }
     // The scene's Pareto plot, from every knob measured on it.
     check_svg(&dir.join("pareto/built-in-cornell-box.svg"), &["Pareto front", "spp (", "depth (", "clamp ("]);

@@ -42,7 +42,7 @@ fn report_scenes(knob: Knob) -> &'static [&'static str] {
     match knob {
         Knob::Spp => &[CORNELL, BUNNY, ROOM, GLOSSY],
         Knob::Depth => &[CORNELL, SPONZA],
-        Knob::Clamp => &[CORNELL, ROOM],
+        Knob::Clamp => &[CORNELL, ROOM, CONFERENCE],
         Knob::Accel => &[CORNELL, BUNNY, SPONZA, CONFERENCE],
         Knob::Effects => &[CORNELL, HELMET],
         Knob::Traversal | Knob::Packets => &[BUNNY],

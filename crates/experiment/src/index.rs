@@ -131,9 +131,11 @@ fn scene_slug(scene: &str) -> String {
 /// Each scene's Pareto plot (`pareto/SCENE.svg`) with its configurations,
 /// for the scenes whose reports measured rendered configurations.
 fn pareto_plots(reports: &[IndexedReport]) -> Vec<(String, Plot, usize)> {
-    // Knobs that render scenes of their own (direct, analytic) measure
-    // against several references: no one front of theirs is a scene's.
+    // The analytic knob measures bias against exact answers, not render
+    // error against a reference: it has no front. The direct knob renders
+    // three scenes of its own, each against its own reference: a front each.
     let on_the_scene = |r: &&IndexedReport| Knob::ALL.iter().any(|k| k.name() == r.report.knob && k.uses_scene());
+    let direct = reports.iter().filter(|r| r.report.knob == Knob::Direct.name());
     let reports: Vec<&IndexedReport> = reports.iter().filter(on_the_scene).collect();
     let mut scenes: Vec<&str> = Vec::new();
     for r in &reports {
@@ -141,7 +143,7 @@ fn pareto_plots(reports: &[IndexedReport]) -> Vec<(String, Plot, usize)> {
             scenes.push(&r.report.scene);
         }
     }
-    scenes
+    let mut plots: Vec<(String, Plot, usize)> = scenes
         .into_iter()
         .filter_map(|scene| {
             let configurations = pareto::configurations(reports.iter().map(|r| &r.report).filter(|r| r.scene == scene));
@@ -153,7 +155,26 @@ fn pareto_plots(reports: &[IndexedReport]) -> Vec<(String, Plot, usize)> {
                 (scene.to_owned(), pareto::plot(&file, &configurations), count)
             })
         })
-        .collect()
+        .collect();
+    for report in direct {
+        // Its series are named "SCENE, STRATEGY".
+        let mut names: Vec<&str> =
+            report.report.series.iter().filter_map(|s| s.name.split_once(", ").map(|(n, _)| n)).collect();
+        names.dedup();
+        for name in names {
+            let configurations: Vec<pareto::Configuration> = pareto::configurations([&report.report])
+                .into_iter()
+                .filter(|c| c.label.starts_with(&format!("{name}, ")))
+                .collect();
+            if !configurations.is_empty() {
+                let file = format!("{PARETO_FOLDER}/direct-knob-{}.svg", scene_slug(name));
+                let count = configurations.len();
+                let scene = format!("the direct knob's {name} scene");
+                plots.push((scene, pareto::plot(&file, &configurations), count));
+            }
+        }
+    }
+    plots
 }
 
 /// The index of the reports below `folder`, as Markdown, from their JSON alone.
@@ -231,7 +252,7 @@ pub fn index_markdown(folder: &Path) -> Result<String, ExperimentError> {
             let _ = writeln!(md, "![{}]({prefix}{})\n", plot.title, plot.file);
         }
         for panel in &report.panels {
-            let _ = writeln!(md, "![{}]({prefix}{})\n", panel.title, panel.file);
+            let _ = writeln!(md, "![{}]({prefix}{})\n", panel.title, crate::panel::labelled_file(&panel.file));
         }
         for finding in &report.findings {
             let _ = writeln!(md, "- {finding}");

@@ -2,10 +2,11 @@
 //! same time, beside a false-colour map of each one's error against the
 //! reference, so that what the numbers say can be seen.
 //!
-//! The panel is a PNG; its labels (configuration, time, RMSE) and the error
-//! scale are written in the report beside it (the caption is a finding, so
-//! the JSON holds it): text in the image would need a font, which no
-//! dependency of ours carries.
+//! The panel is a PNG, and an SVG that shows that PNG with its labels
+//! (configuration, time, RMSE) and the error scale's colour bar: text in
+//! the PNG itself would need a font, which no dependency of ours carries,
+//! while an SVG's text is drawn by the viewer. The caption, with the same
+//! figures, is a finding, so the JSON holds it too.
 
 use std::path::Path;
 
@@ -42,8 +43,15 @@ pub struct Crop {
 const ZOOM: u32 = 3;
 /// White between tiles, in panel pixels.
 const GAP: u32 = 4;
-/// Errors are mapped to colour up to this quantile of all entries' errors (the rest saturate).
+/// Errors are mapped to colour up to this quantile of an entry's errors (the rest saturate).
 const SCALE_QUANTILE: f64 = 0.99;
+/// Height of the SVG's title band and of its label band under the tiles, in pixels.
+const TITLE_BAND: u32 = 30;
+const LABEL_BAND: u32 = 58;
+/// The narrowest a tile is shown in the SVG, in pixels: room for its label.
+const MIN_LABELLED_TILE: u32 = 170;
+/// Height of the colour bar band at the SVG's foot.
+const BAR_BAND: u32 = 40;
 
 /// The absolute error of each pixel (mean over channels).
 fn errors(image: &HdrImage, reference: &HdrImage) -> Vec<f32> {
@@ -75,21 +83,44 @@ pub fn choose_crop(reference: &HdrImage, entries: &[Entry]) -> Crop {
     best.0
 }
 
-/// The top of the error scale: a high quantile of every entry's error in the crop.
+/// The top of the error scale: the median over the entries of each one's
+/// high quantile of error in the crop. One entry full of fireflies (BSDF
+/// sampling of a small light) would otherwise set a scale on which every
+/// other entry is black.
 fn error_scale(reference: &HdrImage, entries: &[Entry], crop: Crop) -> f64 {
-    let mut sorted: Vec<f32> = entries
+    let mut quantiles: Vec<f32> = entries
         .iter()
-        .flat_map(|e| {
+        .filter_map(|e| {
             let errors = errors(&e.image, reference);
-            (crop.y..crop.y + crop.side)
+            let mut sorted: Vec<f32> = (crop.y..crop.y + crop.side)
                 .flat_map(|y| (crop.x..crop.x + crop.side).map(move |x| (y * reference.width() + x) as usize))
-                .map(move |i| errors[i])
-                .collect::<Vec<_>>()
+                .map(|i| errors[i])
+                .filter(|e| e.is_finite())
+                .collect();
+            sorted.sort_by(f32::total_cmp);
+            sorted.get(((sorted.len() as f64 - 1.0) * SCALE_QUANTILE) as usize).copied()
         })
-        .filter(|e| e.is_finite())
         .collect();
-    sorted.sort_by(f32::total_cmp);
-    sorted.get(((sorted.len() as f64 - 1.0) * SCALE_QUANTILE) as usize).copied().unwrap_or(1.0).max(1e-12) as f64
+    quantiles.sort_by(f32::total_cmp);
+    let median = match quantiles.len() {
+        0 => 1.0,
+        n if n % 2 == 1 => quantiles[n / 2],
+        n => 0.5 * (quantiles[n / 2 - 1] + quantiles[n / 2]),
+    };
+    median.max(1e-12) as f64
+}
+
+/// `text` with the characters XML gives a meaning escaped.
+fn xml_escaped(text: &str) -> String {
+    text.replace('&', "&amp;").replace('<', "&lt;").replace('>', "&gt;").replace('"', "&quot;")
+}
+
+/// The SVG's name for a panel's PNG file: the same stem, `.svg`.
+pub fn labelled_file(file: &str) -> String {
+    match file.strip_suffix(".png") {
+        Some(stem) => format!("{stem}.svg"),
+        None => format!("{file}.svg"),
+    }
 }
 
 /// An equal-time panel of a report: renders of several configurations in
@@ -177,7 +208,89 @@ impl Panel {
         let panel = HdrImage::from_pixels(width, height, pixels).expect("the sizes agree");
         panel
             .write(path, &ToneMap::default())
-            .map_err(|e| ExperimentError::Image { path: path.to_owned(), message: e.to_string() })
+            .map_err(|e| ExperimentError::Image { path: path.to_owned(), message: e.to_string() })?;
+        self.write_labelled(path, width, height)
+    }
+
+    /// Writes the SVG beside the PNG at `png`: the PNG (embedded, so the
+    /// SVG stands alone), the title above it, under each column its label,
+    /// time and RMSE, and at the foot the error scale as a colour bar.
+    fn write_labelled(&self, png: &Path, width: u32, height: u32) -> Result<(), ExperimentError> {
+        use base64::Engine;
+        use std::fmt::Write;
+        let bytes = std::fs::read(png).map_err(|source| ExperimentError::Write { path: png.to_owned(), source })?;
+        let encoded = base64::engine::general_purpose::STANDARD.encode(bytes);
+        // Small crops are shown larger, so that each column is wide enough for its label.
+        let scale = MIN_LABELLED_TILE.div_ceil(self.crop.side * ZOOM).max(1);
+        let (width, height) = (width * scale, height * scale);
+        let (tile, gap) = (self.crop.side * ZOOM * scale, GAP * scale);
+        let total_height = TITLE_BAND + height + LABEL_BAND + BAR_BAND;
+        let mut svg = String::new();
+        let _ = writeln!(
+            svg,
+            r#"<svg xmlns="http://www.w3.org/2000/svg" width="{width}" height="{total_height}" viewBox="0 0 {width} {total_height}" font-family="sans-serif">"#
+        );
+        let _ = writeln!(svg, r#"<rect width="100%" height="100%" fill="white"/>"#);
+        let _ = writeln!(
+            svg,
+            r#"<text x="{}" y="20" font-size="15" text-anchor="middle">{}</text>"#,
+            width / 2,
+            xml_escaped(&self.title)
+        );
+        let _ = writeln!(
+            svg,
+            r#"<image x="0" y="{TITLE_BAND}" width="{width}" height="{height}" style="image-rendering:pixelated" href="data:image/png;base64,{encoded}"/>"#
+        );
+        let columns = std::iter::once(("reference".to_owned(), String::new(), String::new())).chain(
+            self.entries.iter().map(|e| {
+                (
+                    e.label.clone(),
+                    format!("{} ms", crate::report::format_ms(e.time_ms)),
+                    format!("RMSE {}", crate::report::format_number(e.rmse)),
+                )
+            }),
+        );
+        let label_top = TITLE_BAND + height + 16;
+        for (column, (label, time, rmse)) in columns.enumerate() {
+            let centre = gap + column as u32 * (tile + gap) + tile / 2;
+            for (line, text) in [label, time, rmse].iter().enumerate() {
+                let _ = writeln!(
+                    svg,
+                    r#"<text x="{centre}" y="{}" font-size="13" text-anchor="middle">{}</text>"#,
+                    label_top + line as u32 * 17,
+                    xml_escaped(text)
+                );
+            }
+        }
+        // The colour bar: the error scale from 0 to the saturating error, in steps.
+        let (bar_left, bar_width, bar_top, steps) = (width / 4, width / 2, TITLE_BAND + height + LABEL_BAND, 64u32);
+        for step in 0..steps {
+            let colour = heat_colour((step as f32 + 0.5) / steps as f32).to_array();
+            let [r, g, b] = colour.map(|c| (rtgi_image::linear_to_srgb(c) * 255.0 + 0.5) as u8);
+            let x = bar_left as f64 + step as f64 * bar_width as f64 / steps as f64;
+            let _ = writeln!(
+                svg,
+                r##"<rect x="{x:.2}" y="{bar_top}" width="{:.2}" height="12" fill="#{r:02x}{g:02x}{b:02x}"/>"##,
+                bar_width as f64 / steps as f64 + 0.3
+            );
+        }
+        let _ = writeln!(
+            svg,
+            r#"<text x="{}" y="{}" font-size="12" text-anchor="end">absolute error 0</text>"#,
+            bar_left - 6,
+            bar_top + 11
+        );
+        let _ = writeln!(
+            svg,
+            r#"<text x="{}" y="{}" font-size="12">{} and above</text>"#,
+            bar_left + bar_width + 6,
+            bar_top + 11,
+            crate::report::format_number(self.scale)
+        );
+        let _ = writeln!(svg, "</svg>");
+        let path = png.with_file_name(labelled_file(&png.file_name().unwrap_or_default().to_string_lossy()));
+        rtgi_image::write_atomically(&path, svg.as_bytes())
+            .map_err(|source| ExperimentError::Write { path: path.clone(), source })
     }
 }
 
@@ -210,7 +323,13 @@ mod tests {
         std::fs::create_dir_all(&dir).unwrap();
         let path = dir.join("panel.png");
         panel.write(&path).unwrap();
-        assert!((panel.scale - 1.5).abs() < 1e-6, "{}", panel.scale);
+        // The median of the two entries' 99th percentiles in the crop: 0 for the exact one, 1.5 for the noisy one.
+        assert!((panel.scale - 0.75).abs() < 1e-6, "{}", panel.scale);
+        let svg = std::fs::read_to_string(dir.join("panel.svg")).unwrap();
+        assert!(
+            svg.contains("data:image/png;base64,") && svg.contains(">noisy<") && svg.contains(">RMSE 0.1<"),
+            "{svg}"
+        );
         assert!(panel.caption().contains("noisy (1.00 ms, RMSE 0.1)"), "{}", panel.caption());
         let png = image::open(&path).unwrap().to_rgb8();
         let tile = crop.side * ZOOM;

@@ -104,6 +104,7 @@ pub fn plot(file: &str, configurations: &[Configuration]) -> Plot {
         log_y: true,
         curves,
         legend: Corner::UpperRight,
+        y_range: None,
     }
 }
 

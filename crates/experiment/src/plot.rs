@@ -69,6 +69,17 @@ impl Curve {
     }
 }
 
+/// A rate of `count` events in `trials`, for a log axis: the rate itself,
+/// or when none was seen, `3 / trials`, the 95% upper bound on a rate never
+/// seen in that many trials (the "rule of three"). Zero has no place on a
+/// log axis, and the bound says what the check resolves.
+pub fn rate_or_bound(count: f64, trials: f64) -> f64 {
+    if count > 0.0 { count / trials.max(1.0) } else { 3.0 / trials.max(1.0) }
+}
+
+/// What an axis of [`rate_or_bound`] values says of its zeros.
+pub const BOUND_NOTE: &str = "none seen: at the 95% bound 3/N";
+
 #[derive(Clone, Debug, PartialEq)]
 /// One SVG plot: curves on linear or logarithmic axes.
 pub struct Plot {
@@ -88,6 +99,9 @@ pub struct Plot {
     pub curves: Vec<Curve>,
     /// Where the legend goes: the corner the curves leave free.
     pub legend: Corner,
+    /// The y axis's range when it is set rather than fitted to the curves:
+    /// room for the legend beside lines that span the whole width.
+    pub y_range: Option<(f64, f64)>,
 }
 
 /// A corner of the plotting area.
@@ -193,10 +207,11 @@ impl Plot {
             log_y: true,
             curves,
             legend: Corner::UpperRight,
+            y_range: None,
         }
     }
 
-    /// The plot as an SVG document; the scene and the machine go into the title.
+    /// The plot as an SVG document; the scene (unless empty) and the machine go into the title.
     pub fn to_svg(&self, scene: &str, machine: &Machine) -> Result<String, ExperimentError> {
         let mut svg = String::new();
         self.draw(&mut svg, scene, machine)
@@ -204,7 +219,11 @@ impl Plot {
         Ok(svg)
     }
 
-    fn draw(&self, svg: &mut String, scene: &str, machine: &Machine) -> Result<(), String> {
+    /// The axes' ranges and the legend's corner: the ranges fit the
+    /// curves (or are the plot's own), and when every corner's legend would
+    /// cover a curve, the y axis grows on the legend's side by the legend's
+    /// height, so that it covers none.
+    fn layout(&self) -> ((f64, f64), (f64, f64), Corner) {
         let xs = self
             .curves
             .iter()
@@ -214,7 +233,32 @@ impl Plot {
             .iter()
             .flat_map(|c| c.points.iter().map(|p| p.1).chain(c.bars.iter().flatten().flat_map(|&(lo, hi)| [lo, hi])));
         let x_range = axis_range(xs, self.log_x);
-        let y_range = axis_range(ys, self.log_y);
+        let y_range = self.y_range.unwrap_or_else(|| axis_range(ys, self.log_y));
+        let (legend, covered) = self.legend_place(x_range, y_range);
+        let y_range = match (covered, self.y_range) {
+            (0, _) | (_, Some(_)) => y_range,
+            _ => {
+                let h = self.legend_size().1.min(0.6);
+                let grow = h / (1.0 - h) * 1.15;
+                let top = matches!(legend, Corner::UpperLeft | Corner::UpperRight);
+                if self.log_y {
+                    let span = (y_range.1 / y_range.0).ln();
+                    if top {
+                        (y_range.0, y_range.1 * (grow * span).exp())
+                    } else {
+                        (y_range.0 / (grow * span).exp(), y_range.1)
+                    }
+                } else {
+                    let span = y_range.1 - y_range.0;
+                    if top { (y_range.0, y_range.1 + grow * span) } else { (y_range.0 - grow * span, y_range.1) }
+                }
+            }
+        };
+        (x_range, y_range, legend)
+    }
+
+    fn draw(&self, svg: &mut String, scene: &str, machine: &Machine) -> Result<(), String> {
+        let (x_range, y_range, legend) = self.layout();
         let root = SVGBackend::with_string(svg, SIZE).into_drawing_area();
         root.fill(&WHITE).map_err(|e| e.to_string())?;
         // A scene file is named by its file name (the folder says nothing in
@@ -224,7 +268,11 @@ impl Plot {
             Some(name) if path.is_file() => name.to_string_lossy().into_owned(),
             _ => scene.split(" (").next().unwrap_or(scene).to_owned(),
         };
-        let caption = format!("{}, {scene} ({})", self.title, machine.short());
+        let caption = if scene.is_empty() {
+            format!("{} ({})", self.title, machine.short())
+        } else {
+            format!("{}, {scene} ({})", self.title, machine.short())
+        };
         // A title never runs off the canvas: it is wrapped into lines that fit.
         let lines = wrap(&caption, TITLE_CHARS_PER_LINE);
         let (title_area, chart_area) = root.split_vertically(TITLE_LINE_HEIGHT * lines.len() as u32 + 10);
@@ -239,7 +287,6 @@ impl Plot {
         }
         let mut builder = ChartBuilder::on(&chart_area);
         builder.margin(14).x_label_area_size(44).y_label_area_size(70);
-        let legend = self.legend_corner(x_range, y_range);
         // The four combinations of linear and log axes are different types;
         // log axes carry their own key points, so a range of less than a
         // decade still has several labelled ticks.
@@ -267,15 +314,60 @@ impl Plot {
 
     /// The corner whose legend box covers the fewest points and bars (the
     /// plot's preferred corner on ties).
+    #[cfg(test)]
     fn legend_corner(&self, x_range: (f64, f64), y_range: (f64, f64)) -> Corner {
+        self.legend_place(x_range, y_range).0
+    }
+
+    /// The legend's width and height as fractions of the plotting area
+    /// (about 7 px a character plus the sample line, 20 px a row).
+    fn legend_size(&self) -> (f64, f64) {
+        let (area_w, area_h) = (SIZE.0 as f64 - 100.0, SIZE.1 as f64 - 130.0);
+        let longest = self.curves.iter().map(|c| c.label.chars().count()).max().unwrap_or(0) as f64;
+        ((longest * 7.0 + 50.0) / area_w, (self.curves.len() as f64 * 20.0 + 12.0) / area_h)
+    }
+
+    /// [`Plot::legend_corner`], with how many points it covers there.
+    fn legend_place(&self, x_range: (f64, f64), y_range: (f64, f64)) -> (Corner, usize) {
         let fraction = |v: f64, (lo, hi): (f64, f64), log: bool| {
             if log { (v.max(1e-300).ln() - lo.ln()) / (hi.ln() - lo.ln()) } else { (v - lo) / (hi - lo) }
         };
-        // The legend's size as a fraction of the plotting area (about 7 px a
-        // character plus the sample line, 20 px a row).
-        let (area_w, area_h) = (SIZE.0 as f64 - 100.0, SIZE.1 as f64 - 130.0);
-        let longest = self.curves.iter().map(|c| c.label.chars().count()).max().unwrap_or(0) as f64;
-        let (w, h) = ((longest * 7.0 + 50.0) / area_w, (self.curves.len() as f64 * 20.0 + 12.0) / area_h);
+        let (w, h) = self.legend_size();
+        // Every curve as points in the plotting area's fractions, with points
+        // along each segment taken in those fractions (a line under the
+        // legend hides as much as a marker; on a log axis a segment is
+        // straight in the fractions, not in the values).
+        let to_area = |(x, y): (f64, f64)| (fraction(x, x_range, self.log_x), fraction(y, y_range, self.log_y));
+        let shown: Vec<(f64, f64)> = self
+            .curves
+            .iter()
+            .flat_map(|c| {
+                let points: Vec<(f64, f64)> =
+                    c.points.iter().copied().filter(|(x, y)| x.is_finite() && y.is_finite()).map(to_area).collect();
+                let along: Vec<(f64, f64)> = if c.markers_only {
+                    Vec::new()
+                } else {
+                    points
+                        .windows(2)
+                        .flat_map(|p| {
+                            (1..16).map(move |k| {
+                                let t = k as f64 / 16.0;
+                                (p[0].0 + t * (p[1].0 - p[0].0), p[0].1 + t * (p[1].1 - p[0].1))
+                            })
+                        })
+                        .collect()
+                };
+                // Error bars hide under a legend too: their ends and middles.
+                let bars = c.points.iter().zip(&c.bars).filter_map(|(&(x, _), bar)| {
+                    bar.map(|(lo, hi)| {
+                        [(x, lo), (x, hi), (x, if self.log_y { (lo * hi).sqrt() } else { (lo + hi) / 2.0 })]
+                    })
+                });
+                let bars: Vec<(f64, f64)> =
+                    bars.flatten().filter(|(x, y)| x.is_finite() && y.is_finite()).map(to_area).collect();
+                points.into_iter().chain(along).chain(bars)
+            })
+            .collect();
         let covered = |corner: Corner| -> usize {
             let (right, top) = match corner {
                 Corner::UpperRight => (true, true),
@@ -283,35 +375,15 @@ impl Plot {
                 Corner::LowerRight => (true, false),
                 Corner::LowerLeft => (false, false),
             };
-            let inside = |x: f64, y: f64| {
-                let (fx, fy) = (fraction(x, x_range, self.log_x), fraction(y, y_range, self.log_y));
+            let inside = |&&(fx, fy): &&(f64, f64)| {
                 (if right { fx >= 1.0 - w } else { fx <= w }) && (if top { fy >= 1.0 - h } else { fy <= h })
             };
-            self.curves
-                .iter()
-                .flat_map(|c| {
-                    // Points, and points along each segment (a line under the legend hides as much as a marker).
-                    let along = c.points.windows(2).flat_map(|p| {
-                        (1..8).map(move |k| {
-                            let t = k as f64 / 8.0;
-                            (p[0].0 + t * (p[1].0 - p[0].0), p[0].1 + t * (p[1].1 - p[0].1))
-                        })
-                    });
-                    // Error bars hide under a legend too: their ends and middles.
-                    let bars = c.points.iter().zip(&c.bars).filter_map(|(&(x, _), bar)| {
-                        bar.map(|(lo, hi)| {
-                            [(x, lo), (x, hi), (x, if self.log_y { (lo * hi).sqrt() } else { (lo + hi) / 2.0 })]
-                        })
-                    });
-                    c.points.iter().copied().chain(along).chain(bars.flatten()).collect::<Vec<_>>()
-                })
-                .filter(|&(x, y)| x.is_finite() && y.is_finite() && inside(x, y))
-                .count()
+            shown.iter().filter(inside).count()
         };
         let mut corners =
             vec![self.legend, Corner::UpperRight, Corner::UpperLeft, Corner::LowerRight, Corner::LowerLeft];
         corners.dedup();
-        corners.into_iter().min_by_key(|&c| covered(c)).unwrap_or(self.legend)
+        corners.into_iter().map(|c| (c, covered(c))).min_by_key(|&(_, n)| n).unwrap_or((self.legend, 0))
     }
 
     fn fill<'a, X, Y>(
@@ -342,7 +414,12 @@ impl Plot {
                     .draw_series(DashedLineSeries::new(points, 6, 4, colour.stroke_width(1)))
                     .map_err(|e| e.to_string())?
                     .label(curve.label.as_str())
-                    .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], colour.stroke_width(1)));
+                    // Dashed in the legend as on the plot: two dashes.
+                    .legend(move |(x, y)| {
+                        EmptyElement::at((x, y))
+                            + PathElement::new(vec![(0, 0), (8, 0)], colour.stroke_width(1))
+                            + PathElement::new(vec![(12, 0), (20, 0)], colour.stroke_width(1))
+                    });
                 continue;
             }
             let markers_only = curve.markers_only;
@@ -406,6 +483,13 @@ mod tests {
     }
 
     #[test]
+    fn a_rate_never_seen_is_drawn_at_its_bound() {
+        assert_eq!(rate_or_bound(2.0, 100.0), 0.02);
+        assert_eq!(rate_or_bound(0.0, 300.0), 0.01);
+        assert_eq!(rate_or_bound(0.0, 0.0), 3.0);
+    }
+
+    #[test]
     fn tick_labels_are_short() {
         assert_eq!(format_tick(1e-4), "1e-4");
         assert_eq!(format_tick(2.5e6), "2.5e6");
@@ -430,6 +514,7 @@ mod tests {
             log_y: false,
             curves: vec![Curve::new("a", vec![(0.0, 1.0), (1.0, 2.0)])],
             legend: Corner::UpperRight,
+            y_range: None,
         };
         let machine = Machine::this(1);
         let svg = plot.to_svg("scene", &machine).unwrap();
@@ -449,6 +534,7 @@ mod tests {
             log_y: true,
             curves: vec![Curve::new("a curve", points)],
             legend,
+            y_range: None,
         };
         let falling = plot(vec![(1.0, 100.0), (10.0, 10.0), (100.0, 1.0)], Corner::UpperLeft);
         let chosen = falling.legend_corner((0.8, 120.0), (0.8, 120.0));
@@ -459,5 +545,14 @@ mod tests {
         // With nothing in the way, the preferred corner stays.
         let middle = plot(vec![(9.0, 9.0), (11.0, 11.0)], Corner::LowerRight);
         assert_eq!(middle.legend_corner((0.8, 120.0), (0.8, 120.0)), Corner::LowerRight);
+        // Lines across the whole width at the top and the bottom leave no
+        // corner free: the axis grows until the legend's corner is.
+        let mut crowded = plot(vec![(1.0, 1.0), (100.0, 1.0)], Corner::LowerLeft);
+        crowded.curves.push(Curve::guide("top", vec![(1.0, 100.0), (100.0, 100.0)]));
+        let (fitted_x, fitted_y) =
+            (axis_range([1.0, 100.0].into_iter(), true), axis_range([1.0, 100.0].into_iter(), true));
+        assert!(crowded.legend_place(fitted_x, fitted_y).1 > 0);
+        let (x_range, y_range, corner) = crowded.layout();
+        assert_eq!(crowded.legend_place(x_range, y_range), (corner, 0));
     }
 }

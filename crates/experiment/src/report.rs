@@ -280,6 +280,7 @@ mod plot_files {
                 log_y: false,
                 curves: Vec::new(),
                 legend: Corner::default(),
+                y_range: None,
             })
             .collect())
     }
@@ -373,8 +374,11 @@ impl Report {
             written.push(path);
             Ok(())
         };
+        // A report over a set of scenes (a glob) leaves the scene out of its
+        // plots' titles: each title names its own.
+        let scene = if self.scene.contains('*') { "" } else { self.scene.as_str() };
         for plot in &self.plots {
-            write(&plot.file, &plot.to_svg(&self.scene, &self.machine)?)?;
+            write(&plot.file, &plot.to_svg(scene, &self.machine)?)?;
         }
         let json = serde_json::to_string_pretty(self).expect("reports serialise");
         write(&format!("{}.json", self.knob), &json)?;
@@ -451,7 +455,7 @@ impl Report {
             let _ = writeln!(md, "![{}]({})\n", plot.title, plot.file);
         }
         for panel in &self.panels {
-            let _ = writeln!(md, "![{}]({})\n", panel.title, panel.file);
+            let _ = writeln!(md, "![{}]({})\n", panel.title, crate::panel::labelled_file(&panel.file));
         }
         for table in &self.tables {
             let _ = writeln!(md, "## {}\n", table.title);

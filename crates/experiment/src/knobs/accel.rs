@@ -15,7 +15,7 @@ use rtgi_math::Ray;
 use rtgi_render::rays::{primary_rays, surface_rays};
 
 use crate::measure::every_nth;
-use crate::plot::{Corner, Curve, Plot};
+use crate::plot::{BOUND_NOTE, Corner, Curve, Plot, rate_or_bound};
 use crate::report::{Point, Report, Series, Table, format_ms, format_number};
 use crate::runner::{build_timed, time_rays};
 use crate::stats::Timing;
@@ -68,7 +68,7 @@ fn answers(accel: &dyn Accel, rays: &[Ray]) -> Vec<Option<Hit>> {
 }
 
 /// Answers that differ in any bit (triangle, t, beta or gamma).
-fn disagreements(a: &[Option<Hit>], b: &[Option<Hit>]) -> usize {
+pub(super) fn disagreements(a: &[Option<Hit>], b: &[Option<Hit>]) -> usize {
     let bits = |h: &Option<Hit>| h.map(|h| (h.triangle, h.t.to_bits(), h.beta.to_bits(), h.gamma.to_bits()));
     a.iter().zip(b).filter(|(x, y)| bits(x) != bits(y)).count()
 }
@@ -281,34 +281,41 @@ pub(super) fn run(
         log_y: true,
         curves: totals,
         legend: Corner::UpperLeft,
+        y_range: None,
     });
     // Error against time: the fraction of answers that differ from the
     // linear scan's in any bit, against the time per incoherent ray.
+    let checked_of = |p: &Point| 2.0 * (p.values["camera_rays_checked"] + p.values["incoherent_rays_checked"]);
     let errors: Vec<Curve> = defaults
         .iter()
         .map(|s| {
             let p = &s.points[0];
-            let checked = 2.0 * (p.values["camera_rays_checked"] + p.values["incoherent_rays_checked"]);
             let wrong = p.values["camera_disagreements"] + p.values["incoherent_disagreements"];
             let ns = p.values["incoherent_ms_per_ray"] * 1e6;
             let spread = (1e3 / p.values["incoherent_mrays_max"], 1e3 / p.values["incoherent_mrays_min"]);
-            Curve::new(s.name.clone(), vec![(ns, wrong / checked.max(1.0))]).with_x_bars(vec![Some(spread)])
+            Curve::new(s.name.clone(), vec![(ns, rate_or_bound(wrong, checked_of(p)))]).with_x_bars(vec![Some(spread)])
         })
         .collect();
-    let all_exact = errors.iter().all(|c| c.points[0].1 == 0.0);
+    let exact = defaults.iter().filter(|s| {
+        let p = &s.points[0];
+        p.values["camera_disagreements"] + p.values["incoherent_disagreements"] == 0.0
+    });
+    let checked = defaults.first().map_or(0.0, |s| checked_of(&s.points[0]));
     report.plots.push(Plot {
         file: "accel-error-time.svg".into(),
-        title: if all_exact {
-            "Answers differing from the linear scan against time per ray: 0 for every structure".into()
-        } else {
-            "Answers differing from the linear scan against time per ray".into()
-        },
+        title: format!(
+            "Answers differing from the linear scan against time per ray: none of {} for {} of {} structures",
+            checked,
+            exact.count(),
+            defaults.len()
+        ),
         x_label: "time per incoherent ray (ns, all threads; bars min–max)".into(),
-        y_label: "fraction of answers differing in any bit".into(),
+        y_label: format!("fraction differing in any bit ({BOUND_NOTE})"),
         log_x: true,
-        log_y: false,
+        log_y: true,
         curves: errors,
         legend: Corner::UpperRight,
+        y_range: None,
     });
 
     let per_batch = |batch: &str| -> Vec<Curve> {
@@ -328,13 +335,17 @@ pub(super) fn run(
     for batch in ["camera", "incoherent"] {
         report.plots.push(Plot {
             file: format!("accel-{batch}.svg"),
-            title: format!("Build time against {batch} ray throughput"),
+            title: format!(
+                "{} ray throughput against build time",
+                if batch == "camera" { "Camera" } else { "Incoherent" }
+            ),
             x_label: "build time (ms, median)".into(),
             y_label: format!("{batch} rays (Mrays/s, median with min and max)"),
             log_x: true,
             log_y: true,
             curves: per_batch(batch),
             legend: Corner::LowerRight,
+            y_range: None,
         });
     }
     let leaf = |kind: &str| -> Curve {
@@ -369,6 +380,7 @@ pub(super) fn run(
         log_y: false,
         curves: vec![leaf("sah"), leaf("bvh8")],
         legend: Corner::LowerRight,
+        y_range: None,
     });
     report.tables.push(table);
     Ok(report)

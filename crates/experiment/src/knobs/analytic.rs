@@ -72,6 +72,7 @@ pub(super) fn run(options: &Options, mut report: Report, progress: &dyn Fn(&str)
         let mut series = Series { name: name.clone(), points: Vec::new() };
         let mut resolved = Vec::new();
         let mut z_scores = Vec::new();
+        let mut by_strategy: Vec<(String, Vec<(Timing, f64, f64, f64)>)> = Vec::new();
         for (index, (label, settings)) in estimators.iter().enumerate() {
             steps.next(&format!("{name}: {label}"));
             let mut means = Vec::new();
@@ -101,7 +102,14 @@ pub(super) fn run(options: &Options, mut report: Report, progress: &dyn Fn(&str)
             // The control stands hundreds of standard errors off; plotted,
             // it would flatten the estimators it vouches for into one line.
             if index + 1 < estimators.len() {
-                z_scores.push((index as f64, z));
+                z_scores.push((time.median_ms, z));
+                // The error of one render's mean against the exact answer: bias and spread together.
+                let error = (bias * bias + spread * spread).sqrt() / exact;
+                let group = label.split_once(", ").map_or(label.as_str(), |(_, rest)| rest).to_owned();
+                match by_strategy.iter_mut().find(|(g, _)| *g == group) {
+                    Some((_, points)) => points.push((time, error, error, error)),
+                    None => by_strategy.push((group, vec![(time, error, error, error)])),
+                }
             }
             table.rows.push(vec![
                 name.clone(),
@@ -132,23 +140,48 @@ pub(super) fn run(options: &Options, mut report: Report, progress: &dyn Fn(&str)
             format_number(exact),
             if resolved.is_empty() { String::new() } else { format!("; resolved: {}", resolved.join(", ")) }
         ));
+        // Error against time: one curve per direct strategy and roulette
+        // setting, a point per pixel sampler (the table names each).
+        let error_curves = by_strategy
+            .iter()
+            .map(|(group, points)| Curve { markers_only: true, ..Curve::error_against_time(group.clone(), points) })
+            .collect();
+        report.plots.push(Plot {
+            file: format!("analytic-error-time-{}.svg", report.plots.len() + 1),
+            title: format!(
+                "{name}: relative error of one render's mean against the exact answer, against render time;                  a point per pixel sampler"
+            ),
+            x_label: "render time (ms, median over the seeds; bars min–max)".into(),
+            y_label: "RMS error of one render's mean / exact".into(),
+            log_x: true,
+            log_y: true,
+            curves: error_curves,
+            legend: Corner::UpperRight,
+            y_range: None,
+        });
         curves.push(Curve::new(name, z_scores));
         report.series.push(series);
     }
-    let last = (estimators.len() - 2) as f64;
-    curves.push(Curve::guide(format!("+{RESOLVED_SE} SE"), vec![(0.0, RESOLVED_SE), (last, RESOLVED_SE)]));
-    curves.push(Curve::guide(format!("−{RESOLVED_SE} SE"), vec![(0.0, -RESOLVED_SE), (last, -RESOLVED_SE)]));
+    let times = curves.iter().flat_map(|c| c.points.iter().map(|p| p.0));
+    let (first, last) = times.fold((f64::INFINITY, 0.0f64), |(lo, hi), t| (lo.min(t), hi.max(t)));
+    curves.push(Curve::guide(format!("+{RESOLVED_SE} SE"), vec![(first, RESOLVED_SE), (last, RESOLVED_SE)]));
+    curves.push(Curve::guide(format!("−{RESOLVED_SE} SE"), vec![(first, -RESOLVED_SE), (last, -RESOLVED_SE)]));
+    let zs = curves.iter().flat_map(|c| c.points.iter().map(|p| p.1));
+    let (lo, hi) = zs.fold((-RESOLVED_SE, RESOLVED_SE), |(lo, hi), z| (lo.min(z), hi.max(z)));
+    let z_range = (lo - 0.35 * (hi - lo), hi + 0.08 * (hi - lo));
     report.plots.push(Plot {
         file: "analytic.svg".into(),
         title: "Bias of each estimator against the exact answer, in standard errors (the biased control, hundreds of \
                 standard errors off, is in the table)"
             .into(),
-        x_label: "estimator (the table's order)".into(),
+        x_label: "render time (ms, median over the seeds); each point an estimator of the table".into(),
         y_label: "bias / standard error".into(),
-        log_x: false,
+        log_x: true,
         log_y: false,
         curves: curves.into_iter().map(|c| Curve { markers_only: !c.guide, ..c }).collect(),
         legend: Corner::LowerLeft,
+        // Room below the −4 SE line for the legend: the guides span the width.
+        y_range: Some(z_range),
     });
     report.tables.push(table);
     Ok(report)

@@ -56,14 +56,20 @@ pub(super) fn run(
         points.push((format!("{factor}× mean"), limit as f64, measure(subject, &settings, options, &reference)));
     }
     let mut series = Series { name: "indirect clamp".to_owned(), points: Vec::new() };
-    let (mut bias_curve, mut variance_curve, mut tradeoff) = (Vec::new(), Vec::new(), Vec::new());
+    let (mut bias_curve, mut variance_curve, mut resolution_curve, mut tradeoff) =
+        (Vec::new(), Vec::new(), Vec::new(), Vec::new());
     for (label, limit, point) in &points {
         let mut row = vec![label.clone(), if limit.is_finite() { format_number(*limit) } else { "–".to_owned() }];
         row.extend(measurement_cells(point));
         table.rows.push(row);
         let (time, error) = (point.time.expect("measured"), point.error.expect("measured"));
         if limit.is_finite() {
-            bias_curve.push((*limit, error.bias2.max(1e-30)));
+            // A bias below what the seeds resolve is noise (it may be
+            // negative): only resolved ones are drawn, above the resolution's line.
+            if error.bias_resolved() {
+                bias_curve.push((*limit, error.bias2));
+            }
+            resolution_curve.push((*limit, error.bias_resolution));
             variance_curve.push((*limit, error.variance));
         }
         tradeoff.push((label.clone(), time, error));
@@ -113,8 +119,13 @@ pub(super) fn run(
         y_label: "per pixel and channel".into(),
         log_x: true,
         log_y: true,
-        curves: vec![Curve::new("bias²", bias_curve), Curve::new("variance", variance_curve)],
+        curves: vec![
+            Curve::new("bias² (where resolved)", bias_curve),
+            Curve::new("variance", variance_curve),
+            Curve::guide("smallest bias² the seeds resolve", resolution_curve),
+        ],
         legend: Corner::LowerLeft,
+        y_range: None,
     });
     let title = format!("RMSE against render time for each clamp, {spp} spp");
     let curves = tradeoff

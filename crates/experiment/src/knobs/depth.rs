@@ -125,6 +125,7 @@ pub(super) fn run(
         log_y: false,
         curves: energy,
         legend: Corner::UpperRight,
+        y_range: None,
     });
     report.plots.push(Plot {
         file: "depth-time.svg".into(),
@@ -135,6 +136,7 @@ pub(super) fn run(
         log_y: false,
         curves: times,
         legend: Corner::UpperLeft,
+        y_range: None,
     });
     report.plots.push(Plot {
         file: "depth-error.svg".into(),
@@ -145,6 +147,7 @@ pub(super) fn run(
         log_y: true,
         curves: errors,
         legend: Corner::UpperRight,
+        y_range: None,
     });
     // The equal-time panel: the deepest depth with and without roulette, and
     // a shallow one (biased: missing energy), in the time roulette takes at the deepest.

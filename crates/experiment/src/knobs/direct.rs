@@ -232,7 +232,7 @@ pub(super) fn run(
         curves.push(Curve::guide("reference noise", vec![(fastest, noise), (slowest, noise)]));
         report.plots.push(Plot::error_against_time(
             format!("direct-{name}.svg"),
-            format!("Direct light, {name}: RMSE against time"),
+            format!("Direct light, the {name} scene: RMSE against time"),
             curves,
         ));
         // The equal-time panel: each strategy given the budget at its measured time per sample.

@@ -223,11 +223,12 @@ pub(super) fn run(
         title: format!("Each decision of the plan reversed, {spp} spp"),
         x_label: "render time / the plan's (median)".into(),
         y_label: "RMSE / the plan's".into(),
-        // Time ratios stay within a decade; the error's span decades.
-        log_x: false,
+        // Log on both axes, so that twice and half the plan's are equally far from it.
+        log_x: true,
         log_y: true,
         curves,
         legend: Corner::UpperRight,
+        y_range: None,
     });
     report.tables.push(table);
     report.reference = Some(reference.info);

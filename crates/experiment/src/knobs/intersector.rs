@@ -20,7 +20,7 @@ use rtgi_accel::{Accel, AccelKind, BuildParams, Intersector};
 use rtgi_math::{Ray, Vec3};
 use rtgi_render::rays::{primary_rays, surface_rays};
 
-use crate::plot::{Corner, Curve, Plot};
+use crate::plot::{BOUND_NOTE, Corner, Curve, Plot, rate_or_bound};
 use crate::report::{Point, Report, Series, Table, format_number};
 use crate::runner::time_rays;
 use crate::stats::Timing;
@@ -342,51 +342,62 @@ fn findings(report: &mut Report, kind: AccelKind) {
 
 fn plots(report: &mut Report) {
     let rows = measured(report);
+    // Error against time: rays lost at shared edges and from inside closed
+    // meshes, against the time per incoherent ray.
     let speed: Vec<Curve> = rows
         .iter()
         .map(|(name, p, _)| {
             let v = &p.values;
-            let lost = 100.0 * (v["shared_edge_leaks"] + v["closed_mesh_leaks"])
-                / (v["shared_edge_rays"] + v["closed_mesh_rays"]).max(1.0);
-            Curve::new(name.clone(), vec![(lost, v["incoherent_mrays"])])
-                .with_bars(vec![Some((v["incoherent_mrays_min"], v["incoherent_mrays_max"]))])
+            let lost = rate_or_bound(
+                v["shared_edge_leaks"] + v["closed_mesh_leaks"],
+                v["shared_edge_rays"] + v["closed_mesh_rays"],
+            );
+            let ns = |mrays: f64| 1e3 / mrays.max(1e-12);
+            Curve::new(name.clone(), vec![(ns(v["incoherent_mrays"]), lost)])
+                .with_x_bars(vec![Some((ns(v["incoherent_mrays_max"]), ns(v["incoherent_mrays_min"])))])
         })
         .collect();
-    let by_distance = |value: &str| -> Vec<Curve> {
+    let by_distance = |count: &str, trials: &str| -> Vec<Curve> {
         rows.iter()
-            .map(|(name, _, points)| Curve::new(name.clone(), points.iter().map(|p| (p.x, p.values[value])).collect()))
+            .map(|(name, _, points)| {
+                let rates = points.iter().map(|p| (p.x, 100.0 * rate_or_bound(p.values[count], p.values[trials])));
+                Curve::new(name.clone(), rates.collect())
+            })
             .collect()
     };
-    let (self_hits, leaks) = (by_distance("self_hit_percent"), by_distance("escaped_percent"));
+    let (self_hits, leaks) = (by_distance("self_hits", "secondary_rays"), by_distance("escaped", "escaping_rays"));
     report.plots.push(Plot {
         file: "intersector-speed.svg".into(),
-        title: "Incoherent ray throughput against rays lost at shared edges and vertices".into(),
-        x_label: "rays through shared edges and from inside closed meshes that escape (%)".into(),
-        y_label: "incoherent rays, one at a time (Mrays/s, median with min and max)".into(),
-        log_x: false,
-        log_y: false,
+        title: "Rays lost at shared edges and vertices against time per incoherent ray".into(),
+        x_label: "time per incoherent ray (ns, one at a time on all threads; bars min–max)".into(),
+        y_label: format!("rays through shared edges and from inside closed meshes that escape ({BOUND_NOTE})"),
+        log_x: true,
+        log_y: true,
         curves: speed,
         legend: Corner::LowerRight,
+        y_range: None,
     });
     report.plots.push(Plot {
         file: "intersector-self-hits.svg".into(),
         title: "Secondary rays that hit the surface they leave, by distance from the origin".into(),
         x_label: "distance of the solids from the origin (world units)".into(),
-        y_label: "self-hits (% of secondary rays)".into(),
+        y_label: format!("self-hits (% of secondary rays; {BOUND_NOTE})"),
         log_x: true,
-        log_y: false,
+        log_y: true,
         curves: self_hits,
         legend: Corner::UpperLeft,
+        y_range: None,
     });
     report.plots.push(Plot {
         file: "intersector-leaks.svg".into(),
         title: "Rays from inside closed solids that escape, by distance from the origin".into(),
         x_label: "distance of the solids from the origin (world units)".into(),
-        y_label: "escaped (% of rays from inside)".into(),
+        y_label: format!("escaped (% of rays from inside; {BOUND_NOTE})"),
         log_x: true,
-        log_y: false,
+        log_y: true,
         curves: leaks,
         // Möller-Trumbore's losses are highest near the origin.
         legend: Corner::UpperRight,
+        y_range: None,
     });
 }

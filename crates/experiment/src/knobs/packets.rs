@@ -8,7 +8,7 @@ use rtgi_math::Ray;
 use rtgi_render::rays::{primary_rays, surface_rays};
 
 use crate::measure::{every_nth, time_rays};
-use crate::plot::{Corner, Curve, Plot};
+use crate::plot::{BOUND_NOTE, Corner, Curve, Plot, rate_or_bound};
 use crate::report::{Point, Report, Series, Table, format_number, format_timing};
 use crate::verdict::{Spread, compare};
 use crate::{ExperimentError, Options, Steps, Subject};
@@ -93,7 +93,7 @@ pub(super) fn run(
                 format!("{differ} of {}", subset.len()),
             ]);
             let ns = |ms: f64| ms * 1e6 / rays.len() as f64;
-            let fraction = differ as f64 / subset.len().max(1) as f64;
+            let fraction = rate_or_bound(differ as f64, subset.len() as f64);
             for (mode, timing) in [("single", single), ("batch", batched)] {
                 curves.push(
                     Curve::new(format!("{kind}, {batch}, {mode}"), vec![(ns(timing.median_ms), fraction)])
@@ -113,11 +113,12 @@ pub(super) fn run(
         title: "Batch (packets) against one ray at a time: answers differing from the linear scan against time per ray"
             .into(),
         x_label: "time per ray (ns, all threads; bars min–max)".into(),
-        y_label: "fraction of batch answers differing in any bit".into(),
+        y_label: format!("fraction of batch answers differing in any bit ({BOUND_NOTE})"),
         log_x: true,
-        log_y: false,
+        log_y: true,
         curves,
         legend: Corner::UpperRight,
+        y_range: None,
     });
     report.tables.push(table);
     Ok(report)

@@ -310,6 +310,7 @@ fn plots(report: &mut Report) {
                     .map(|&i| curve(i.name().to_owned(), series(report, i, family), value, Some(max)))
                     .collect(),
                 legend: Corner::UpperLeft,
+                y_range: None,
             });
         }
     }
@@ -330,6 +331,7 @@ fn plots(report: &mut Report) {
             })
             .collect(),
         legend: Corner::UpperRight,
+        y_range: None,
     });
     // The trade-off on one plot: each test's largest error of t on each
     // family against its time per test (the median over the family, with
@@ -357,6 +359,7 @@ fn plots(report: &mut Report) {
             })
             .collect(),
         legend: Corner::UpperRight,
+        y_range: None,
     });
     report.plots.extend(plots);
 }

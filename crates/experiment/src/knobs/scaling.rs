@@ -9,10 +9,11 @@
 
 use std::time::Instant;
 
+use rayon::prelude::*;
 use rtgi_accel::{AccelKind, BuildParams};
 use rtgi_math::{Ray, Rng, Vec3, uniform_sphere};
 
-use crate::plot::{Corner, Curve, Plot};
+use crate::plot::{BOUND_NOTE, Corner, Curve, Plot, rate_or_bound};
 use crate::report::{Point, Report, Series, Table, format_ms, format_number};
 use crate::{ExperimentError, Options, Steps};
 
@@ -93,6 +94,8 @@ pub(super) fn run(options: &Options, mut report: Report, progress: &dyn Fn(&str)
     };
     for &count in &counts {
         let triangles = sphere(count);
+        // The linear scan's answers on the rays it traces: what the others are checked against.
+        let mut expected: Vec<Option<rtgi_accel::Hit>> = Vec::new();
         for (kind, series) in kinds.iter().zip(&mut series) {
             steps.next(&format!("{kind} over {} triangles", triangles.len()));
             let params = kind.default_params();
@@ -111,8 +114,19 @@ pub(super) fn run(options: &Options, mut report: Report, progress: &dyn Fn(&str)
             let timing = crate::measure::time_rays(rays, options.repeats, |chunk| {
                 chunk.iter().filter(|r| accel.intersect(r).is_some()).count()
             });
+            let answers: Vec<Option<rtgi_accel::Hit>> = all_rays
+                [..if *kind == AccelKind::Linear { limit } else { expected.len() }]
+                .par_iter()
+                .map(|r| accel.intersect(r))
+                .collect();
+            if *kind == AccelKind::Linear {
+                expected = answers.clone();
+            }
+            let differing = super::accel::disagreements(&answers, &expected);
             let per_ray = |ms: f64| ms * 1e6 / rays.len() as f64;
             let mut point = Point::new(triangles.len() as f64, triangles.len().to_string())
+                .with("differing", differing as f64)
+                .with("checked", expected.len() as f64)
                 .with("ns_per_ray", per_ray(timing.median_ms))
                 .with("ns_per_ray_min", per_ray(timing.min_ms))
                 .with("ns_per_ray_max", per_ray(timing.max_ms))
@@ -136,7 +150,7 @@ pub(super) fn run(options: &Options, mut report: Report, progress: &dyn Fn(&str)
             series.points.push(point);
         }
     }
-    let mut curves = Vec::new();
+    let (mut curves, mut error_curves) = (Vec::new(), Vec::new());
     for s in &series {
         let xy: Vec<(f64, f64)> = s.points.iter().map(|p| (p.x, p.values["ns_per_ray"])).collect();
         let large: Vec<(f64, f64)> = xy.iter().copied().filter(|p| p.0 >= LARGE).collect();
@@ -153,7 +167,36 @@ pub(super) fn run(options: &Options, mut report: Report, progress: &dyn Fn(&str)
         };
         let bars = s.points.iter().map(|p| Some((p.values["ns_per_ray_min"], p.values["ns_per_ray_max"]))).collect();
         curves.push(Curve::new(label, xy).with_bars(bars));
+        let against_time: Vec<(f64, f64)> = s
+            .points
+            .iter()
+            .map(|p| (p.values["ns_per_ray"], rate_or_bound(p.values["differing"], p.values["checked"])))
+            .collect();
+        let x_bars = s.points.iter().map(|p| Some((p.values["ns_per_ray_min"], p.values["ns_per_ray_max"]))).collect();
+        error_curves.push(Curve::new(s.name.clone(), against_time).with_x_bars(x_bars));
     }
+    for s in series.iter().skip(1) {
+        let sum = |key: &str| s.points.iter().map(|p| p.values[key]).sum::<f64>();
+        let peer = AccelKind::PEERS.iter().any(|k| k.name() == s.name);
+        report.findings.push(format!(
+            "{}: {} of {} answers differ from the linear scan's in any bit, over all mesh sizes{}",
+            s.name,
+            sum("differing"),
+            sum("checked"),
+            if peer { " (a peer, outside the exactness contract)" } else { "" }
+        ));
+    }
+    report.plots.push(Plot {
+        file: "scaling-error-time.svg".into(),
+        title: "Answers differing from the linear scan against time per ray, one point per mesh size".into(),
+        x_label: "time per closest-hit ray (ns, median; bars min–max)".into(),
+        y_label: format!("fraction differing in any bit ({BOUND_NOTE})"),
+        log_x: true,
+        log_y: true,
+        curves: error_curves,
+        legend: Corner::UpperLeft,
+        y_range: None,
+    });
     // The naive search's cost per triangle: constant while the triangles
     // fit in the caches, higher once every ray streams them from memory,
     // which bends the fitted exponent above 1.
@@ -189,6 +232,7 @@ pub(super) fn run(options: &Options, mut report: Report, progress: &dyn Fn(&str)
         log_y: true,
         curves,
         legend: Corner::UpperLeft,
+        y_range: None,
     });
     report.tables.push(table);
     Ok(report)

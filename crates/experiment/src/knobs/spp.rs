@@ -138,6 +138,7 @@ pub(super) fn run(
             log_y: true,
             curves: error_curves,
             legend: Corner::LowerLeft,
+            y_range: None,
         });
         report.plots.push(Plot::error_against_time(
             format!("spp{suffix}-time.svg"),
