@@ -158,7 +158,14 @@ fn format_tick(v: f64) -> String {
 /// 2 and 5 times them, then every integer mantissa, whichever first gives
 /// at least three ticks inside the range.
 fn log_ticks(lo: f64, hi: f64) -> Vec<f64> {
-    let (first, last) = (lo.log10().floor() as i32, hi.log10().ceil() as i32);
+    // Within the doubles' range, whatever the axis was given (a range of a
+    // thousand decades would otherwise ask for billions of ticks).
+    let (first, last) = (lo.log10().floor().clamp(-310.0, 310.0) as i32, hi.log10().ceil().clamp(-310.0, 310.0) as i32);
+    if last - first > 12 {
+        // Many decades: every few powers of ten.
+        let step = ((last - first) / 6).max(1) as usize;
+        return (first..=last).step_by(step).map(|e| 10f64.powi(e)).filter(|v| *v >= lo && *v <= hi).collect();
+    }
     let tenths: Vec<f64> = (10..100).map(|m| m as f64 / 10.0).collect();
     for mantissas in [&[1.0][..], &[1.0, 2.0, 5.0], &[1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 8.0, 9.0], &tenths] {
         let ticks: Vec<f64> = (first..=last)
@@ -228,12 +235,13 @@ impl Plot {
             .curves
             .iter()
             .flat_map(|c| c.points.iter().map(|p| p.0).chain(c.x_bars.iter().flatten().flat_map(|&(lo, hi)| [lo, hi])));
-        let ys = self
-            .curves
-            .iter()
-            .flat_map(|c| c.points.iter().map(|p| p.1).chain(c.bars.iter().flatten().flat_map(|&(lo, hi)| [lo, hi])));
+        let ys = || {
+            self.curves.iter().flat_map(|c| {
+                c.points.iter().map(|p| p.1).chain(c.bars.iter().flatten().flat_map(|&(lo, hi)| [lo, hi]))
+            })
+        };
         let x_range = axis_range(xs, self.log_x);
-        let y_range = self.y_range.unwrap_or_else(|| axis_range(ys, self.log_y));
+        let y_range = self.y_range.unwrap_or_else(|| axis_range(ys(), self.log_y));
         let (legend, covered) = self.legend_place(x_range, y_range);
         let y_range = match (covered, self.y_range) {
             (0, _) | (_, Some(_)) => y_range,
@@ -253,6 +261,12 @@ impl Plot {
                     if top { (y_range.0, y_range.1 + grow * span) } else { (y_range.0 - grow * span, y_range.1) }
                 }
             }
+        };
+        // A range that grew past the doubles (a degenerate fit) keeps its fitted size.
+        let y_range = if y_range.0.is_finite() && y_range.1.is_finite() && (!self.log_y || y_range.0 > 0.0) {
+            y_range
+        } else {
+            self.y_range.unwrap_or_else(|| axis_range(ys(), self.log_y))
         };
         (x_range, y_range, legend)
     }
@@ -476,7 +490,10 @@ mod tests {
         assert_eq!(log_ticks(0.011, 0.06), vec![0.02, 0.03, 0.04, 0.05, 0.06]);
         assert_eq!(log_ticks(0.109, 0.1616), vec![0.11, 0.12, 0.13, 0.14, 0.15, 0.16]);
         assert_eq!(log_ticks(0.01211, 0.01219).len(), 3);
-        for (lo, hi) in [(1e-5, 2e-5), (3.0, 7.0), (0.9, 1.1), (1.0, 1e6)] {
+        // Hundreds of decades (a degenerate value on the axis): a handful of powers of ten.
+        assert!(log_ticks(1e-300, 1e300).len() <= 8);
+        assert!(log_ticks(f64::MIN_POSITIVE, f64::INFINITY).len() <= 8);
+        for (lo, hi) in [(1e-5, 2e-5), (3.0, 7.0), (0.9, 1.1), (1.0, 1e6), (1e-30, 1.0)] {
             let ticks = log_ticks(lo, hi);
             assert!(ticks.len() >= 3 && ticks.iter().all(|t| (lo..=hi).contains(t)), "{lo}..{hi}: {ticks:?}");
         }

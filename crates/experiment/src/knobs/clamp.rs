@@ -69,7 +69,10 @@ pub(super) fn run(
             if error.bias_resolved() {
                 bias_curve.push((*limit, error.bias2));
             }
-            resolution_curve.push((*limit, error.bias_resolution));
+            // One seed resolves no bias at all (its resolution is the largest double).
+            if error.seeds > 1 {
+                resolution_curve.push((*limit, error.bias_resolution));
+            }
             variance_curve.push((*limit, error.variance));
         }
         tradeoff.push((label.clone(), time, error));
