@@ -170,6 +170,42 @@ fn nothing_escapes_closed_meshes_in_any_variant() {
 }
 
 #[test]
+// The coordinates are exact f32 values (multiples of 2^-3 near 2^20), as reported.
+#[allow(clippy::excessive_precision)]
+fn a_ray_leaving_a_needle_near_a_long_shared_edge_hits_it() {
+    // Found by a user: a closed needle (radius 32, length 2^19, 64 sides)
+    // centred 2^20 from the origin, and a ray from inside nearly along its
+    // axis. Every structure missed both facets beside its exit, with the
+    // single-precision watertight test; the double-precision one hit.
+    let facets = [
+        [
+            Vec3::new(786432.0, 1048602.5, 1048594.0),
+            Vec3::new(786432.0, 1048600.5, 1048596.5),
+            Vec3::new(1310720.0, 1048600.5, 1048596.5),
+        ],
+        [
+            Vec3::new(786432.0, 1048600.5, 1048596.5),
+            Vec3::new(1310720.0, 1048598.5, 1048598.5),
+            Vec3::new(1310720.0, 1048600.5, 1048596.5),
+        ],
+    ];
+    let ray = Ray::new(Vec3::new(1048574.0, 1048565.25, 1048573.875), Vec3::new(-0.99947125, 0.027363928, 0.017563386));
+    expect_all_hit("needle exit", &facets, &[ray]);
+    let hit = AccelKind::Linear.build(&facets, &BuildParams::default()).intersect(&ray).expect("the exit");
+    assert_eq!(hit.triangle, 1);
+    assert!((hit.t - 1288.0).abs() < 2.0, "{hit:?}");
+}
+
+#[test]
+fn nothing_escapes_hollow_needles_far_from_the_origin() {
+    // Rays from inside needles at 2^0 … 2^23 from the origin, nearly along
+    // their axis, leaving near the long edges between facets.
+    let case = rtgi_accel::verify::adversarial_cases(400, 5).into_iter().find(|c| c.name == "hollow-needles").unwrap();
+    let rays: Vec<Ray> = case.special_rays.iter().flat_map(|(_, rays)| rays.iter().map(|p| p.ray)).collect();
+    expect_all_hit("hollow needles", &case.triangles, &rays);
+}
+
+#[test]
 fn nothing_escapes_closed_meshes_over_a_million_rays() {
     // The default structure and intersector, on many more rays than the
     // all-variant test can afford.

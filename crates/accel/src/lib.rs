@@ -101,6 +101,7 @@ mod contract;
 mod counters;
 #[cfg(feature = "embree")]
 mod embree;
+mod exact;
 mod indexed_mesh;
 mod kind;
 mod linear;

@@ -3,6 +3,7 @@
 use rtgi_math::{Vec3, Vec3A};
 
 use crate::contract::{PreparedRay, hit_triangle};
+use crate::exact;
 use crate::simd::arith;
 use crate::simd::triangles::{self, BlockHits, TriangleBlock};
 
@@ -163,6 +164,8 @@ pub(crate) struct Watertight;
 /// largest becomes z, and a shear maps the direction onto +z.
 pub(crate) struct WatertightRay {
     pub(crate) origin: Vec3A,
+    /// The direction as given, for the exact signs of edges near the ray.
+    pub(crate) direction: Vec3A,
     /// Source axes of the permuted x, y and z.
     pub(crate) axes: [usize; 3],
     pub(crate) shear: [f32; 3],
@@ -189,7 +192,7 @@ impl TriangleTest for Watertight {
         if d[kz] < 0.0 {
             std::mem::swap(&mut kx, &mut ky);
         }
-        WatertightRay { origin, axes: [kx, ky, kz], shear: [d[kx] / d[kz], d[ky] / d[kz], 1.0 / d[kz]] }
+        WatertightRay { origin, direction, axes: [kx, ky, kz], shear: [d[kx] / d[kz], d[ky] / d[kz], 1.0 / d[kz]] }
     }
 
     #[inline(always)]
@@ -203,11 +206,13 @@ impl TriangleTest for Watertight {
             [r[kx], r[ky], r[kz]]
         });
         let [xs, ys, zs] = arith::watertight_shear(relative, ray.shear);
-        let mut uvw = arith::watertight_edges(xs, ys);
-        // On an edge, single precision may have rounded a tiny value to zero:
-        // decide in double precision, where the products are exact.
-        if uvw.contains(&0.0) {
-            uvw = watertight_edges_f64(xs, ys);
+        let uvw = arith::watertight_edges(xs, ys);
+        // Near an edge, rounding may have given an edge function the wrong
+        // sign; neighbours would still agree, but the hit could fall outside
+        // the triangle's box and be lost to the box rule. Decide those exactly.
+        let bound = arith::watertight_edge_bound(xs, ys, relative.map(|r| r[2]), ray.shear);
+        if uvw.iter().any(|e| e.abs() <= bound) {
+            return exact_hit(ray, t_min, t_max, v, uvw, bound);
         }
         if uvw.iter().any(|&e| e < 0.0) && uvw.iter().any(|&e| e > 0.0) {
             return None;
@@ -299,14 +304,65 @@ impl TriangleTest for WatertightF64 {
     }
 }
 
-/// The edge functions of [`arith::watertight_edges`] in double precision,
-/// where the products of single-precision numbers are exact, rounded to
-/// single precision: used when single precision gave an exact zero.
+/// The watertight test where an edge function is within rounding of zero:
+/// each such edge's sign is decided exactly ([`exact::edge_sign`]), the
+/// others keep the sign single precision gave them (certain, being above
+/// `bound`). A ray exactly through an edge or corner hits (zero counts as
+/// inside), so the test stays watertight, and every hit it reports is a
+/// hit of the exact ray, inside the triangle's box. The distance comes
+/// from the triangle's plane and the barycentrics from the edge functions
+/// in double precision, with the decided signs.
 #[inline(never)]
-pub(crate) fn watertight_edges_f64(xs: [f32; 3], ys: [f32; 3]) -> [f32; 3] {
-    let (xs, ys) = (xs.map(f64::from), ys.map(f64::from));
-    let edge = |p: usize, q: usize| (xs[p] * ys[q] - ys[p] * xs[q]) as f32;
-    [edge(2, 1), edge(0, 2), edge(1, 0)]
+fn exact_hit(
+    ray: &WatertightRay,
+    t_min: f32,
+    t_max: f32,
+    v: &[Vec3A; 3],
+    uvw: [f32; 3],
+    bound: f32,
+) -> Option<TriangleHit> {
+    let (o, d) = (ray.origin, ray.direction);
+    let edges = [(2, 1), (0, 2), (1, 0)];
+    let signs: [i32; 3] = std::array::from_fn(|i| {
+        if uvw[i].abs() > bound {
+            if uvw[i] > 0.0 { 1 } else { -1 }
+        } else {
+            let (p, q) = edges[i];
+            exact::edge_sign(v[p], v[q], o, d)
+        }
+    });
+    if signs.contains(&1) && signs.contains(&-1) || signs == [0; 3] {
+        return None;
+    }
+    let facing = if signs.contains(&1) { 1.0 } else { -1.0 };
+    let [a, b, c] = v.map(|corner| corner.as_dvec3());
+    let (origin, direction) = (o.as_dvec3(), d.as_dvec3());
+    let normal = (b - a).cross(c - a);
+    let along = direction.dot(normal);
+    if along == 0.0 || !along.is_finite() {
+        return None;
+    }
+    let t = ((a - origin).dot(normal) / along) as f32;
+    if !(t >= t_min && t <= t_max && t.is_finite()) {
+        return None;
+    }
+    // Barycentrics: the edge functions' magnitudes in double precision
+    // (the signed volumes over the ray), zero where the sign is.
+    let weights: [f64; 3] = std::array::from_fn(|i| {
+        let (p, q) = edges[i];
+        let (p, q) = (v[p].as_dvec3() - origin, v[q].as_dvec3() - origin);
+        if signs[i] == 0 { 0.0 } else { (p.cross(q).dot(direction) * facing).max(0.0) }
+    });
+    let total = weights[0] + weights[1] + weights[2];
+    let (beta, gamma) = if total > 0.0 && total.is_finite() {
+        ((weights[1] / total) as f32, (weights[2] / total) as f32)
+    } else {
+        // Every magnitude rounded away: the corners whose edges are not zero share the hit.
+        let nonzero = signs.map(|s| (s != 0) as u32 as f32);
+        let count = nonzero.iter().sum::<f32>();
+        (nonzero[1] / count, nonzero[2] / count)
+    };
+    Some(TriangleHit { t, beta, gamma })
 }
 
 #[cfg(test)]
@@ -383,5 +439,46 @@ mod tests {
                 }
             }
         }
+    }
+
+    #[test]
+    fn edge_functions_above_their_bound_have_the_exact_sign() {
+        // Triangles at offsets up to 2^23 and scales down to 2^-20, rays from
+        // nearby in every direction, many nearly along an edge: wherever the
+        // single-precision edge function is trusted (above its bound), its
+        // sign is the exact one; the rest are decided exactly.
+        let mut rng = rtgi_math::Rng::new(3, 0);
+        let mut next = || rng.next_f32() * 2.0 - 1.0;
+        let (mut trusted, mut decided) = (0u32, 0u32);
+        for case in 0..40_000 {
+            let offset = Vec3::splat(2f32.powi(case % 24)) * Vec3::new(next(), next(), next());
+            let scale = 2f32.powi((case % 11) * 3 - 20).max(offset.abs().max_element() * 1e-4);
+            let v = [0; 3].map(|_| Vec3A::from(offset + Vec3::new(next(), next(), next()) * scale));
+            let origin = Vec3A::from(offset + Vec3::new(next(), next(), next()) * scale * 4.0);
+            let toward = if case % 2 == 0 { v[case as usize % 3] } else { (v[0] + v[1]) * 0.5 };
+            let direction = (toward - origin) + Vec3A::new(next(), next(), next()) * scale * 1e-3;
+            if direction.abs().max_element() == 0.0 {
+                continue;
+            }
+            let ray = Watertight::prepare(origin, direction);
+            let [kx, ky, kz] = ray.axes;
+            let relative = v.map(|corner| {
+                let r = (corner - ray.origin).to_array();
+                [r[kx], r[ky], r[kz]]
+            });
+            let [xs, ys, _] = arith::watertight_shear(relative, ray.shear);
+            let uvw = arith::watertight_edges(xs, ys);
+            let bound = arith::watertight_edge_bound(xs, ys, relative.map(|r| r[2]), ray.shear);
+            for (i, (p, q)) in [(2, 1), (0, 2), (1, 0)].into_iter().enumerate() {
+                let exact = exact::edge_sign(v[p], v[q], origin, direction);
+                if uvw[i].abs() > bound {
+                    trusted += 1;
+                    assert_eq!(uvw[i].signum() as i32, exact, "case {case}, edge {i}: {} (bound {bound})", uvw[i]);
+                } else {
+                    decided += 1;
+                }
+            }
+        }
+        assert!(trusted > 100_000 && decided > 100, "trusted {trusted}, decided exactly {decided}");
     }
 }

@@ -14,6 +14,9 @@ pub(crate) trait Lanes:
     Copy + Add<Output = Self> + Sub<Output = Self> + Mul<Output = Self> + Div<Output = Self>
 {
     fn splat(value: f32) -> Self;
+    fn abs(self) -> Self;
+    /// The larger of two numbers, neither of them NaN.
+    fn max(self, other: Self) -> Self;
 }
 
 impl Lanes for f32 {
@@ -21,12 +24,32 @@ impl Lanes for f32 {
     fn splat(value: f32) -> Self {
         value
     }
+
+    #[inline(always)]
+    fn abs(self) -> Self {
+        f32::abs(self)
+    }
+
+    #[inline(always)]
+    fn max(self, other: Self) -> Self {
+        if self > other { self } else { other }
+    }
 }
 
 impl Lanes for Vec4 {
     #[inline(always)]
     fn splat(value: f32) -> Self {
         Vec4::splat(value)
+    }
+
+    #[inline(always)]
+    fn abs(self) -> Self {
+        Vec4::abs(self)
+    }
+
+    #[inline(always)]
+    fn max(self, other: Self) -> Self {
+        Vec4::max(self, other)
     }
 }
 
@@ -82,6 +105,28 @@ pub(crate) fn watertight_shear<L: Lanes>(relative: [[L; 3]; 3], shear: [f32; 3])
 #[inline(always)]
 pub(crate) fn watertight_edges<L: Lanes>(xs: [L; 3], ys: [L; 3]) -> [L; 3] {
     [xs[2] * ys[1] - ys[2] * xs[1], xs[0] * ys[2] - ys[0] * xs[2], xs[1] * ys[0] - ys[1] * xs[0]]
+}
+
+/// A bound on the difference between the single-precision edge functions
+/// of [`watertight_edges`] and the exact ones (of the exact ray and
+/// corners): an edge function larger than this in magnitude has the exact
+/// sign, and a smaller one is decided exactly ([`crate::exact`]).
+///
+/// A sheared coordinate `x' = (v − o)ₓ − sₓ (v − o)_z` is off by at most
+/// about `5ε (X + |sₓ| Z)` (rounding in the two differences, the shear
+/// factor, its product and the subtraction), with `X`, `Y` the largest
+/// sheared magnitudes and `Z` the largest unsheared height; an edge
+/// function, a difference of two products, then by about
+/// `24ε X Y + 10ε Z (X |s_y| + Y |sₓ|)`. The bound is `32ε` times
+/// `X Y + Z (X |s_y| + Y |sₓ|)` (ε = 2⁻²⁴), plus a few units of the
+/// smallest subnormal for products that underflow. `relative_z` are the
+/// corners' unsheared heights.
+#[inline(always)]
+pub(crate) fn watertight_edge_bound<L: Lanes>(xs: [L; 3], ys: [L; 3], relative_z: [L; 3], shear: [f32; 3]) -> L {
+    let largest = |v: [L; 3]| v[0].abs().max(v[1].abs()).max(v[2].abs());
+    let (x, y, z) = (largest(xs), largest(ys), largest(relative_z));
+    let spread = z * (x * L::splat(shear[1].abs()) + y * L::splat(shear[0].abs()));
+    L::splat(32.0 * f32::EPSILON / 2.0) * (x * y + spread) + L::splat(f32::from_bits(1 << 4))
 }
 
 /// The watertight test's determinant and its distance scaled by the

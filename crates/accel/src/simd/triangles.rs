@@ -125,7 +125,9 @@ pub(crate) fn watertight_block(
     let [xs, ys, zs] = arith::watertight_shear(relative, shear);
     let uvw = arith::watertight_edges(xs, ys);
     let zero = Vec4::ZERO;
-    let rescan = uvw[0].cmpeq(zero) | uvw[1].cmpeq(zero) | uvw[2].cmpeq(zero);
+    // Edges within rounding of the ray are decided exactly, by the scalar test.
+    let bound = arith::watertight_edge_bound(xs, ys, relative.map(|r| r[2]), shear);
+    let rescan = uvw[0].abs().cmple(bound) | uvw[1].abs().cmple(bound) | uvw[2].abs().cmple(bound);
     let negative = uvw[0].cmplt(zero) | uvw[1].cmplt(zero) | uvw[2].cmplt(zero);
     let positive = uvw[0].cmpgt(zero) | uvw[1].cmpgt(zero) | uvw[2].cmpgt(zero);
     let (det, t_scaled) = arith::watertight_det_and_scaled_t(uvw, zs);

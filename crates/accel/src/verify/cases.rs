@@ -45,6 +45,7 @@ pub fn adversarial_cases(special: usize, seed: u64) -> Vec<Case> {
     cases.push(shared_edges(special, seed));
     cases.push(touching_boxes());
     cases.push(walls_and_needles(25 * special, seed));
+    cases.push(hollow_needles(4 * special, seed));
     cases
 }
 
@@ -285,6 +286,49 @@ fn walls_and_needles(count: usize, seed: u64) -> Case {
     // offset too small): many secondary rays.
     let leaving = RayKind::Secondary.rays(&triangles, count, seed ^ 0x5e1f);
     Case { name: "walls-and-needles".into(), triangles, special_rays: vec![("leaving", leaving)] }
+}
+
+/// A closed needle: a 64-sided cylinder of radius `radius` and length
+/// `length` along x, centred on `centre`, its sides single facets the full
+/// length, capped by fans.
+pub fn needle(radius: f32, length: f32, centre: Vec3) -> ClosedMesh {
+    let unit = cylinder(64, 1);
+    let vertices =
+        unit.vertices.iter().map(|v| centre + Vec3::new(0.5 * length * v.z, radius * v.x, radius * v.y)).collect();
+    ClosedMesh { vertices, faces: unit.faces }
+}
+
+/// Closed needles (aspect 16384 : 1) at offsets 2^0 … 2^23 from the origin,
+/// and rays from inside them nearly parallel to their axis: each leaves
+/// through a long facet near the edge it shares with the next, where the
+/// sheared coordinates of the watertight test lose most of their digits to
+/// cancellation. (A leak of this kind was found in the single-precision
+/// test: both facets beside the exit refused the ray.)
+fn hollow_needles(count: usize, seed: u64) -> Case {
+    let mut rng = Rng::new(seed, 8);
+    let offsets = [0, 8, 12, 16, 20, 22, 23];
+    let per_needle = count.div_ceil(offsets.len()).max(1);
+    let (mut triangles, mut rays) = (Vec::new(), Vec::new());
+    for exponent in offsets {
+        let offset = 2f32.powi(exponent);
+        // 256 ulps across the radius wherever it is: the facets survive rounding.
+        let radius = 32f32.max(256.0 * ulp(offset));
+        let length = 16384.0 * radius;
+        let centre = Vec3::splat(offset);
+        triangles.extend(needle(radius, length, centre).triangles());
+        for _ in 0..per_needle {
+            let along = (rng.next_f32() - 0.5) * 0.5 * length;
+            let around = uniform_sphere(rng.next_f32(), rng.next_f32()) * 0.6 * radius;
+            let origin = centre + Vec3::new(along, around.y, around.z);
+            // Towards either end, leaning out by 10⁻⁴ to 1 of the radius over the length.
+            let lean = radius / length * 10f32.powf(4.0 * rng.next_f32());
+            let sideways = uniform_sphere(rng.next_f32(), rng.next_f32());
+            let sign = if rng.next_f32() < 0.5 { -1.0 } else { 1.0 };
+            let direction = Vec3::new(sign, lean * sideways.y, lean * sideways.z);
+            rays.push(ProbeRay { ray: Ray::new(origin, direction), expect: Expect::HitBy(2.0 * length) });
+        }
+    }
+    Case { name: "hollow-needles".into(), triangles, special_rays: vec![("inside", rays)] }
 }
 
 /// A 4 × 4 × 4 block of unit cubes that touch: neighbouring faces coincide,

@@ -1,0 +1,167 @@
+//! Exact signs for the watertight triangle test, for the rare edges whose
+//! single-precision value is too close to zero to trust.
+//!
+//! The watertight test's edge function for the edge from `p` to `q` has
+//! the sign of `((p − o) × (q − o)) · d` (the sheared 2D cross product is
+//! that triple product over `d[kz]`, and the axis swap for `d[kz] < 0`
+//! cancels the division's sign). With single-precision inputs this value
+//! is a sum of products of three numbers that double precision holds only
+//! approximately, so it is summed as a floating-point *expansion*
+//! (Shewchuk, "Adaptive Precision Floating-Point Arithmetic and Fast Robust
+//! Geometric Predicates", 1997): a list of doubles whose exact sum is the
+//! value, whose largest term has the value's sign.
+//!
+//! Every `f32` difference is exact as two doubles, and every product of
+//! three `f32`-sized factors stays far inside the range of doubles
+//! (`2^-447` to `2^387`), so no step underflows or overflows: the sign is
+//! exact for every finite input.
+
+use rtgi_math::Vec3A;
+
+/// `a + b` as `(sum, error)`, exactly.
+#[inline]
+fn two_sum(a: f64, b: f64) -> (f64, f64) {
+    let sum = a + b;
+    let b_virtual = sum - a;
+    let a_virtual = sum - b_virtual;
+    (sum, (a - a_virtual) + (b - b_virtual))
+}
+
+/// `a · b` as `(product, error)`, exactly (the fused multiply-add's error term).
+#[inline]
+fn two_product(a: f64, b: f64) -> (f64, f64) {
+    let product = a * b;
+    (product, a.mul_add(b, -product))
+}
+
+/// Adds `b` to the expansion `terms` (non-overlapping, increasing
+/// magnitude, no zeros), keeping those properties (Shewchuk's
+/// Grow-Expansion with zero elimination).
+fn grow(terms: &mut Vec<f64>, b: f64) {
+    let mut carry = b;
+    let mut kept = 0;
+    for i in 0..terms.len() {
+        let (sum, error) = two_sum(carry, terms[i]);
+        if error != 0.0 {
+            terms[kept] = error;
+            kept += 1;
+        }
+        carry = sum;
+    }
+    terms.truncate(kept);
+    if carry != 0.0 {
+        terms.push(carry);
+    }
+}
+
+/// The exact sign (−1, 0 or 1) of `((p − o) × (q − o)) · d`.
+pub(crate) fn edge_sign(p: Vec3A, q: Vec3A, origin: Vec3A, direction: Vec3A) -> i32 {
+    // Each difference exactly, as the two doubles (high, low).
+    let difference = |v: Vec3A| -> [[f64; 2]; 3] {
+        let (v, o) = (v.to_array(), origin.to_array());
+        std::array::from_fn(|axis| {
+            let (high, low) = two_sum(f64::from(v[axis]), -f64::from(o[axis]));
+            [high, low]
+        })
+    };
+    let (a, b) = (difference(p), difference(q));
+    let d = direction.to_array().map(f64::from);
+    let mut terms: Vec<f64> = Vec::with_capacity(96);
+    // (a × b) · d = Σ over cyclic (i, j, k) of d_i (a_j b_k − a_k b_j).
+    for (i, j, k) in [(0, 1, 2), (1, 2, 0), (2, 0, 1)] {
+        for (x, y, sign) in [(a[j], b[k], 1.0), (a[k], b[j], -1.0)] {
+            for xs in x {
+                for ys in y {
+                    let (product, error) = two_product(xs, ys);
+                    for part in [product, error] {
+                        let (high, low) = two_product(part, sign * d[i]);
+                        grow(&mut terms, high);
+                        grow(&mut terms, low);
+                    }
+                }
+            }
+        }
+    }
+    // The largest term decides: the others sum to less than half its unit in the last place.
+    match terms.last() {
+        Some(&top) if top > 0.0 => 1,
+        Some(&top) if top < 0.0 => -1,
+        _ => 0,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn v(x: f32, y: f32, z: f32) -> Vec3A {
+        Vec3A::new(x, y, z)
+    }
+
+    #[test]
+    fn signs_of_plain_triple_products() {
+        let o = v(0.0, 0.0, 0.0);
+        assert_eq!(edge_sign(v(1.0, 0.0, 0.0), v(0.0, 1.0, 0.0), o, v(0.0, 0.0, 1.0)), 1);
+        assert_eq!(edge_sign(v(0.0, 1.0, 0.0), v(1.0, 0.0, 0.0), o, v(0.0, 0.0, 1.0)), -1);
+        assert_eq!(edge_sign(v(1.0, 0.0, 0.0), v(2.0, 0.0, 0.0), o, v(0.0, 0.0, 1.0)), 0);
+        // The ray through the edge's line exactly.
+        assert_eq!(edge_sign(v(1.0, 1.0, 1.0), v(1.0, 1.0, 3.0), v(1.0, 1.0, 0.0), v(0.0, 0.0, 1.0)), 0);
+    }
+
+    /// The sign in 128-bit integers, for integer-valued inputs.
+    fn integer_sign(p: [i64; 3], q: [i64; 3], o: [i64; 3], d: [i64; 3]) -> i32 {
+        let a: [i128; 3] = std::array::from_fn(|i| (p[i] - o[i]) as i128);
+        let b: [i128; 3] = std::array::from_fn(|i| (q[i] - o[i]) as i128);
+        let c = [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]];
+        let value = c[0] * d[0] as i128 + c[1] * d[1] as i128 + c[2] * d[2] as i128;
+        value.signum() as i32
+    }
+
+    #[test]
+    fn near_and_exactly_coplanar_edges_far_out_match_integer_arithmetic() {
+        // Integer coordinates up to 2^24 and directions up to 2^18: triple
+        // products near 2^68, past what doubles hold. Edges whose plane
+        // contains the ray exactly (p = o + k d), then nudged by one unit.
+        let mut rng = rtgi_math::Rng::new(7, 0);
+        let mut coordinate = |limit: i64| (rng.next_f32() as f64 * (2 * limit) as f64) as i64 - limit;
+        let (mut zeros, mut doubles_wrong) = (0, 0);
+        for _ in 0..20_000 {
+            let o = [coordinate(1 << 23), coordinate(1 << 23), coordinate(1 << 23)];
+            let d = [coordinate(1 << 18), coordinate(1 << 18), coordinate(1 << 18)];
+            let k = coordinate(32);
+            let mut p: [i64; 3] = std::array::from_fn(|i| o[i] + k * d[i]);
+            let q = [coordinate(1 << 23), coordinate(1 << 23), coordinate(1 << 23)];
+            let nudge = coordinate(2);
+            p[(k & 1) as usize] += nudge;
+            if p.iter().chain(&q).any(|c| c.abs() >= 1 << 24) || d == [0; 3] {
+                continue;
+            }
+            let f = |c: [i64; 3]| Vec3A::new(c[0] as f32, c[1] as f32, c[2] as f32);
+            let exact = integer_sign(p, q, o, d);
+            assert_eq!(edge_sign(f(p), f(q), f(o), f(d)), exact, "p {p:?} q {q:?} o {o:?} d {d:?}");
+            assert_eq!(edge_sign(f(q), f(p), f(o), f(d)), -exact);
+            zeros += (exact == 0) as u32;
+            // How often plain doubles would have got the sign wrong here.
+            let g = |c: [i64; 3], o: [i64; 3]| [0, 1, 2].map(|i| (c[i] - o[i]) as f64);
+            let (a, b) = (g(p, o), g(q, o));
+            let naive = d[0] as f64 * (a[1] * b[2] - a[2] * b[1])
+                + d[1] as f64 * (a[2] * b[0] - a[0] * b[2])
+                + d[2] as f64 * (a[0] * b[1] - a[1] * b[0]);
+            doubles_wrong += (naive.signum() as i32 != exact && !(naive == 0.0 && exact == 0)) as u32;
+        }
+        assert!(zeros > 1000, "too few exactly coplanar cases: {zeros}");
+        assert!(doubles_wrong > 100, "the cases are not hard: doubles got {doubles_wrong} wrong");
+    }
+
+    #[test]
+    fn extreme_magnitudes_keep_their_sign() {
+        let tiny = f32::from_bits(1); // the smallest subnormal
+        let huge = f32::MAX;
+        let o = v(0.0, 0.0, 0.0);
+        let d = v(0.0, 0.0, 1.0);
+        assert_eq!(edge_sign(v(tiny, 0.0, 0.0), v(0.0, tiny, 0.0), o, d), 1);
+        assert_eq!(edge_sign(v(huge, 0.0, 0.0), v(0.0, huge, 0.0), o, d), 1);
+        assert_eq!(edge_sign(v(huge, tiny, 0.0), v(-huge, 0.0, 0.0), o, d), 1);
+        assert_eq!(edge_sign(v(huge, tiny, 0.0), v(-huge, -tiny, 0.0), o, d), 0);
+    }
+}
