@@ -218,6 +218,9 @@ impl TriangleTest for Watertight {
             return None;
         }
         let (det, t_scaled) = arith::watertight_det_and_scaled_t(uvw, zs);
+        if t_scaled.abs() <= arith::watertight_t_bound(det, zs, bound) {
+            return exact_hit(ray, t_min, t_max, v, uvw, bound);
+        }
         if det == 0.0 || !det.is_finite() {
             return None;
         }

@@ -129,6 +129,20 @@ pub(crate) fn watertight_edge_bound<L: Lanes>(xs: [L; 3], ys: [L; 3], relative_z
     L::splat(32.0 * f32::EPSILON / 2.0) * (x * y + spread) + L::splat(f32::from_bits(1 << 4))
 }
 
+/// A bound on the error of the scaled distance `t · det` of
+/// [`watertight_det_and_scaled_t`] for a triangle the ray hits (edge
+/// functions of one sign, so `Σ|e| = |det|`): each term `e z` carries the
+/// edge function's error (at most `bound`) and a few roundings of its own,
+/// less than `(8ε |det| + 3 bound) max|z|`. A scaled distance within it may
+/// have the wrong sign or no digit right: the corners lie on both sides of
+/// the origin and the terms cancel (a long triangle beside the ray's
+/// origin), and the distance is taken from the triangle's plane instead.
+#[inline(always)]
+pub(crate) fn watertight_t_bound<L: Lanes>(det: L, zs: [L; 3], bound: L) -> L {
+    let z = zs[0].abs().max(zs[1].abs()).max(zs[2].abs());
+    (L::splat(8.0 * f32::EPSILON / 2.0) * det.abs() + L::splat(3.0) * bound) * z
+}
+
 /// The watertight test's determinant and its distance scaled by the
 /// determinant, from the scaled barycentrics and the sheared corner heights.
 #[inline(always)]

@@ -131,6 +131,8 @@ pub(crate) fn watertight_block(
     let negative = uvw[0].cmplt(zero) | uvw[1].cmplt(zero) | uvw[2].cmplt(zero);
     let positive = uvw[0].cmpgt(zero) | uvw[1].cmpgt(zero) | uvw[2].cmpgt(zero);
     let (det, t_scaled) = arith::watertight_det_and_scaled_t(uvw, zs);
+    // So are distances lost to cancellation, for lanes whose edges say hit.
+    let rescan = rescan | (!(negative & positive) & t_scaled.abs().cmple(arith::watertight_t_bound(det, zs, bound)));
     let t = t_scaled / det;
     let hit = !(negative & positive) & det.cmpne(zero) & det.is_finite_mask() & in_range(t, t_min, t_max);
     BlockHits {
