@@ -27,35 +27,104 @@ fn two_sum(a: f64, b: f64) -> (f64, f64) {
     (sum, (a - a_virtual) + (b - b_virtual))
 }
 
-/// `a · b` as `(product, error)`, exactly (the fused multiply-add's error term).
+/// `a` as two halves of 26 bits each whose sum is `a` (Veltkamp's split).
+#[inline]
+fn split(a: f64) -> (f64, f64) {
+    let c = 134_217_729.0 * a; // 2^27 + 1
+    let high = c - (c - a);
+    (high, a - high)
+}
+
+/// `a · b` as `(product, error)`, exactly (Dekker's product: no fused
+/// multiply-add, which x86-64-v2 lacks and software emulates slowly).
 #[inline]
 fn two_product(a: f64, b: f64) -> (f64, f64) {
     let product = a * b;
-    (product, a.mul_add(b, -product))
+    let ((a_high, a_low), (b_high, b_low)) = (split(a), split(b));
+    let error = ((a_high * b_high - product) + a_low * b_high + a_high * b_low) + a_low * b_low;
+    (product, error)
 }
 
-/// Adds `b` to the expansion `terms` (non-overlapping, increasing
-/// magnitude, no zeros), keeping those properties (Shewchuk's
-/// Grow-Expansion with zero elimination).
-fn grow(terms: &mut Vec<f64>, b: f64) {
-    let mut carry = b;
-    let mut kept = 0;
-    for i in 0..terms.len() {
-        let (sum, error) = two_sum(carry, terms[i]);
-        if error != 0.0 {
-            terms[kept] = error;
+/// Most terms an edge's expansion can reach: one per product term added.
+const MOST_TERMS: usize = 96;
+
+/// A floating-point expansion held in place (the exact path allocates nothing).
+struct Expansion {
+    /// Non-overlapping, increasing magnitude, no zeros.
+    terms: [f64; MOST_TERMS],
+    len: usize,
+}
+
+impl Expansion {
+    fn new() -> Expansion {
+        Expansion { terms: [0.0; MOST_TERMS], len: 0 }
+    }
+
+    /// Adds `b`, keeping the terms' properties (Shewchuk's Grow-Expansion
+    /// with zero elimination).
+    fn grow(&mut self, b: f64) {
+        let mut carry = b;
+        let mut kept = 0;
+        for i in 0..self.len {
+            let (sum, error) = two_sum(carry, self.terms[i]);
+            if error != 0.0 {
+                self.terms[kept] = error;
+                kept += 1;
+            }
+            carry = sum;
+        }
+        if carry != 0.0 {
+            self.terms[kept] = carry;
             kept += 1;
         }
-        carry = sum;
+        self.len = kept;
     }
-    terms.truncate(kept);
-    if carry != 0.0 {
-        terms.push(carry);
+
+    /// The sign of the exact sum: its largest term's (the others sum to
+    /// less than half its unit in the last place).
+    fn sign(&self) -> i32 {
+        match self.terms[..self.len].last() {
+            Some(&top) if top > 0.0 => 1,
+            Some(&top) if top < 0.0 => -1,
+            _ => 0,
+        }
     }
 }
 
 /// The exact sign (−1, 0 or 1) of `((p − o) × (q − o)) · d`.
+///
+/// Double precision with a bound on its rounding error decides almost
+/// every edge the single-precision test could not; the expansion is for
+/// rays within that bound of the edge's plane.
 pub(crate) fn edge_sign(p: Vec3A, q: Vec3A, origin: Vec3A, direction: Vec3A) -> i32 {
+    let (o, d) = (origin.as_dvec3(), direction.as_dvec3());
+    let (a, b) = (p.as_dvec3() - o, q.as_dvec3() - o);
+    let products = [
+        d.x * (a.y * b.z),
+        -d.x * (a.z * b.y),
+        d.y * (a.z * b.x),
+        -d.y * (a.x * b.z),
+        d.z * (a.x * b.y),
+        -d.z * (a.y * b.x),
+    ];
+    let value = d.x * (a.y * b.z - a.z * b.y) + d.y * (a.z * b.x - a.x * b.z) + d.z * (a.x * b.y - a.y * b.x);
+    let magnitude: f64 = products.iter().map(|t| t.abs()).sum();
+    // Each difference, product, subtraction and sum above rounds once, for
+    // at most 7 units of 2^-53 of the magnitude (plus second-order terms);
+    // 8 · 2^-52 leaves a factor of two to spare. No step under- or
+    // overflows for f32 inputs, so the bound holds for every finite input.
+    let bound = 8.0 * f64::EPSILON * magnitude;
+    if value > bound {
+        return 1;
+    }
+    if value < -bound {
+        return -1;
+    }
+    expansion_sign(p, q, origin, direction)
+}
+
+/// [`edge_sign`] by the exact sum alone.
+fn expansion_sign(p: Vec3A, q: Vec3A, origin: Vec3A, direction: Vec3A) -> i32 {
     // Each difference exactly, as the two doubles (high, low).
     let difference = |v: Vec3A| -> [[f64; 2]; 3] {
         let (v, o) = (v.to_array(), origin.to_array());
@@ -66,28 +135,27 @@ pub(crate) fn edge_sign(p: Vec3A, q: Vec3A, origin: Vec3A, direction: Vec3A) -> 
     };
     let (a, b) = (difference(p), difference(q));
     let d = direction.to_array().map(f64::from);
-    let mut terms: Vec<f64> = Vec::with_capacity(96);
+    let mut sum = Expansion::new();
     // (a × b) · d = Σ over cyclic (i, j, k) of d_i (a_j b_k − a_k b_j).
     for (i, j, k) in [(0, 1, 2), (1, 2, 0), (2, 0, 1)] {
         for (x, y, sign) in [(a[j], b[k], 1.0), (a[k], b[j], -1.0)] {
             for xs in x {
                 for ys in y {
+                    // Differences of f32s are mostly exact in one double: skip the zero halves.
+                    if xs == 0.0 || ys == 0.0 {
+                        continue;
+                    }
                     let (product, error) = two_product(xs, ys);
                     for part in [product, error] {
                         let (high, low) = two_product(part, sign * d[i]);
-                        grow(&mut terms, high);
-                        grow(&mut terms, low);
+                        sum.grow(high);
+                        sum.grow(low);
                     }
                 }
             }
         }
     }
-    // The largest term decides: the others sum to less than half its unit in the last place.
-    match terms.last() {
-        Some(&top) if top > 0.0 => 1,
-        Some(&top) if top < 0.0 => -1,
-        _ => 0,
-    }
+    sum.sign()
 }
 
 #[cfg(test)]
@@ -140,6 +208,8 @@ mod tests {
             let exact = integer_sign(p, q, o, d);
             assert_eq!(edge_sign(f(p), f(q), f(o), f(d)), exact, "p {p:?} q {q:?} o {o:?} d {d:?}");
             assert_eq!(edge_sign(f(q), f(p), f(o), f(d)), -exact);
+            // The expansion alone agrees too, wherever the filter decided.
+            assert_eq!(expansion_sign(f(p), f(q), f(o), f(d)), exact, "p {p:?} q {q:?} o {o:?} d {d:?}");
             zeros += (exact == 0) as u32;
             // How often plain doubles would have got the sign wrong here.
             let g = |c: [i64; 3], o: [i64; 3]| [0, 1, 2].map(|i| (c[i] - o[i]) as f64);

@@ -20,7 +20,7 @@ mod cases;
 mod rays;
 pub mod shapes;
 
-pub use cases::{Case, Solid, adversarial_cases, needle, solids};
+pub use cases::{Case, Solid, adversarial_cases, hollow_needles, needle, solids};
 pub use rays::RayKind;
 
 use rayon::prelude::*;
