@@ -14,6 +14,9 @@ use crate::report::{Point, Report, Series, Table, format_number, format_timing};
 use crate::stats::Timing;
 use crate::{ExperimentError, Options, Steps, Subject};
 
+/// A render's time and its error, with the error's range (here one value thrice).
+type TimedError = (Timing, f64, f64, f64);
+
 /// A bias beyond this many standard errors is reported as resolved.
 pub(crate) const RESOLVED_SE: f64 = 4.0;
 
@@ -72,7 +75,7 @@ pub(super) fn run(options: &Options, mut report: Report, progress: &dyn Fn(&str)
         let mut series = Series { name: name.clone(), points: Vec::new() };
         let mut resolved = Vec::new();
         let mut z_scores = Vec::new();
-        let mut by_strategy: Vec<(String, Vec<(Timing, f64, f64, f64)>)> = Vec::new();
+        let mut by_strategy: Vec<(String, Vec<TimedError>)> = Vec::new();
         for (index, (label, settings)) in estimators.iter().enumerate() {
             steps.next(&format!("{name}: {label}"));
             let mut means = Vec::new();
