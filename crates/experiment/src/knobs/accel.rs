@@ -63,7 +63,8 @@ fn configurations(triangles: usize, quick: bool) -> Vec<(String, AccelKind, Buil
     list
 }
 
-fn answers(accel: &dyn Accel, rays: &[Ray]) -> Vec<Option<Hit>> {
+/// Each ray's closest hit, on all threads.
+pub(super) fn answers(accel: &dyn Accel, rays: &[Ray]) -> Vec<Option<Hit>> {
     rays.par_iter().map(|r| accel.intersect(r)).collect()
 }
 
