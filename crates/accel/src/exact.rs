@@ -6,10 +6,13 @@
 //! that triple product over `d[kz]`, and the axis swap for `d[kz] < 0`
 //! cancels the division's sign). With single-precision inputs this value
 //! is a sum of products of three numbers that double precision holds only
-//! approximately, so it is summed as a floating-point *expansion*
-//! (Shewchuk, "Adaptive Precision Floating-Point Arithmetic and Fast Robust
-//! Geometric Predicates", 1997): a list of doubles whose exact sum is the
-//! value, whose largest term has the value's sign.
+//! approximately. Double precision with an error bound decides most edges;
+//! the rest are split into products that are exact as two doubles each,
+//! whose exact sum is found by error-free summation sweeps and, for sums at
+//! zero, a floating-point *expansion* (Shewchuk, "Adaptive Precision
+//! Floating-Point Arithmetic and Fast Robust Geometric Predicates", 1997):
+//! a list of doubles whose exact sum is the value, whose largest term has
+//! the value's sign.
 //!
 //! Every `f32` difference is exact as two doubles, and every product of
 //! three `f32`-sized factors stays far inside the range of doubles
@@ -45,8 +48,8 @@ fn two_product(a: f64, b: f64) -> (f64, f64) {
     (product, error)
 }
 
-/// Most terms an edge's expansion can reach: one per product term added.
-const MOST_TERMS: usize = 96;
+/// Most terms an edge's value takes ([`product_terms`]): two per product.
+const MOST_TERMS: usize = 36;
 
 /// A floating-point expansion held in place (the exact path allocates nothing).
 struct Expansion {
@@ -120,40 +123,95 @@ pub(crate) fn edge_sign(p: Vec3A, q: Vec3A, origin: Vec3A, direction: Vec3A) -> 
     if value < -bound {
         return -1;
     }
-    expansion_sign(p, q, origin, direction)
+    if magnitude == 0.0 {
+        // Every product is exactly zero (none underflows), so is the value.
+        return 0;
+    }
+    swept_sign(p, q, origin, direction)
 }
 
-/// [`edge_sign`] by the exact sum alone.
-fn expansion_sign(p: Vec3A, q: Vec3A, origin: Vec3A, direction: Vec3A) -> i32 {
-    // Each difference exactly, as the two doubles (high, low).
-    let difference = |v: Vec3A| -> [[f64; 2]; 3] {
-        let (v, o) = (v.to_array(), origin.to_array());
-        std::array::from_fn(|axis| {
-            let (high, low) = two_sum(f64::from(v[axis]), -f64::from(o[axis]));
-            [high, low]
-        })
-    };
-    let (a, b) = (difference(p), difference(q));
-    let d = direction.to_array().map(f64::from);
-    let mut sum = Expansion::new();
-    // (a × b) · d = Σ over cyclic (i, j, k) of d_i (a_j b_k − a_k b_j).
-    for (i, j, k) in [(0, 1, 2), (1, 2, 0), (2, 0, 1)] {
-        for (x, y, sign) in [(a[j], b[k], 1.0), (a[k], b[j], -1.0)] {
-            for xs in x {
-                for ys in y {
-                    // Differences of f32s are mostly exact in one double: skip the zero halves.
-                    if xs == 0.0 || ys == 0.0 {
-                        continue;
-                    }
-                    let (product, error) = two_product(xs, ys);
-                    for part in [product, error] {
-                        let (high, low) = two_product(part, sign * d[i]);
-                        sum.grow(high);
-                        sum.grow(low);
-                    }
-                }
+/// The exact product terms of `((p − o) × (q − o)) · d`: at most
+/// [`MOST_TERMS`] doubles whose exact sum is the value.
+///
+/// The value is rewritten as `d · (p × q) + (p − q) · (d × o)` (the `o × o`
+/// part of the product is zero), in which every product of two `f32`s is
+/// exact in one double: six terms `d_i (p_j q_k)` and the exact difference
+/// `p − q` times the six exact products `d_j o_k`, each product of two
+/// doubles as two. Unlike the differences from `o`, which for an origin far
+/// from the edge keep the origin's huge parts to cancel later, this form
+/// has nothing to cancel when the ray runs through the world's origin.
+fn product_terms(p: Vec3A, q: Vec3A, origin: Vec3A, direction: Vec3A) -> ([f64; MOST_TERMS], usize) {
+    let (p, q) = (p.to_array().map(f64::from), q.to_array().map(f64::from));
+    let (o, d) = (origin.to_array().map(f64::from), direction.to_array().map(f64::from));
+    let (mut terms, mut len) = ([0.0; MOST_TERMS], 0);
+    let mut push = |(high, low): (f64, f64)| {
+        for term in [high, low] {
+            if term != 0.0 {
+                terms[len] = term;
+                len += 1;
             }
         }
+    };
+    for (i, j, k) in [(0, 1, 2), (1, 2, 0), (2, 0, 1)] {
+        // d_i (p_j q_k − p_k q_j), the inner products exact.
+        push(two_product(d[i], p[j] * q[k]));
+        push(two_product(-d[i], p[k] * q[j]));
+        // (p_i − q_i)(d_j o_k − d_k o_j), the difference as (high, low).
+        let (high, low) = two_sum(p[i], -q[i]);
+        for part in [high, low] {
+            if part != 0.0 {
+                push(two_product(part, d[j] * o[k]));
+                push(two_product(-part, d[k] * o[j]));
+            }
+        }
+    }
+    (terms, len)
+}
+
+/// [`edge_sign`] past the double-precision filter: a few error-free
+/// summation sweeps (Ogita, Rump and Oishi's VecSum, "Accurate Sum and Dot
+/// Product", 2005), each of which keeps the exact sum and moves it into the
+/// last term, until that term outweighs all the others together; the
+/// expansion when that does not happen within a few sweeps (sums at or
+/// extremely near zero). A sweep costs as much as adding one term to the
+/// expansion, which is what makes the difference for rays from extremely
+/// far away, whose differences all carry a low half.
+fn swept_sign(p: Vec3A, q: Vec3A, origin: Vec3A, direction: Vec3A) -> i32 {
+    let (mut terms, len) = product_terms(p, q, origin, direction);
+    let terms = &mut terms[..len];
+    if terms.is_empty() {
+        return 0;
+    }
+    for _ in 0..4 {
+        for i in 1..terms.len() {
+            let (sum, error) = two_sum(terms[i], terms[i - 1]);
+            (terms[i], terms[i - 1]) = (sum, error);
+        }
+        let (top, rest) = terms.split_last().expect("not empty");
+        let rest: f64 = rest.iter().map(|t| t.abs()).sum();
+        // The computed sum of n magnitudes is within a factor (1 ± ε)^n of
+        // the exact one; 1 + 4nε covers it with room to spare.
+        if top.abs() > rest * (1.0 + 4.0 * terms.len() as f64 * f64::EPSILON) {
+            return if *top > 0.0 { 1 } else { -1 };
+        }
+        if *top == 0.0 && rest == 0.0 {
+            return 0;
+        }
+    }
+    let mut sum = Expansion::new();
+    for &term in terms.iter() {
+        sum.grow(term);
+    }
+    sum.sign()
+}
+
+/// [`edge_sign`] by the exact sum alone (Shewchuk's expansion).
+#[cfg(test)]
+fn expansion_sign(p: Vec3A, q: Vec3A, origin: Vec3A, direction: Vec3A) -> i32 {
+    let (terms, len) = product_terms(p, q, origin, direction);
+    let mut sum = Expansion::new();
+    for &term in &terms[..len] {
+        sum.grow(term);
     }
     sum.sign()
 }
@@ -208,7 +266,8 @@ mod tests {
             let exact = integer_sign(p, q, o, d);
             assert_eq!(edge_sign(f(p), f(q), f(o), f(d)), exact, "p {p:?} q {q:?} o {o:?} d {d:?}");
             assert_eq!(edge_sign(f(q), f(p), f(o), f(d)), -exact);
-            // The expansion alone agrees too, wherever the filter decided.
+            // The sweeps and the expansion alone agree too, wherever the filter decided.
+            assert_eq!(swept_sign(f(p), f(q), f(o), f(d)), exact, "p {p:?} q {q:?} o {o:?} d {d:?}");
             assert_eq!(expansion_sign(f(p), f(q), f(o), f(d)), exact, "p {p:?} q {q:?} o {o:?} d {d:?}");
             zeros += (exact == 0) as u32;
             // How often plain doubles would have got the sign wrong here.
@@ -221,6 +280,66 @@ mod tests {
         }
         assert!(zeros > 1000, "too few exactly coplanar cases: {zeros}");
         assert!(doubles_wrong > 100, "the cases are not hard: doubles got {doubles_wrong} wrong");
+    }
+
+    /// The sign by the differences from the origin, summed as one
+    /// expansion: the way [`product_terms`] does not take, as a check on it.
+    fn sign_from_differences(p: Vec3A, q: Vec3A, o: Vec3A, d: Vec3A) -> i32 {
+        let difference = |v: Vec3A| -> [[f64; 2]; 3] {
+            let (v, o) = (v.to_array(), o.to_array());
+            std::array::from_fn(|axis| {
+                let (high, low) = two_sum(f64::from(v[axis]), -f64::from(o[axis]));
+                [high, low]
+            })
+        };
+        let (a, b, d) = (difference(p), difference(q), d.to_array().map(f64::from));
+        let mut terms = Vec::new();
+        for (i, j, k) in [(0, 1, 2), (1, 2, 0), (2, 0, 1)] {
+            for (x, y, sign) in [(a[j], b[k], 1.0), (a[k], b[j], -1.0)] {
+                for (xs, ys) in x.into_iter().flat_map(|xs| y.map(|ys| (xs, ys))) {
+                    let (product, error) = two_product(xs, ys);
+                    for part in [product, error] {
+                        let (high, low) = two_product(part, sign * d[i]);
+                        terms.extend([high, low]);
+                    }
+                }
+            }
+        }
+        // Grown in pieces: one expansion holds at most MOST_TERMS terms.
+        let mut sum = Expansion::new();
+        for term in terms {
+            sum.grow(term);
+            assert!(sum.len < MOST_TERMS, "the check's expansion outgrew its array");
+        }
+        sum.sign()
+    }
+
+    #[test]
+    fn rays_from_far_away_through_small_edges_keep_their_sign() {
+        // Origins up to 2^100 away aimed at edges near the world's origin,
+        // exactly through it (d = −o) and nudged off it: the differences
+        // from the origin lose the edge entirely in double precision.
+        let mut rng = rtgi_math::Rng::new(11, 0);
+        let mut next = || rng.next_f32() * 2.0 - 1.0;
+        let (mut nonzero, mut zeros) = (0, 0);
+        for case in 0..20_000 {
+            let far = 2f32.powi(case % 101);
+            let o = v(next(), next(), next()) * far;
+            let p = v(next(), next(), next()) * 8.0;
+            let q = if case % 3 == 0 { p * 2.0 } else { v(next(), next(), next()) * 8.0 };
+            let d = match case % 4 {
+                0 => -o,
+                1 => p - o,
+                _ => -o + v(next(), next(), next()) * 8.0,
+            };
+            let expected = sign_from_differences(p, q, o, d);
+            assert_eq!(edge_sign(p, q, o, d), expected, "p {p:?} q {q:?} o {o:?} d {d:?}");
+            assert_eq!(swept_sign(p, q, o, d), expected, "p {p:?} q {q:?} o {o:?} d {d:?}");
+            assert_eq!(expansion_sign(p, q, o, d), expected, "p {p:?} q {q:?} o {o:?} d {d:?}");
+            nonzero += (expected != 0) as u32;
+            zeros += (expected == 0) as u32;
+        }
+        assert!(nonzero > 10_000 && zeros > 100, "{nonzero} non-zero, {zeros} zero");
     }
 
     #[test]

@@ -326,18 +326,15 @@ fn exact_hit(
 ) -> Option<TriangleHit> {
     let (o, d) = (ray.origin, ray.direction);
     let edges = [(2, 1), (0, 2), (1, 0)];
-    let signs: [i32; 3] = std::array::from_fn(|i| {
-        if uvw[i].abs() > bound {
-            if uvw[i] > 0.0 { 1 } else { -1 }
-        } else {
-            let (p, q) = edges[i];
-            exact::edge_sign(v[p], v[q], o, d)
-        }
-    });
-    if signs.contains(&1) && signs.contains(&-1) || signs == [0; 3] {
+    // Everything that rejects the hit whatever the uncertain signs turn out
+    // to be comes first, as the exact signs are the costly part: two
+    // certain signs that differ, a degenerate or non-finite plane (most
+    // degenerate triangles of scanned meshes end here), a distance out of
+    // range.
+    let certain = uvw.map(|value| if value.abs() > bound { value.signum() as i32 } else { 0 });
+    if certain.contains(&1) && certain.contains(&-1) {
         return None;
     }
-    let facing = if signs.contains(&1) { 1.0 } else { -1.0 };
     let [a, b, c] = v.map(|corner| corner.as_dvec3());
     let (origin, direction) = (o.as_dvec3(), d.as_dvec3());
     let normal = (b - a).cross(c - a);
@@ -349,6 +346,20 @@ fn exact_hit(
     if !(t >= t_min && t <= t_max && t.is_finite()) {
         return None;
     }
+    let mut signs = certain;
+    for (i, &(p, q)) in edges.iter().enumerate() {
+        if uvw[i].abs() > bound {
+            continue;
+        }
+        signs[i] = exact::edge_sign(v[p], v[q], o, d);
+        if signs.contains(&1) && signs.contains(&-1) {
+            return None;
+        }
+    }
+    if signs == [0; 3] {
+        return None;
+    }
+    let facing = if signs.contains(&1) { 1.0 } else { -1.0 };
     // Barycentrics: the edge functions' magnitudes in double precision
     // (the signed volumes over the ray), zero where the sign is.
     let weights: [f64; 3] = std::array::from_fn(|i| {
