@@ -13,7 +13,7 @@ use rtgi_tests::for_every_variant;
 #[test]
 fn adversarial_cases_agree_bit_for_bit_with_the_linear_scan() {
     let mut report = Vec::new();
-    for case in adversarial_cases(4000, 12) {
+    for case in adversarial_cases(2500, 12) {
         let rays = case.rays(1500, 12);
         let references: Vec<(Intersector, Vec<Vec<Answer>>)> = Intersector::ALL
             .iter()
