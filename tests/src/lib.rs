@@ -65,12 +65,41 @@ pub fn render_cornell_box(
     rtgi_render::render(scene, accel.as_ref(), &camera, &settings, &|_| {}).0
 }
 
-/// A fresh empty folder for one test's files.
-pub fn scratch_dir(test: &str) -> PathBuf {
+/// A fresh empty folder for one test's files, removed when the test
+/// passes and kept (its path printed) when it fails, for a look at what the
+/// failing run wrote.
+pub fn scratch_dir(test: &str) -> ScratchDir {
     let dir = std::env::temp_dir().join(format!("rtgi-tests-{}-{test}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
     std::fs::create_dir_all(&dir).expect("cannot create a scratch folder");
-    dir
+    ScratchDir(dir)
+}
+
+/// The folder of [`scratch_dir`]; a path wherever one is expected.
+#[derive(Debug)]
+pub struct ScratchDir(PathBuf);
+
+impl std::ops::Deref for ScratchDir {
+    type Target = PathBuf;
+    fn deref(&self) -> &PathBuf {
+        &self.0
+    }
+}
+
+impl AsRef<std::path::Path> for ScratchDir {
+    fn as_ref(&self) -> &std::path::Path {
+        &self.0
+    }
+}
+
+impl Drop for ScratchDir {
+    fn drop(&mut self) {
+        if std::thread::panicking() {
+            eprintln!("the failing test's files are kept in {}", self.0.display());
+        } else {
+            let _ = std::fs::remove_dir_all(&self.0);
+        }
+    }
 }
 
 /// What a run of the CLI did.

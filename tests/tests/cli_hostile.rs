@@ -147,7 +147,8 @@ fn bench_ends_quietly_when_its_reader_goes_away() {
     let stderr = assert_quiet_when_the_pipe_closes(&args, 0);
     assert!(stderr.contains("measuring sah"), "{stderr}");
     // The JSON file asked for is written all the same.
-    let json = scratch_dir("hostile-pipe-bench").join("bench.json");
+    let json_dir = scratch_dir("hostile-pipe-bench");
+    let json = json_dir.join("bench.json");
     let with_json = [&args[..], &["--json", s(&json)]].concat();
     assert_quiet_when_the_pipe_closes(&with_json, 0);
     let report: serde_json::Value = serde_json::from_slice(&std::fs::read(&json).unwrap()).unwrap();

@@ -3,7 +3,7 @@
 //! run against the importers from before the fix (where each fails).
 
 use std::panic::{AssertUnwindSafe, catch_unwind};
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use rtgi_math::Vec3;
 use rtgi_scene::{Scene, SceneError};
@@ -16,7 +16,7 @@ fn load(path: &Path) -> Result<Scene, SceneError> {
 }
 
 /// Writes `files` (name, contents) into a fresh scratch folder and returns it.
-fn folder(test: &str, files: &[(&str, &[u8])]) -> PathBuf {
+fn folder(test: &str, files: &[(&str, &[u8])]) -> rtgi_tests::ScratchDir {
     let dir = scratch_dir(test);
     for (name, contents) in files {
         let path = dir.join(name);

@@ -26,7 +26,8 @@ fn fan_obj(count: u32) -> String {
 
 #[test]
 fn a_fan_of_100000_triangles_without_normals_loads_in_linear_time() {
-    let path = scratch_dir("loading_scale").join("fan.obj");
+    let dir = scratch_dir("loading_scale");
+    let path = dir.join("fan.obj");
     std::fs::write(&path, fan_obj(100_000)).unwrap();
 
     let start = Instant::now();

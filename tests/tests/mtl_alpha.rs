@@ -6,8 +6,9 @@ use rtgi_render::{Integrator, PixelSampler, RenderSettings, render};
 use rtgi_scene::{AlphaMode, Camera, Scene};
 use rtgi_tests::scratch_dir;
 
-/// A unit quad facing +Z with material `m`, whose MTL has `statements`.
-fn quad(test: &str, statements: &str) -> std::path::PathBuf {
+/// A unit quad facing +Z with material `m`, whose MTL has `statements`:
+/// `q.obj` in the folder returned.
+fn quad(test: &str, statements: &str) -> rtgi_tests::ScratchDir {
     let dir = scratch_dir(test);
     // The mask: black (a hole) on the left half, white on the right.
     let mask = image::GrayImage::from_fn(8, 8, |x, _| image::Luma([if x < 4 { 0 } else { 255 }]));
@@ -15,7 +16,7 @@ fn quad(test: &str, statements: &str) -> std::path::PathBuf {
     std::fs::write(dir.join("q.mtl"), format!("newmtl m\nKd 0.8 0.8 0.8\n{statements}\n")).unwrap();
     let obj = "mtllib q.mtl\nv -1 -1 0\nv 1 -1 0\nv 1 1 0\nv -1 1 0\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nusemtl m\nf 1/1 2/2 3/3 4/4\n";
     std::fs::write(dir.join("q.obj"), obj).unwrap();
-    dir.join("q.obj")
+    dir
 }
 
 /// How much of the left and right thirds of a head-on view of the quad is covered (0 to 1).
@@ -46,7 +47,7 @@ fn coverage(scene: &Scene) -> (f32, f32) {
 
 #[test]
 fn a_map_d_mask_cuts_holes() {
-    let scene = Scene::load(&quad("map-d", "map_d mask.png")).unwrap();
+    let scene = Scene::load(&quad("map-d", "map_d mask.png").join("q.obj")).unwrap();
     assert!(matches!(scene.materials[0].alpha_mode, AlphaMode::Mask { .. }), "{:?}", scene.materials[0]);
     let (left, right) = coverage(&scene);
     assert_eq!((left, right), (0.0, 1.0));
@@ -54,20 +55,21 @@ fn a_map_d_mask_cuts_holes() {
 
 #[test]
 fn a_dissolve_below_one_lets_part_of_the_light_through() {
-    let scene = Scene::load(&quad("dissolve", "d 0.25")).unwrap();
+    let scene = Scene::load(&quad("dissolve", "d 0.25").join("q.obj")).unwrap();
     assert_eq!(scene.materials[0].alpha_mode, AlphaMode::Blend);
     let (left, right) = coverage(&scene);
     for covered in [left, right] {
         assert!((covered - 0.25).abs() < 0.05, "{covered}");
     }
-    let opaque = Scene::load(&quad("opaque", "d 1")).unwrap();
+    let opaque = Scene::load(&quad("opaque", "d 1").join("q.obj")).unwrap();
     assert_eq!(opaque.materials[0].alpha_mode, AlphaMode::Opaque);
     assert_eq!(coverage(&opaque), (1.0, 1.0));
 }
 
 #[test]
 fn info_says_which_materials_are_cut_out_blended_or_transmissive() {
-    let path = quad("info-alpha", "map_d mask.png");
+    let dir = quad("info-alpha", "map_d mask.png");
+    let path = dir.join("q.obj");
     let run = rtgi_tests::run_cli(env!("CARGO_BIN_EXE_rtgi-under-test"), &["info", path.to_str().unwrap()]);
     assert!(run.success, "{run:?}");
     assert!(run.stdout.contains("cut-out (alpha mask, cutoff 0.5, from a mask texture)"), "{run:?}");
