@@ -34,7 +34,7 @@ pub(crate) fn load(
     sources: &mut Vec<PathBuf>,
 ) -> Result<Scene, SceneError> {
     let error = |message: String| SceneError::Obj { path: path.to_owned(), message };
-    check_face_sizes(bytes).map_err(error)?;
+    let statements = scan_statements(bytes).map_err(error)?;
     // tobj's loader is a `Fn`: what it collects goes through cells.
     let warnings = RefCell::new(Vec::new());
     let materials: RefCell<Vec<MtlMaterial>> = RefCell::new(Vec::new());
@@ -64,18 +64,99 @@ pub(crate) fn load(
         Ok((placeholders, names.into_iter().collect()))
     };
     let (models, _) = tobj::load_obj_buf(&mut &bytes[..], &LOAD_OPTIONS, loader).map_err(|e| error(e.to_string()))?;
+    // Checked after tobj's parse, whose errors name what is malformed.
+    if statements.faces == 0 {
+        let why = statements.unknown_note().map_or(String::new(), |note| format!("; {note}"));
+        return Err(error(format!("no faces (f statements), so nothing to render{why}")));
+    }
     sources.extend(read_sources.into_inner());
     let mut scene = from_tobj(&models, &materials.into_inner(), files, path, sources)?;
     scene.warnings.splice(0..0, warnings.into_inner());
+    if let Some(note) = statements.unknown_note() {
+        scene.warnings.insert(0, format!("{}: {note}, ignored", path.display()));
+    }
     Ok(scene)
 }
 
-/// Refuses faces with more than [`MAX_FACE_VERTICES`] vertices before tobj
-/// allocates them: a cheap scan of the statements' words.
-fn check_face_sizes(bytes: &[u8]) -> Result<(), String> {
+/// What a cheap scan of an OBJ file's statements found.
+#[derive(Default)]
+struct Statements {
+    /// Face statements (`f`).
+    faces: usize,
+    /// The first statement that OBJ does not define, with its line number,
+    /// and how many such lines there are.
+    unknown: Option<(usize, String)>,
+    unknown_lines: usize,
+}
+
+/// The statements OBJ defines (free-form geometry and display attributes
+/// included, which are read as nothing).
+const OBJ_STATEMENTS: &[&[u8]] = &[
+    b"v",
+    b"vt",
+    b"vn",
+    b"vp",
+    b"f",
+    b"fo",
+    b"l",
+    b"p",
+    b"o",
+    b"g",
+    b"s",
+    b"mg",
+    b"mtllib",
+    b"usemtl",
+    b"usemap",
+    b"maplib",
+    b"cstype",
+    b"deg",
+    b"bmat",
+    b"step",
+    b"curv",
+    b"curv2",
+    b"surf",
+    b"parm",
+    b"trim",
+    b"hole",
+    b"scrv",
+    b"sp",
+    b"end",
+    b"con",
+    b"lod",
+    b"shadow_obj",
+    b"trace_obj",
+    b"ctech",
+    b"stech",
+    b"bevel",
+    b"c_interp",
+    b"d_interp",
+    b"call",
+    b"csh",
+];
+
+/// Scans the statements' first words: refuses faces with more than
+/// [`MAX_FACE_VERTICES`] vertices before tobj allocates them, and counts
+/// faces and lines OBJ does not define, for the messages about them.
+fn scan_statements(bytes: &[u8]) -> Result<Statements, String> {
+    let mut found = Statements::default();
     for (number, line) in bytes.split(|&b| b == b'\n').enumerate() {
         let mut words = line.split(|b| b.is_ascii_whitespace()).filter(|w| !w.is_empty());
-        if !matches!(words.next(), Some(b"f" | b"l" | b"p")) {
+        let Some(first) = words.next() else { continue };
+        if first.starts_with(b"#") {
+            continue;
+        }
+        if !OBJ_STATEMENTS.contains(&first) {
+            found.unknown_lines += 1;
+            if found.unknown.is_none() {
+                let shown: String = String::from_utf8_lossy(first).chars().take(40).collect();
+                found.unknown = Some((number + 1, shown));
+            }
+            continue;
+        }
+        if first == b"f" {
+            found.faces += 1;
+        }
+        if !matches!(first, b"f" | b"l" | b"p") {
             continue;
         }
         let count = words.count();
@@ -86,7 +167,19 @@ fn check_face_sizes(bytes: &[u8]) -> Result<(), String> {
             ));
         }
     }
-    Ok(())
+    Ok(found)
+}
+
+impl Statements {
+    /// A note on the lines OBJ does not define, as a message's tail.
+    fn unknown_note(&self) -> Option<String> {
+        let (line, word) = self.unknown.as_ref()?;
+        let more = match self.unknown_lines {
+            1 => String::new(),
+            n => format!(" ({} more such lines)", n - 1),
+        };
+        Some(format!("line {line}: '{word}' is not an OBJ statement{more}"))
+    }
 }
 
 /// Loads OBJ text whose MTL text is given too; for scenes built into programs.
@@ -277,5 +370,27 @@ mod tests {
         assert!(err.to_string().starts_with("bad.obj: "), "{err}");
         let err = load_from_text("v 0 0 0\nf 1 2 3\n", "", "range.obj").unwrap_err();
         assert!(err.to_string().starts_with("range.obj: "), "{err}");
+    }
+
+    #[test]
+    fn a_file_without_faces_is_an_error_naming_what_it_holds() {
+        let err = load_from_text("x\n", "", "x.obj").unwrap_err().to_string();
+        assert_eq!(
+            err,
+            "x.obj: not a valid OBJ file: no faces (f statements), so nothing to render; line 1: 'x' is not an OBJ statement"
+        );
+        let err = load_from_text("# points only\nv 0 0 0\np 1\n", "", "points.obj").unwrap_err().to_string();
+        assert_eq!(err, "points.obj: not a valid OBJ file: no faces (f statements), so nothing to render");
+    }
+
+    #[test]
+    fn lines_obj_does_not_define_are_a_warning_naming_the_first() {
+        let obj = "v 0 0 0\nv 1 0 0\nv 0 1 0\nvertex 1 2 3\nf 1 2 3\nface 1 2 3\n";
+        let scene = load_from_text(obj, "", "t.obj").unwrap();
+        assert_eq!(scene.triangles.len(), 1);
+        assert_eq!(scene.warnings, ["t.obj: line 4: 'vertex' is not an OBJ statement (1 more such lines), ignored"]);
+        // Free-form statements and comments are OBJ's own: no warning.
+        let scene = load_from_text("cstype bspline\nv 0 0 0\nv 1 0 0\nv 0 1 0\n#x\nf 1 2 3\n", "", "t.obj").unwrap();
+        assert!(scene.warnings.is_empty(), "{:?}", scene.warnings);
     }
 }
