@@ -70,6 +70,10 @@ pub(crate) fn check_output_folder(path: &Path) -> Result<()> {
     if path.is_dir() {
         bail!("{}: is a directory", path.display());
     }
+    if let Some(folder) = path.parent().filter(|folder| !folder.as_os_str().is_empty() && !folder.is_dir()) {
+        let what = if folder.exists() { "is not a folder" } else { "does not exist" };
+        bail!("{}: cannot write: {} {what}", path.display(), folder.display());
+    }
     let probe = beside(path, "probe");
     std::fs::File::create(&probe).with_context(|| format!("{}: cannot write", path.display()))?;
     let _ = std::fs::remove_file(&probe);

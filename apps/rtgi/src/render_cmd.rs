@@ -28,8 +28,10 @@ pub(crate) fn check_output(path: &Path) -> Result<()> {
     if is_accumulation(path) {
         check_output_folder(path)
     } else {
-        check_writable(path).map(|_| ()).map_err(|e| {
-            anyhow::anyhow!("{e}").context("the output is an image (.png, .exr) or a render's accumulation (.accum)")
+        check_writable(path).map(|_| ()).map_err(|e| match e {
+            rtgi_image::ImageError::UnsupportedFormat { .. } => anyhow::anyhow!("{e}")
+                .context("the output is an image (.png, .exr) or a render's accumulation (.accum)"),
+            other => anyhow::anyhow!("{other}"),
         })
     }
 }

@@ -146,6 +146,13 @@ pub fn check_writable(path: &Path) -> Result<OutputFormat, ImageError> {
             source: std::io::Error::new(std::io::ErrorKind::IsADirectory, "is a directory"),
         });
     }
+    if let Some(folder) = path.parent().filter(|folder| !folder.as_os_str().is_empty() && !folder.is_dir()) {
+        let what = if folder.exists() { "is not a folder" } else { "does not exist" };
+        return Err(ImageError::Io {
+            path: path.to_owned(),
+            source: std::io::Error::new(std::io::ErrorKind::NotFound, format!("{} {what}", folder.display())),
+        });
+    }
     let probe = temporary_path(path);
     let created = File::create(&probe).and_then(|mut f| f.write_all(b""));
     let _ = fs::remove_file(&probe);
@@ -199,8 +206,13 @@ mod tests {
         let err = image.write(&scratch("x.bmp"), &ToneMap::default()).unwrap_err();
         assert!(err.to_string().contains("x.bmp"), "{err}");
         let missing = scratch("no-such-folder").join("x.png");
-        assert!(check_writable(&missing).is_err());
+        let err = check_writable(&missing).unwrap_err().to_string();
+        assert!(err.ends_with("no-such-folder does not exist"), "{err}");
         assert!(image.write(&missing, &ToneMap::default()).is_err());
+        // A file where the folder should be.
+        std::fs::write(scratch("a-file"), b"").unwrap();
+        let err = check_writable(&scratch("a-file").join("x.png")).unwrap_err().to_string();
+        assert!(err.ends_with("a-file is not a folder"), "{err}");
         assert!(!missing.exists());
     }
 
