@@ -176,28 +176,32 @@ fn print_text(info: &Info) -> Result<()> {
         )?;
     }
     outln!("textures    {}", info.textures.len())?;
-    for t in &info.textures {
-        outln!("  {} ({}x{})", t.name, t.width, t.height)?;
+    for (index, t) in info.textures.iter().enumerate() {
+        outln!("  [{index}] {} ({}x{})", t.name, t.width, t.height)?;
     }
     outln!("lights      {}", info.lights.len())?;
     for l in &info.lights {
         outln!("  {:<24} {} at {}, colour {}, intensity {}", l.name, l.kind, v(l.position), v(l.color), l.intensity)?;
     }
     outln!("cameras     {}", info.cameras.len())?;
-    for c in &info.cameras {
+    for (index, c) in info.cameras.iter().enumerate() {
         outln!(
-            "  at {} looking {}, up {}, vertical field of view {:.2}°",
+            "  [{index}] at {} looking {}, up {}, vertical field of view {:.2}°{}",
             v(c.position),
             v(c.direction),
             v(c.up),
-            c.vertical_fov_degrees
+            c.vertical_fov_degrees,
+            c.aspect.map_or(String::new(), |aspect| format!(", aspect {aspect}"))
         )?;
     }
     if !info.extensions_used.is_empty() {
-        outln!("extensions  {}", info.extensions_used.join(", "))?;
-    }
-    for e in &info.extensions_unsupported {
-        outln!("warning: extension {e} is not supported and is ignored")?;
+        // The loader has warned about the unsupported ones already.
+        let named: Vec<String> = info
+            .extensions_used
+            .iter()
+            .map(|e| if info.extensions_unsupported.contains(e) { format!("{e} (ignored)") } else { e.clone() })
+            .collect();
+        outln!("extensions  {}", named.join(", "))?;
     }
     out!("{}", info.plan)
 }

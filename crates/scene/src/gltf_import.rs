@@ -436,7 +436,17 @@ impl TextureTable {
             .map(|&(index, srgb, wrap_u, wrap_v)| {
                 let encoding = if srgb { ColorEncoding::Srgb } else { ColorEncoding::Linear };
                 let bytes = read[&index].as_ref().map_err(Clone::clone)?;
-                let name = images[index].name().map_or_else(|| format!("image {index}"), str::to_owned);
+                // The image's name where it has one, and where its pixels are,
+                // for `rtgi info` and messages.
+                let source = match images[index].source() {
+                    gltf::image::Source::Uri { uri, .. } if uri.starts_with("data:") => "a data URI".to_owned(),
+                    gltf::image::Source::Uri { uri, .. } => format!("'{uri}'"),
+                    gltf::image::Source::View { view, .. } => format!("buffer view {}", view.index()),
+                };
+                let name = match images[index].name() {
+                    Some(name) => format!("image {index} '{name}' from {source}"),
+                    None => format!("image {index} from {source}"),
+                };
                 Texture::decode(bytes, &name, encoding).map(|t| t.with_wrap(wrap_u, wrap_v))
             })
             .collect();
