@@ -99,8 +99,27 @@ pub(crate) fn run(args: &VerifyArgs) -> Result<()> {
     for (case, per_kind) in &cases {
         let rays = pool.install(|| case.rays(*per_kind, args.seed.value));
         let budget_rays = (args.linear_budget / case.triangles.len().max(1) as u64) as usize;
+        if cases.len() == 1 {
+            eprintln!(
+                "{}: {} triangles, {} rays through {} structures, the linear scan's answers for up to {budget_rays} \
+                 of each kind (--linear-budget)",
+                case.name,
+                case.triangles.len(),
+                rays.iter().map(|(_, r)| r.len()).sum::<usize>(),
+                configurations.len()
+            );
+        }
+        let mut heartbeat = Heartbeat { start, last: Instant::now() };
         pool.install(|| {
-            check_case(case, &rays, &configurations, &intersectors, budget_rays, &mut kinds, &mut structures)
+            check_case(
+                case,
+                &rays,
+                &configurations,
+                &intersectors,
+                budget_rays,
+                (&mut kinds, &mut structures),
+                &mut heartbeat,
+            )
         })?;
         eprintln!(
             "{}: {} triangles, {} rays per structure checked ({:.1} s)",
@@ -156,6 +175,24 @@ fn label(kind: AccelKind, params: &BuildParams) -> String {
     label + ")"
 }
 
+/// A progress line on standard error when a check has been quiet for a
+/// while: a large scene takes minutes, and a silent program looks hung.
+struct Heartbeat {
+    start: Instant,
+    last: Instant,
+}
+
+impl Heartbeat {
+    const QUIET: std::time::Duration = std::time::Duration::from_secs(5);
+
+    fn beat(&mut self, what: impl FnOnce() -> String) {
+        if self.last.elapsed() >= Self::QUIET {
+            eprintln!("  {} ({:.1} s)", what(), self.start.elapsed().as_secs_f64());
+            self.last = Instant::now();
+        }
+    }
+}
+
 /// Checks every configuration on one scene's rays, adding to the kind rows
 /// and the structure totals.
 fn check_case(
@@ -164,8 +201,8 @@ fn check_case(
     configurations: &[(AccelKind, BuildParams)],
     intersectors: &[Intersector],
     linear_rays: usize,
-    kinds: &mut BTreeMap<String, KindRow>,
-    structures: &mut Vec<StructureRow>,
+    (kinds, structures): (&mut BTreeMap<String, KindRow>, &mut Vec<StructureRow>),
+    heartbeat: &mut Heartbeat,
 ) -> anyhow::Result<()> {
     let add = |name: String, watertight: bool, peer: bool, tally: &Tally, structures: &mut Vec<StructureRow>| {
         match structures.iter_mut().find(|s| s.structure == name) {
@@ -180,11 +217,28 @@ fn check_case(
             configurations.iter().filter(|(_, p)| p.intersector == intersector).collect();
         let built: Vec<(AccelKind, String, Box<dyn Accel>)> = chosen
             .iter()
-            .map(|(kind, params)| Ok((*kind, label(*kind, params), kind.try_build(&case.triangles, params)?)))
+            .map(|(kind, params)| {
+                let name = label(*kind, params);
+                let accel = kind.try_build(&case.triangles, params)?;
+                heartbeat.beat(|| format!("{}: built {name}", case.name));
+                Ok((*kind, name, accel))
+            })
             .collect::<anyhow::Result<_>>()?;
         for (kind, probes) in rays {
+            let ray_kind = *kind;
             let checked = probes.len().min(linear_rays);
-            let linear_answers = Answer::all(&linear, &probes[..checked]);
+            // In chunks, for the progress line: on a large scene the scan is most of the time.
+            let mut linear_answers = Vec::with_capacity(checked);
+            for chunk in probes[..checked].chunks(4096) {
+                linear_answers.extend(Answer::all(&linear, chunk));
+                heartbeat.beat(|| {
+                    format!(
+                        "{}: {ray_kind} rays: {} of {checked} through the linear scan ({intersector})",
+                        case.name,
+                        linear_answers.len()
+                    )
+                });
+            }
             let linear_tally = Tally::of(&probes[..checked], &linear_answers, None);
             add(format!("linear ({intersector})"), watertight, false, &linear_tally, structures);
             // The reference: the linear scan where it answered, else the
@@ -204,6 +258,7 @@ fn check_case(
             for (kind, name, accel) in &built {
                 let tally = Tally::of(probes, &Answer::all(accel.as_ref(), probes), Some(&reference));
                 add(name.clone(), watertight, kind.is_peer(), &tally, structures);
+                heartbeat.beat(|| format!("{}: {ray_kind} rays: {} through {name}", case.name, probes.len()));
                 if kind.is_peer() {
                     row.peers.get_or_insert_with(Tally::default).add(&Tally { rays: 0, compared: 0, ..tally });
                     continue;
