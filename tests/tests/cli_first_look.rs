@@ -139,3 +139,52 @@ fn parse_errors_are_one_line_made_from_clap_s_error_kinds() {
         assert_eq!(run.stderr.trim(), expected, "{args:?}");
     }
 }
+
+#[test]
+fn a_file_that_is_not_an_obj_is_refused_naming_its_first_line() {
+    let dir = scratch_dir("not-obj");
+    let scene = dir.join("x.obj");
+    std::fs::write(&scene, "x\n").unwrap();
+    let out = dir.join("x.png");
+    let run = rtgi(&["render", path_str(&scene), "-o", path_str(&out), "--quick"]);
+    assert!(!run.success && run.code == Some(1), "{run:?}");
+    assert!(run.stderr.contains("x.obj: not a valid OBJ file: no faces"), "{run:?}");
+    assert!(run.stderr.contains("line 1: 'x' is not an OBJ statement"), "{run:?}");
+    assert!(!out.exists());
+}
+
+#[test]
+fn an_output_folder_that_does_not_exist_is_named_as_such() {
+    let dir = scratch_dir("missing-output-folder");
+    let out = dir.join("no-such-folder").join("x.png");
+    let run = rtgi(&["render", ROOM, "-o", path_str(&out), "--quick"]);
+    assert!(!run.success, "{run:?}");
+    assert!(run.stderr.contains("no-such-folder does not exist"), "{run:?}");
+    // Not a complaint about the format: the name ends in .png.
+    assert!(!run.stderr.contains(".exr"), "{run:?}");
+}
+
+/// `rtgi info` on the shared glTF samples: cameras and textures with their
+/// index, textures with the file they came from, and an unsupported
+/// extension warned about once.
+#[test]
+fn info_numbers_cameras_and_names_texture_files() {
+    let (Some(helmet), Some(cameras), Some(transmission)) = (
+        rtgi_tests::shared_scene("gltf/DamagedHelmet/glTF/DamagedHelmet.gltf"),
+        rtgi_tests::shared_scene("gltf/Cameras/glTF/Cameras.gltf"),
+        rtgi_tests::shared_scene("gltf/TransmissionTest/glTF/TransmissionTest.gltf"),
+    ) else {
+        return; // shared_scene said which is missing
+    };
+    let run = rtgi(&["info", path_str(&helmet)]);
+    assert!(run.success, "{run:?}");
+    assert!(run.stdout.contains("  [0] image 0 from 'Default_albedo.jpg' (2048x2048)"), "{}", run.stdout);
+    let run = rtgi(&["info", path_str(&cameras)]);
+    assert!(run.success, "{run:?}");
+    assert!(run.stdout.contains("  [0] at (0.5, 0.5, 3)"), "{}", run.stdout);
+    let run = rtgi(&["info", path_str(&transmission)]);
+    assert!(run.success, "{run:?}");
+    let said = format!("{}{}", run.stdout, run.stderr);
+    assert_eq!(said.matches("KHR_xmp is not supported").count(), 1, "{said}");
+    assert!(run.stdout.contains("KHR_xmp (ignored)"), "{}", run.stdout);
+}
