@@ -15,6 +15,7 @@ use crate::bsdf::Bsdf;
 use crate::effects::{Effect, EffectPlan, is_glossy, transmits};
 use crate::lights::{Environment, LightSet};
 use crate::shade::{alpha_accepts, closest_hit};
+use crate::shading_normal::bent_towards_view;
 use crate::{EffectSet, PathStart, RenderSettings};
 
 /// What the renderer computes for each pixel.
@@ -311,7 +312,7 @@ impl<'a, A: Accel + ?Sized> Transport<'a, A> {
             if depth == self.max_depth {
                 break;
             }
-            let interaction = self.interact::<S>(&hit, triangle, material, u[dim::LOBE]);
+            let interaction = self.interact::<S>(&hit, triangle, material, wo, u[dim::LOBE]);
             let (frame, bsdf) = (&interaction.frame, &interaction.bsdf);
             let wo_local = frame.to_local(wo);
             let reflects_only = !matches!(
@@ -408,7 +409,14 @@ impl<'a, A: Accel + ?Sized> Transport<'a, A> {
     }
 
     /// The shading frame and BSDF at a hit.
-    fn interact<const S: u16>(&self, hit: &Hit, triangle: &Triangle, material: &Material, u_lobe: f32) -> Interaction {
+    fn interact<const S: u16>(
+        &self,
+        hit: &Hit,
+        triangle: &Triangle,
+        material: &Material,
+        wo: Vec3,
+        u_lobe: f32,
+    ) -> Interaction {
         let scene = self.scene;
         let corners = triangle.vertices.map(|v| scene.vertices[v as usize].position);
         let point =
@@ -448,6 +456,11 @@ impl<'a, A: Accel + ?Sized> Transport<'a, A> {
         }
         if !normal.is_finite() {
             normal = point.normal;
+        }
+        // A viewer in front of the true surface must not be behind the
+        // shading normal (black fringes along smooth silhouettes).
+        if wo.dot(point.normal) > 0.0 {
+            normal = bent_towards_view(normal, point.normal, wo);
         }
         let surface = SurfaceValues { base_color, roughness, metallic, transmission };
         let (bsdf, weight) = self.choose_bsdf::<S>(material, &surface, u_lobe);

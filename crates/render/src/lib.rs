@@ -45,6 +45,7 @@ pub mod rays;
 pub mod recipe;
 mod sampler;
 mod shade;
+mod shading_normal;
 
 pub use accumulation::{Accumulation, FIXED_POINT_BITS, MergeError, PartSpan, PixelSum, SAMPLE_LIMIT};
 pub use accumulation_file::{AccumulationFileError, MergeFilesError};
