@@ -102,8 +102,12 @@ impl LightingArgs {
     }
 }
 
-/// Warns that a camera from the file or the options seems to be inside geometry.
-pub(crate) fn warn_if_blocked(chosen: &ChosenCamera) {
+/// Says which of several file cameras was used, and warns that a camera
+/// from the file or the options seems to be inside geometry.
+pub(crate) fn report_camera(chosen: &ChosenCamera) {
+    if let Some(choice) = &chosen.file_choice {
+        eprintln!("note: the view is {choice}");
+    }
     if let Some(fraction) = chosen.blocked {
         eprintln!(
             "warning: the camera seems to be inside geometry: {:.0}% of the rays through its view hit the back of a \
@@ -118,7 +122,7 @@ pub(crate) fn warn_if_blocked(chosen: &ChosenCamera) {
 /// when a given camera seems buried.
 pub(crate) fn choose_camera(scene: &Scene, accel: &dyn Accel, options: &CameraArgs, aspect: f32) -> Result<Camera> {
     let chosen = recipe::choose_camera(scene, accel, &options.choice(), aspect)?;
-    warn_if_blocked(&chosen);
+    report_camera(&chosen);
     Ok(chosen.camera)
 }
 
@@ -142,7 +146,7 @@ pub(crate) fn prepare_render(
     apply_lighting(lighting, scene, settings)?;
     let built = pool.install(|| accel.build(scene))?;
     let prepared = recipe::prepare(scene, built.as_ref(), settings, &camera.choice())?;
-    warn_if_blocked(&prepared.camera);
+    report_camera(&prepared.camera);
     Ok((built, prepared))
 }
 

@@ -32,6 +32,7 @@ mod accumulation;
 mod accumulation_file;
 pub mod bsdf;
 mod camera;
+pub mod camera_choice;
 mod default_lighting;
 mod distribution;
 mod effect_set;

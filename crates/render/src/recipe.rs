@@ -12,9 +12,10 @@ use rtgi_image::{HdrImage, ToneMap, ToneOperator, auto_exposure};
 use rtgi_math::Vec3;
 use rtgi_scene::{Camera, Light, Scene};
 
+use crate::camera_choice::{ViewScore, best_file_camera, score_view, surface_points};
 use crate::{
     DEFAULT_VERTICAL_FOV_DEGREES, DirectStrategy, ENCLOSED, EffectOverrides, EffectPlan, EnvironmentSpec, Integrator,
-    PixelSampler, RenderSettings, camera_blocked, default_camera, frame_scene, room_light, sky_visibility,
+    PixelSampler, RenderSettings, camera_blocked, frame_scene, room_light, sky_visibility,
 };
 
 /// Why a render cannot be prepared; the messages name the option.
@@ -55,11 +56,61 @@ pub struct CameraChoice {
     pub fov_degrees: Option<f32>,
 }
 
+/// Which of several file cameras was taken, and why, for the user to read.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum FileCameraChoice {
+    /// The file's camera that sees most of the model.
+    SeesMost {
+        /// Its index among the file's cameras.
+        index: usize,
+        /// How many cameras the file has.
+        count: usize,
+        /// What it sees.
+        score: ViewScore,
+    },
+    /// None of the file's cameras holds the whole model in its frame, and
+    /// the automatic view sees more of it than the best of them.
+    Automatic {
+        /// How many cameras the file has.
+        count: usize,
+        /// The file camera that sees most.
+        best: usize,
+        /// What that camera sees.
+        best_score: ViewScore,
+        /// What the automatic view sees.
+        automatic: ViewScore,
+    },
+}
+
+impl std::fmt::Display for FileCameraChoice {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let percent = |x: f32| (100.0 * x).round();
+        match *self {
+            FileCameraChoice::SeesMost { index, count, score } => write!(
+                f,
+                "camera {index} of the file's {count} (0 to {}), the one that sees most of the model ({}% of its \
+                 surface in view); --camera N picks another",
+                count - 1,
+                percent(score.seen)
+            ),
+            FileCameraChoice::Automatic { count, best, best_score, automatic } => write!(
+                f,
+                "the automatic view: none of the file's {count} cameras holds the whole model, and the best, camera \
+                 {best}, sees {}% of its surface against the automatic view's {}%; --camera N picks one",
+                percent(best_score.seen),
+                percent(automatic.seen)
+            ),
+        }
+    }
+}
+
 /// A chosen camera, and whether it seems to be inside geometry.
 #[derive(Clone, Debug, PartialEq)]
 pub struct ChosenCamera {
     /// The camera.
     pub camera: Camera,
+    /// How the camera was picked among several in the file, when no index was given.
+    pub file_choice: Option<FileCameraChoice>,
     /// For a camera from the file or the options: the fraction of its rays
     /// that meet the back of a surface or start against one, when that
     /// suggests it is inside geometry (the automatic framing avoids such views).
@@ -73,11 +124,27 @@ pub fn choose_camera(
     choice: &CameraChoice,
     aspect: f32,
 ) -> Result<ChosenCamera, RecipeError> {
+    let mut file_choice = None;
     let chosen = match choice.index {
         Some(index) if index >= scene.cameras.len() => {
             return Err(RecipeError::CameraIndex { index, count: scene.cameras.len() });
         }
         Some(index) => scene.cameras.get(index),
+        // Several cameras: the one that sees most of the model, or the
+        // automatic view when none frames it whole and that view sees more.
+        None if scene.cameras.len() > 1 => {
+            let count = scene.cameras.len();
+            let (best, score) = best_file_camera(scene, accel, aspect).expect("the scene has cameras");
+            let automatic_view = frame_scene(scene, accel, DEFAULT_VERTICAL_FOV_DEGREES.to_radians(), aspect);
+            let automatic = score_view(accel, &automatic_view, aspect, &surface_points(scene));
+            if !score.sees_it_whole() && automatic.seen > score.seen {
+                file_choice = Some(FileCameraChoice::Automatic { count, best, best_score: score, automatic });
+                None
+            } else {
+                file_choice = Some(FileCameraChoice::SeesMost { index: best, count, score });
+                scene.cameras.get(best)
+            }
+        }
         None => scene.cameras.first(),
     };
     let fov = match choice.fov_degrees {
@@ -88,7 +155,10 @@ pub fn choose_camera(
     let automatic = chosen.is_none() && choice.at.is_none();
     let mut camera = match chosen {
         Some(camera) => *camera,
-        None if choice.fov_degrees.is_none() => default_camera(scene, accel, aspect),
+        // No camera in the file, or none worth taking: the automatic view.
+        None if choice.fov_degrees.is_none() => {
+            frame_scene(scene, accel, DEFAULT_VERTICAL_FOV_DEGREES.to_radians(), aspect)
+        }
         None => frame_scene(scene, accel, fov, aspect),
     };
     camera.vertical_fov = fov;
@@ -108,7 +178,7 @@ pub fn choose_camera(
         return Err(RecipeError::DegenerateCamera);
     }
     let blocked = if automatic { None } else { camera_blocked(scene, accel, &camera, aspect) };
-    Ok(ChosenCamera { camera, blocked })
+    Ok(ChosenCamera { camera, file_choice, blocked })
 }
 
 /// The lighting options: lights added to the scene, the integrator and its
