@@ -188,3 +188,43 @@ fn info_numbers_cameras_and_names_texture_files() {
     assert_eq!(said.matches("KHR_xmp is not supported").count(), 1, "{said}");
     assert!(run.stdout.contains("KHR_xmp (ignored)"), "{}", run.stdout);
 }
+
+/// A glTF triangle (0,0,0), (1,0,0), (0,1,0) with two perspective cameras
+/// of aspect ratio 1.5 at z = 3: the first turned away, the second facing it.
+fn two_camera_gltf(dir: &Path) -> std::path::PathBuf {
+    use base64::Engine as _;
+    let bytes: Vec<u8> =
+        [0.0f32, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0].iter().flat_map(|f| f.to_le_bytes()).collect();
+    let data = base64::engine::general_purpose::STANDARD.encode(bytes);
+    let text = format!(
+        r#"{{"asset":{{"version":"2.0"}},"scene":0,"scenes":[{{"nodes":[0,1,2]}}],
+        "nodes":[{{"mesh":0}},
+                 {{"camera":0,"translation":[0.3,0.3,3],"rotation":[0,1,0,0]}},
+                 {{"camera":0,"translation":[0.3,0.3,3]}}],
+        "cameras":[{{"type":"perspective","perspective":{{"aspectRatio":1.5,"yfov":0.7,"znear":0.01}}}}],
+        "meshes":[{{"primitives":[{{"attributes":{{"POSITION":0}}}}]}}],
+        "buffers":[{{"uri":"data:application/octet-stream;base64,{data}","byteLength":36}}],
+        "bufferViews":[{{"buffer":0,"byteOffset":0,"byteLength":36}}],
+        "accessors":[{{"bufferView":0,"componentType":5126,"count":3,"type":"VEC3","max":[1,1,0],"min":[0,0,0]}}]}}"#
+    );
+    let path = dir.join("two-cameras.gltf");
+    std::fs::write(&path, text).unwrap();
+    path
+}
+
+#[test]
+fn of_two_file_cameras_the_one_that_sees_the_model_is_used_at_its_aspect_ratio() {
+    let dir = scratch_dir("two-cameras");
+    let scene = two_camera_gltf(&dir);
+    let out = dir.join("two.png");
+    let run = rtgi(&["render", path_str(&scene), "-o", path_str(&out), "--spp", "1"]);
+    assert!(run.success, "{run:?}");
+    // (The loader numbers the cameras in its own order of the nodes.)
+    assert!(run.stderr.contains("of the file's 2 (0 to 1), the one that sees most of the model (100% of"), "{run:?}");
+    // 512 wide, as tall as the camera's aspect ratio of 1.5 asks.
+    assert_eq!(image::image_dimensions(&out).unwrap(), (512, 341));
+    // A size given wins; an index given needs no note.
+    let run = rtgi(&["render", path_str(&scene), "-o", path_str(&out), "--spp", "1", "--camera", "0", "--width", "64"]);
+    assert!(run.success && !run.stderr.contains("note: the view is"), "{run:?}");
+    assert_eq!(image::image_dimensions(&out).unwrap(), (64, 512));
+}

@@ -582,9 +582,9 @@ impl RenderArgs {
     pub(crate) fn resolution(&self) -> (u32, u32, u32) {
         let spp = self.spp.unwrap_or(if self.lighting.integrator.simulates_light() { 16 } else { 1 });
         if self.quick {
-            ((self.size.width / 4).max(16), (self.size.height / 4).max(16), spp.min(4))
+            ((self.size.width() / 4).max(16), (self.size.height() / 4).max(16), spp.min(4))
         } else {
-            (self.size.width, self.size.height, spp)
+            (self.size.width(), self.size.height(), spp)
         }
     }
 }
@@ -659,17 +659,43 @@ impl OutputArgs {
 /// The size of an image in pixels.
 #[derive(Debug, Args)]
 pub(crate) struct ImageSize {
-    #[arg(long, default_value_t = 512, value_parser = clap::value_parser!(u32).range(1..=MAX_IMAGE_SIDE as i64))]
-    pub(crate) width: u32,
+    /// Width in pixels [default: 512, or to match the aspect ratio of a camera from the scene file that has one]
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=MAX_IMAGE_SIDE as i64))]
+    width: Option<u32>,
 
-    #[arg(long, default_value_t = 512, value_parser = clap::value_parser!(u32).range(1..=MAX_IMAGE_SIDE as i64))]
-    pub(crate) height: u32,
+    /// Height in pixels [default: 512, or to match the aspect ratio of a camera from the scene file that has one]
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=MAX_IMAGE_SIDE as i64))]
+    height: Option<u32>,
 }
 
+/// The side of an image when neither --width nor --height says otherwise.
+const DEFAULT_IMAGE_SIDE: u32 = 512;
+
 impl ImageSize {
-    pub(crate) fn aspect(&self) -> f32 {
-        self.width as f32 / self.height as f32
+    pub(crate) fn width(&self) -> u32 {
+        self.width.unwrap_or(DEFAULT_IMAGE_SIDE)
     }
+
+    pub(crate) fn height(&self) -> u32 {
+        self.height.unwrap_or(DEFAULT_IMAGE_SIDE)
+    }
+
+    pub(crate) fn aspect(&self) -> f32 {
+        self.width() as f32 / self.height() as f32
+    }
+
+    /// Whether --width or --height was given.
+    pub(crate) fn given(&self) -> bool {
+        self.width.is_some() || self.height.is_some()
+    }
+}
+
+/// `width` × `height` reshaped to `aspect` (width over height), the longer
+/// side kept: how an image follows a file camera's aspect ratio.
+pub(crate) fn reshaped(width: u32, height: u32, aspect: f32) -> (u32, u32) {
+    let side = width.max(height) as f32;
+    let clamp = |x: f32| (x.round() as u32).clamp(1, MAX_IMAGE_SIDE);
+    if aspect >= 1.0 { (clamp(side), clamp(side / aspect)) } else { (clamp(side * aspect), clamp(side)) }
 }
 
 /// The acceleration structure and its build parameters.

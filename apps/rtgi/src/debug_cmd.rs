@@ -83,7 +83,7 @@ pub(crate) fn heatmap(args: &HeatmapArgs) -> Result<()> {
     let accel = pool.install(|| args.accel.build(&scene))?;
     let camera = choose_camera(&scene, accel.as_ref(), &args.camera, args.size.aspect())?;
     let (counts, total) =
-        pool.install(|| render_traversal_cost(accel.as_ref(), &camera, args.size.width, args.size.height, &|_| {}));
+        pool.install(|| render_traversal_cost(accel.as_ref(), &camera, args.size.width(), args.size.height(), &|_| {}));
 
     let channel = |p: rtgi_math::Vec3| if args.triangles { p.y } else { p.x };
     let maximum = counts.pixels().iter().map(|&p| channel(p)).fold(0.0f32, f32::max);
@@ -92,7 +92,7 @@ pub(crate) fn heatmap(args: &HeatmapArgs) -> Result<()> {
         OutputFormat::Exr => counts,
         OutputFormat::Png => {
             let pixels = counts.pixels().iter().map(|&p| heat_colour(channel(p) / scale)).collect();
-            HdrImage::from_pixels(args.size.width, args.size.height, pixels).expect("one colour per pixel")
+            HdrImage::from_pixels(args.size.width(), args.size.height(), pixels).expect("one colour per pixel")
         }
     };
     image.write(&output, &ToneMap::default())?;

@@ -45,8 +45,8 @@ pub(crate) fn run(args: &BenchEffectsArgs) -> Result<()> {
     }
     let LoadedScene { mut scene, name, .. } = load_scene(args.scene.as_deref())?;
     let mut settings = RenderSettings {
-        width: args.size.width,
-        height: args.size.height,
+        width: args.size.width(),
+        height: args.size.height(),
         samples_per_pixel: args.spp,
         sampler: rtgi_render::recipe::default_sampler(args.spp),
         ..RenderSettings::default()

@@ -7,8 +7,8 @@ use rtgi_render::{
     Accumulation, EffectPlan, EnvironmentSpec, Integrator, RenderIdentity, RenderSettings, recipe, render,
 };
 
-use crate::cli::RenderArgs;
 use crate::cli::ToneArgs;
+use crate::cli::{RenderArgs, reshaped};
 use crate::common::{LoadedScene, check_output_folder, load_scene, prepare_render, refuse_inputs_as_outputs};
 use crate::interrupt;
 use crate::output::{out, outln};
@@ -106,11 +106,16 @@ pub(crate) fn render_image(args: &RenderArgs) -> Result<Rendered> {
         background: args.background,
         ..RenderSettings::default()
     };
-    let (rows, samples) = job.share(settings.height, spp)?;
     let pool = args.threads.pool()?;
     let (accel, prepared) =
         prepare_render(&mut scene, &mut settings, &args.lighting, &args.camera, &args.accel, &pool)?;
     let (camera, room_light) = (prepared.camera.camera, prepared.room_light);
+    // A file camera's aspect ratio shapes the image unless its size was given.
+    if let Some(aspect) = camera.aspect.filter(|&a| a.is_finite() && a > 0.0 && !args.size.given()) {
+        (settings.width, settings.height) = reshaped(settings.width, settings.height, aspect);
+        check_memory(settings.width, settings.height)?;
+    }
+    let (rows, samples) = job.share(settings.height, spp)?;
 
     // What is printed goes on standard output; a reader that goes away
     // (`| head`) does not stop the render, and the first failed write is
