@@ -276,6 +276,12 @@ pub(crate) struct LightingArgs {
     /// Force effects on or off, like +glossy,-textures (see the plan `rtgi info` prints)
     #[arg(long, allow_hyphen_values = true, default_value = "")]
     pub(crate) effects: EffectOverrides,
+
+    /// Never add light the scene does not bring: no default sky and sun (for scenes without
+    /// lights, with emitters too weak to light them, or whose lights leave the view dark), and
+    /// no lamp over an enclosed, unlit room
+    #[arg(long)]
+    pub(crate) no_default_lighting: bool,
 }
 
 /// Parses a finite number that `accept` allows; the error names the

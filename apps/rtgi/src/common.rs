@@ -98,6 +98,7 @@ impl LightingArgs {
             indirect_clamp: self.clamp_indirect,
             environment: self.environment.clone(),
             effects: self.effects.clone(),
+            no_default_lighting: self.no_default_lighting,
         }
     }
 }

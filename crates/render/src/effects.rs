@@ -331,13 +331,25 @@ impl EffectPlan {
         let sky_power = default_sky_power(scene);
         let weak_emitters = emitted > 0.0 && emitted < WEAK_EMITTERS * sky_power;
         let lit_by_emitters = emitters.iter().any(|m| m.emission_texture.is_none()) && !weak_emitters;
-        let default_environment = lighting && !environment_given && lights == 0 && !lit_by_emitters;
+        let view_unlit = match settings.default_lighting {
+            crate::DefaultLighting::ViewUnlit(fraction) => Some(fraction),
+            _ => None,
+        };
+        let default_lighting_off = settings.default_lighting == crate::DefaultLighting::Off;
+        let wants_default = (lights == 0 && !lit_by_emitters) || view_unlit.is_some();
+        let default_environment = lighting && !environment_given && !default_lighting_off && wants_default;
         let environment = if !lighting {
             decide(Effect::Environment, false, not_lit())
         } else if environment_given {
             decide(Effect::Environment, true, "an environment is set".into())
         } else if default_environment {
-            let why = if weak_emitters {
+            let why = if let Some(fraction) = view_unlit {
+                format!(
+                    "the scene's own lights give the surfaces in view {:.1}% of the light a sky and sun would, too \
+                     little to see them by (--no-default-lighting keeps to the scene's own)",
+                    100.0 * fraction
+                )
+            } else if weak_emitters {
                 format!(
                     "the scene's emitters give {:.2}% of the light a sky would, too little to light it",
                     100.0 * emitted / sky_power
@@ -352,6 +364,13 @@ impl EffectPlan {
                  it; --environment or --light chooses others"
             );
             decide(Effect::Environment, true, reason)
+        } else if default_lighting_off && lighting && wants_default {
+            decide(
+                Effect::Environment,
+                false,
+                "the scene brings too little light of its own, but default lighting is off (--no-default-lighting)"
+                    .into(),
+            )
         } else {
             decide(Effect::Environment, false, "no environment is set (--environment sets one)".into())
         };

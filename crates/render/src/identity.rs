@@ -51,6 +51,7 @@ impl RenderIdentity {
             russian_roulette,
             environment,
             effects,
+            default_lighting,
         } = settings;
         let environment = match environment {
             None => "planned".to_owned(),
@@ -71,6 +72,7 @@ impl RenderIdentity {
             ("russian roulette", russian_roulette.to_string()),
             ("environment", environment),
             ("effects", format!("{effects:?}")),
+            ("default lighting", format!("{default_lighting:?}")),
         ];
         Self {
             width: *width,

@@ -47,6 +47,7 @@ pub mod recipe;
 mod sampler;
 mod shade;
 mod shading_normal;
+pub mod view_lighting;
 
 pub use accumulation::{Accumulation, FIXED_POINT_BITS, MergeError, PartSpan, PixelSum, SAMPLE_LIMIT};
 pub use accumulation_file::{AccumulationFileError, MergeFilesError};
@@ -117,6 +118,26 @@ pub struct RenderSettings {
     pub environment: Option<Environment>,
     /// Effects forced on or off, whatever the scene needs.
     pub effects: EffectOverrides,
+    /// Whether the planner may add the default sky and sun (and the lamp of
+    /// an enclosed camera), and whether a probe of the view found the
+    /// scene's own lights too weak for it.
+    pub default_lighting: DefaultLighting,
+}
+
+/// Light the planner adds to scenes that bring too little of their own.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub enum DefaultLighting {
+    /// The default sky and sun for scenes without lights or with emitters
+    /// too weak to light them (judged by their power).
+    #[default]
+    Auto,
+    /// As `Auto`, and the view was probed
+    /// ([`view_lighting::own_light_fraction`]): the scene's own lights
+    /// give the surfaces in view this fraction of the default sky and
+    /// sun's light, too little, so those are added.
+    ViewUnlit(f32),
+    /// Never: only the scene's lights and the options' light it.
+    Off,
 }
 
 impl Default for RenderSettings {
@@ -135,6 +156,7 @@ impl Default for RenderSettings {
             russian_roulette: true,
             environment: None,
             effects: EffectOverrides::default(),
+            default_lighting: DefaultLighting::Auto,
         }
     }
 }

@@ -13,9 +13,10 @@ use rtgi_math::Vec3;
 use rtgi_scene::{Camera, Light, Scene};
 
 use crate::camera_choice::{ViewScore, best_file_camera, score_view, surface_points};
+use crate::view_lighting::{UNLIT_VIEW, own_light_fraction};
 use crate::{
-    DEFAULT_VERTICAL_FOV_DEGREES, DirectStrategy, ENCLOSED, EffectOverrides, EffectPlan, EnvironmentSpec, Integrator,
-    PixelSampler, RenderSettings, camera_blocked, frame_scene, room_light, sky_visibility,
+    DEFAULT_VERTICAL_FOV_DEGREES, DefaultLighting, DirectStrategy, ENCLOSED, EffectOverrides, EffectPlan,
+    EnvironmentSpec, Integrator, PixelSampler, RenderSettings, camera_blocked, frame_scene, room_light, sky_visibility,
 };
 
 /// Why a render cannot be prepared; the messages name the option.
@@ -199,6 +200,8 @@ pub struct Lighting {
     pub environment: Option<EnvironmentSpec>,
     /// Effects forced on or off.
     pub effects: EffectOverrides,
+    /// Never add the default sky and sun, nor the lamp of an enclosed camera.
+    pub no_default_lighting: bool,
 }
 
 /// Adds `lighting`'s lights to `scene` and sets its options in `settings` (reading an environment map).
@@ -214,6 +217,9 @@ pub fn apply_lighting(
     settings.indirect_clamp = lighting.indirect_clamp;
     settings.effects = lighting.effects.clone();
     settings.environment = lighting.environment.as_ref().map(EnvironmentSpec::load).transpose()?;
+    if lighting.no_default_lighting {
+        settings.default_lighting = DefaultLighting::Off;
+    }
     Ok(())
 }
 
@@ -240,6 +246,24 @@ pub fn light_enclosed_camera(
     Some(light)
 }
 
+/// For a scene whose own lights would get no default sky, probes the view
+/// ([`own_light_fraction`]); when they leave it dark, marks the settings so
+/// that the plan adds the default sky and sun and says why.
+pub fn light_unlit_view(scene: &Scene, accel: &dyn Accel, camera: &Camera, aspect: f32, settings: &mut RenderSettings) {
+    if settings.default_lighting != DefaultLighting::Auto
+        || settings.environment.is_some()
+        || !settings.integrator.simulates_light()
+        || EffectPlan::new(scene, settings).default_environment
+    {
+        return;
+    }
+    if let Some(fraction) = own_light_fraction(scene, accel, camera, aspect)
+        && fraction < UNLIT_VIEW
+    {
+        settings.default_lighting = DefaultLighting::ViewUnlit(fraction);
+    }
+}
+
 /// A scene made ready to render: its camera, and the lamp added for an enclosed camera.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Prepared {
@@ -255,10 +279,12 @@ pub struct Prepared {
 pub fn prepare(
     scene: &mut Scene,
     accel: &dyn Accel,
-    settings: &RenderSettings,
+    settings: &mut RenderSettings,
     choice: &CameraChoice,
 ) -> Result<Prepared, RecipeError> {
-    let camera = choose_camera(scene, accel, choice, settings.width as f32 / settings.height.max(1) as f32)?;
+    let aspect = settings.width as f32 / settings.height.max(1) as f32;
+    let camera = choose_camera(scene, accel, choice, aspect)?;
+    light_unlit_view(scene, accel, &camera.camera, aspect, settings);
     let room_light = light_enclosed_camera(scene, accel, &camera.camera, settings);
     Ok(Prepared { camera, room_light })
 }

@@ -1,0 +1,65 @@
+//! Lighting judged by what reaches the view: a scene whose own lights
+//! leave the surfaces in view dark gets the default sky and sun, says why,
+//! and keeps to its own light when told to.
+
+use rtgi_accel::{AccelKind, BuildParams};
+use rtgi_render::recipe::{CameraChoice, prepare};
+use rtgi_render::{DefaultLighting, EffectPlan, RenderSettings};
+use rtgi_scene::Scene;
+
+/// A red box 4 × 1.5 × 2 with two bright lamps on its +X face, facing
+/// away from it (headlights with nothing in front of them).
+const CAR: &str = "mtllib car.mtl
+v -2 0 -1\nv 2 0 -1\nv 2 1.5 -1\nv -2 1.5 -1\nv -2 0 1\nv 2 0 1\nv 2 1.5 1\nv -2 1.5 1
+usemtl body
+f 1 4 3 2\nf 5 6 7 8\nf 1 5 8 4\nf 2 3 7 6\nf 4 8 7 3\nf 1 2 6 5
+v 2.01 0.8 0.5\nv 2.01 0.8 0.8\nv 2.01 1.1 0.8\nv 2.01 1.1 0.5
+v 2.01 0.8 -0.8\nv 2.01 0.8 -0.5\nv 2.01 1.1 -0.5\nv 2.01 1.1 -0.8
+usemtl lamp
+f 12 11 10 9\nf 16 15 14 13
+";
+const CAR_MTL: &str = "newmtl body\nKd 0.6 0.1 0.1\nnewmtl lamp\nKd 0 0 0\nKe 400 400 380\n";
+
+fn prepared(scene: &mut Scene, settings: &mut RenderSettings) -> EffectPlan {
+    let accel = AccelKind::Bvh8.build(&scene.triangle_positions(), &BuildParams::default());
+    prepare(scene, accel.as_ref(), settings, &CameraChoice::default()).unwrap();
+    EffectPlan::new(scene, settings)
+}
+
+#[test]
+fn lamps_that_light_nothing_in_view_get_the_default_sky_and_say_so() {
+    let mut scene = rtgi_scene::obj::load_from_text(CAR, CAR_MTL, "car.obj").unwrap();
+    let mut settings = RenderSettings::default();
+    let plan = prepared(&mut scene, &mut settings);
+    let DefaultLighting::ViewUnlit(fraction) = settings.default_lighting else {
+        panic!("{:?}", settings.default_lighting)
+    };
+    assert!(fraction < 0.001, "{fraction}");
+    assert!(plan.default_environment);
+    assert!(plan.to_string().contains("the scene's own lights give the surfaces in view 0.0%"), "{plan}");
+}
+
+#[test]
+fn lamps_that_light_the_view_keep_it_to_themselves() {
+    // The same lamps turned round to face the box: its front is lit.
+    let facing = CAR.replace("f 12 11 10 9\nf 16 15 14 13", "f 9 10 11 12\nf 13 14 15 16");
+    let mut scene = rtgi_scene::obj::load_from_text(&facing, CAR_MTL, "car.obj").unwrap();
+    let mut settings = RenderSettings::default();
+    let plan = prepared(&mut scene, &mut settings);
+    assert_eq!(settings.default_lighting, DefaultLighting::Auto);
+    assert!(!plan.default_environment, "{plan}");
+}
+
+#[test]
+fn no_default_lighting_keeps_to_the_scene_s_own_light() {
+    let mut scene = rtgi_scene::obj::load_from_text(CAR, CAR_MTL, "car.obj").unwrap();
+    let mut settings = RenderSettings { default_lighting: DefaultLighting::Off, ..RenderSettings::default() };
+    let plan = prepared(&mut scene, &mut settings);
+    assert_eq!(settings.default_lighting, DefaultLighting::Off);
+    assert!(!plan.default_environment, "{plan}");
+    // A scene with no light at all stays dark too, and the plan says why.
+    let mut bare = rtgi_scene::obj::load_from_text("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n", "", "t.obj").unwrap();
+    let plan = prepared(&mut bare, &mut settings);
+    assert!(!plan.default_environment);
+    assert!(plan.to_string().contains("default lighting is off (--no-default-lighting)"), "{plan}");
+}
