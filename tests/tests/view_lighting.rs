@@ -63,3 +63,44 @@ fn no_default_lighting_keeps_to_the_scene_s_own_light() {
     assert!(!plan.default_environment);
     assert!(plan.to_string().contains("default lighting is off (--no-default-lighting)"), "{plan}");
 }
+
+#[test]
+fn mirrors_under_a_point_light_get_a_dim_grey_world_to_reflect_that_the_camera_does_not_see() {
+    use rtgi_math::Vec3;
+    use rtgi_scene::{Light, LightKind};
+    // A glossy box on a matte floor under a point light.
+    let obj = "mtllib m.mtl
+v -1 0 -1\nv 1 0 -1\nv 1 1 -1\nv -1 1 -1\nv -1 0 1\nv 1 0 1\nv 1 1 1\nv -1 1 1
+usemtl shiny
+f 1 4 3 2\nf 5 6 7 8\nf 1 5 8 4\nf 2 3 7 6\nf 4 8 7 3
+v -4 0 -4\nv 4 0 -4\nv 4 0 4\nv -4 0 4
+usemtl floor
+f 9 12 11 10
+";
+    let mtl = "newmtl shiny\nKd 0.05 0.05 0.05\nKs 0.9 0.9 0.9\nNs 2000\nnewmtl floor\nKd 0.5 0.5 0.5\n";
+    let mut scene = rtgi_scene::obj::load_from_text(obj, mtl, "shiny.obj").unwrap();
+    scene.lights.push(Light {
+        name: "bulb".into(),
+        kind: LightKind::Point,
+        position: Vec3::new(2.0, 4.0, 3.0),
+        direction: Vec3::NEG_Y,
+        color: Vec3::ONE,
+        intensity: 50.0,
+        range: None,
+    });
+    let background = Vec3::new(0.05, 0.05, 0.06);
+    let mut settings =
+        RenderSettings { width: 32, height: 32, samples_per_pixel: 4, background, ..RenderSettings::default() };
+    let accel = AccelKind::Bvh8.build(&scene.triangle_positions(), &BuildParams::default());
+    let prepared = prepare(&mut scene, accel.as_ref(), &mut settings, &CameraChoice::default()).unwrap();
+    let DefaultLighting::Reflections(radiance) = settings.default_lighting else {
+        panic!("{:?}", settings.default_lighting)
+    };
+    assert!(radiance > 0.0 && radiance.is_finite(), "{radiance}");
+    let plan = EffectPlan::new(&scene, &settings);
+    assert!(plan.to_string().contains("a dim grey environment"), "{plan}");
+    // The camera sees the background where its rays miss, not the grey.
+    let (image, _) = rtgi_render::render(&scene, accel.as_ref(), &prepared.camera.camera, &settings, &|_| {});
+    let missed = (0..32).flat_map(|x| (0..32).map(move |y| (x, y))).filter(|&(x, y)| image.get(x, y) == background);
+    assert!(missed.count() > 10, "no pixel shows the background");
+}

@@ -340,6 +340,13 @@ impl EffectPlan {
         let default_environment = lighting && !environment_given && !default_lighting_off && wants_default;
         let environment = if !lighting {
             decide(Effect::Environment, false, not_lit())
+        } else if let crate::DefaultLighting::Reflections(radiance) = settings.default_lighting {
+            let reason = format!(
+                "the scene's lights are all punctual and glossy or metal surfaces would reflect black, so a dim \
+                 grey environment (radiance {radiance:.3}, a tenth of their light on the view) gives them \
+                 something to reflect; --environment or --no-default-lighting chooses otherwise"
+            );
+            decide(Effect::Environment, true, reason)
         } else if environment_given {
             decide(Effect::Environment, true, "an environment is set".into())
         } else if default_environment {

@@ -169,6 +169,9 @@ pub(crate) struct Transport<'a, A: Accel + ?Sized> {
     lights: LightSet,
     environment: Option<&'a Environment>,
     background: Vec3,
+    /// Whether camera rays that miss see the environment: not the dim one
+    /// set only for glossy surfaces to reflect ([`crate::DefaultLighting::Reflections`]).
+    environment_in_view: bool,
     max_depth: u32,
     strategy: DirectStrategy,
     indirect_clamp: Option<f32>,
@@ -227,6 +230,7 @@ impl<'a, A: Accel + ?Sized> Transport<'a, A> {
             ),
             environment,
             background: settings.background,
+            environment_in_view: !matches!(settings.default_lighting, crate::DefaultLighting::Reflections(_)),
             max_depth: plan.max_depth,
             strategy: settings.direct_strategy,
             indirect_clamp: settings.indirect_clamp,
@@ -285,7 +289,7 @@ impl<'a, A: Accel + ?Sized> Transport<'a, A> {
             };
             let Some(hit) = hit else {
                 match self.environment {
-                    Some(environment) if compiled(S, Effect::Emission) => {
+                    Some(environment) if compiled(S, Effect::Emission) && (depth > 0 || self.environment_in_view) => {
                         let direction = ray.direction.normalize();
                         let weight = self
                             .emitted_weight::<S>(previous_pdf, || self.lights.pdf_environment(environment, direction));

@@ -136,6 +136,11 @@ pub enum DefaultLighting {
     /// give the surfaces in view this fraction of the default sky and
     /// sun's light, too little, so those are added.
     ViewUnlit(f32),
+    /// As `Auto`, and the view was probed: the scene's lights are all
+    /// punctual and light it, and glossy or metal surfaces in view would
+    /// reflect black, so a dim grey environment of this radiance is set
+    /// ([`view_lighting::REFLECTED_SHARE`] of their light) for them to reflect.
+    Reflections(f32),
     /// Never: only the scene's lights and the options' light it.
     Off,
 }

@@ -13,7 +13,7 @@ use rtgi_math::Vec3;
 use rtgi_scene::{Camera, Light, Scene};
 
 use crate::camera_choice::{ViewScore, best_file_camera, score_view, surface_points};
-use crate::view_lighting::{UNLIT_VIEW, own_light_fraction};
+use crate::view_lighting::{REFLECTED_SHARE, UNLIT_VIEW, view_light};
 use crate::{
     DEFAULT_VERTICAL_FOV_DEGREES, DefaultLighting, DirectStrategy, ENCLOSED, EffectOverrides, EffectPlan,
     EnvironmentSpec, Integrator, PixelSampler, RenderSettings, camera_blocked, frame_scene, room_light, sky_visibility,
@@ -247,9 +247,17 @@ pub fn light_enclosed_camera(
 }
 
 /// For a scene whose own lights would get no default sky, probes the view
-/// ([`own_light_fraction`]); when they leave it dark, marks the settings so
-/// that the plan adds the default sky and sun and says why.
-pub fn light_unlit_view(scene: &Scene, accel: &dyn Accel, camera: &Camera, aspect: f32, settings: &mut RenderSettings) {
+/// ([`view_light`]): when they leave it dark, marks the settings so that
+/// the plan adds the default sky and sun and says why; when they light it
+/// but are all punctual and glossy or metal surfaces are in use, which
+/// would reflect black, adds a dim grey environment for them to reflect.
+pub fn judge_view_lighting(
+    scene: &Scene,
+    accel: &dyn Accel,
+    camera: &Camera,
+    aspect: f32,
+    settings: &mut RenderSettings,
+) {
     if settings.default_lighting != DefaultLighting::Auto
         || settings.environment.is_some()
         || !settings.integrator.simulates_light()
@@ -257,10 +265,29 @@ pub fn light_unlit_view(scene: &Scene, accel: &dyn Accel, camera: &Camera, aspec
     {
         return;
     }
-    if let Some(fraction) = own_light_fraction(scene, accel, camera, aspect)
+    let Some(view) = view_light(scene, accel, camera, aspect) else { return };
+    if let Some(fraction) = view.own_fraction()
         && fraction < UNLIT_VIEW
     {
         settings.default_lighting = DefaultLighting::ViewUnlit(fraction);
+        return;
+    }
+    let mut used = vec![false; scene.materials.len()];
+    for triangle in &scene.triangles {
+        used[triangle.material as usize] = true;
+    }
+    let in_use = || scene.materials.iter().zip(&used).filter(|&(_, &used)| used).map(|(m, _)| m);
+    // Emission through a texture is glowing detail, not light (as the plan judges it).
+    let emits = in_use().any(|m| m.is_emissive() && m.emission_texture.is_none());
+    // Surfaces that show their surroundings: a specular lobe, metal, or smooth.
+    let glossy = in_use().any(|m| match m.model {
+        rtgi_scene::SurfaceModel::DiffuseSpecular => m.specular.max_element() > 0.0,
+        rtgi_scene::SurfaceModel::MetallicRoughness => m.metallic >= 0.5 || m.roughness < 0.5,
+    });
+    if !scene.lights.is_empty() && !emits && glossy && view.own > 0.0 {
+        let radiance = REFLECTED_SHARE * view.own / std::f32::consts::PI;
+        settings.environment = Some(crate::Environment::Uniform(Vec3::splat(radiance)));
+        settings.default_lighting = DefaultLighting::Reflections(radiance);
     }
 }
 
@@ -284,7 +311,7 @@ pub fn prepare(
 ) -> Result<Prepared, RecipeError> {
     let aspect = settings.width as f32 / settings.height.max(1) as f32;
     let camera = choose_camera(scene, accel, choice, aspect)?;
-    light_unlit_view(scene, accel, &camera.camera, aspect, settings);
+    judge_view_lighting(scene, accel, &camera.camera, aspect, settings);
     let room_light = light_enclosed_camera(scene, accel, &camera.camera, settings);
     Ok(Prepared { camera, room_light })
 }

@@ -19,23 +19,43 @@ use crate::{CameraRays, default_sky, default_sun};
 /// surfaces in view, the scene's own lights leave the view dark.
 pub const UNLIT_VIEW: f32 = 0.02;
 
+/// The irradiance a dim grey environment brings, as a share of the scene's
+/// own lights' on the surfaces in view: enough for metals and glossy
+/// surfaces to show a reflection, too little to change how the scene is lit.
+pub const REFLECTED_SHARE: f32 = 0.1;
+
 /// Probe rays per side of the view, and light samples per surface point.
 const PROBES_PER_SIDE: u32 = 16;
 const LIGHT_SAMPLES: u32 = 8;
 
-/// The irradiance that the scene's own lights and emitters bring to the
-/// surfaces `camera` sees, as a fraction of what the default sky and sun
-/// would bring them (luminance, summed over the probe points). `None` when
-/// the view shows no surface or no sky would reach it (an enclosed room,
-/// where a sky would not help).
-pub fn own_light_fraction<A: Accel + ?Sized>(scene: &Scene, accel: &A, camera: &Camera, aspect: f32) -> Option<f32> {
+/// The light on the surfaces a view shows: the mean irradiance (luminance)
+/// that the scene's own lights and emitters bring them, and that the
+/// default sky and sun would.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ViewLight {
+    /// From the scene's own lights and emitters.
+    pub own: f32,
+    /// From the default sky and sun; zero where no sky reaches (an enclosed room).
+    pub sky: f32,
+}
+
+impl ViewLight {
+    /// The scene's own light as a fraction of the sky's, where a sky would reach.
+    pub fn own_fraction(&self) -> Option<f32> {
+        (self.sky > 0.0).then(|| self.own / self.sky)
+    }
+}
+
+/// The light on the surfaces `camera` sees ([`ViewLight`]); `None` when
+/// the view shows no surface.
+pub fn view_light<A: Accel + ?Sized>(scene: &Scene, accel: &A, camera: &Camera, aspect: f32) -> Option<ViewLight> {
     let own = LightSet::new(scene, &[], true, None);
     let sky_environment = default_sky();
     let sky = LightSet::new(scene, std::slice::from_ref(&default_sun()), false, Some(sky_environment));
     let width = ((PROBES_PER_SIDE as f32 * aspect).round() as u32).clamp(1, 4 * PROBES_PER_SIDE);
     let rays = CameraRays::new(camera, width, PROBES_PER_SIDE);
     let mut rng = Rng::new(0x0176_4b17, 0);
-    let (mut own_total, mut sky_total) = (0.0f64, 0.0f64);
+    let (mut own_total, mut sky_total, mut samples) = (0.0f64, 0.0f64, 0u32);
     for y in 0..PROBES_PER_SIDE {
         for x in 0..width {
             let ray = rays.ray(x, y, Vec2::splat(0.5));
@@ -58,8 +78,10 @@ pub fn own_light_fraction<A: Accel + ?Sized>(scene: &Scene, accel: &A, camera: &
                 };
                 own_total += irradiance(&own, None);
                 sky_total += irradiance(&sky, Some(sky_environment));
+                samples += 1;
             }
         }
     }
-    (sky_total > 0.0 && own_total.is_finite()).then(|| (own_total / sky_total) as f32)
+    let mean = |total: f64| (total / f64::from(samples)) as f32;
+    (samples > 0 && own_total.is_finite()).then(|| ViewLight { own: mean(own_total), sky: mean(sky_total) })
 }
