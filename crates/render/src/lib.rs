@@ -132,7 +132,7 @@ pub enum DefaultLighting {
     #[default]
     Auto,
     /// As `Auto`, and the view was probed
-    /// ([`view_lighting::own_light_fraction`]): the scene's own lights
+    /// ([`view_lighting::view_light`]): the scene's own lights
     /// give the surfaces in view this fraction of the default sky and
     /// sun's light, too little, so those are added.
     ViewUnlit(f32),
