@@ -70,9 +70,8 @@ pub(crate) fn check_output_folder(path: &Path) -> Result<()> {
     if path.is_dir() {
         bail!("{}: is a directory", path.display());
     }
-    if let Some(folder) = path.parent().filter(|folder| !folder.as_os_str().is_empty() && !folder.is_dir()) {
-        let what = if folder.exists() { "is not a folder" } else { "does not exist" };
-        bail!("{}: cannot write: {} {what}", path.display(), folder.display());
+    if let Some(why) = rtgi_image::unusable_folder(path) {
+        bail!("{}: cannot write: {why}", path.display());
     }
     let probe = beside(path, "probe");
     std::fs::File::create(&probe).with_context(|| format!("{}: cannot write", path.display()))?;

@@ -99,13 +99,13 @@ pub(crate) fn run(args: &VerifyArgs) -> Result<()> {
     for (case, per_kind) in &cases {
         let rays = pool.install(|| case.rays(*per_kind, args.seed.value));
         let budget_rays = (args.linear_budget / case.triangles.len().max(1) as u64) as usize;
+        let ray_count: usize = rays.iter().map(|(_, r)| r.len()).sum();
         if cases.len() == 1 {
             eprintln!(
-                "{}: {} triangles, {} rays through {} structures, the linear scan's answers for up to {budget_rays} \
-                 of each kind (--linear-budget)",
+                "{}: {} triangles, {ray_count} rays through {} structures, the linear scan's answers for up to \
+                 {budget_rays} of each kind (--linear-budget)",
                 case.name,
                 case.triangles.len(),
-                rays.iter().map(|(_, r)| r.len()).sum::<usize>(),
                 configurations.len()
             );
         }
@@ -125,7 +125,7 @@ pub(crate) fn run(args: &VerifyArgs) -> Result<()> {
             "{}: {} triangles, {} rays per structure checked ({:.1} s)",
             case.name,
             case.triangles.len(),
-            rays.iter().map(|(_, r)| r.len()).sum::<usize>(),
+            ray_count,
             start.elapsed().as_secs_f64()
         );
     }

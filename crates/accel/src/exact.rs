@@ -83,6 +83,15 @@ impl Expansion {
         self.len = kept;
     }
 
+    /// The expansion of the sum of `terms` (at most [`MOST_TERMS`]).
+    fn of(terms: &[f64]) -> Expansion {
+        let mut sum = Expansion::new();
+        for &term in terms {
+            sum.grow(term);
+        }
+        sum
+    }
+
     /// The sign of the exact sum: its largest term's (the others sum to
     /// less than half its unit in the last place).
     fn sign(&self) -> i32 {
@@ -198,22 +207,14 @@ fn swept_sign(p: Vec3A, q: Vec3A, origin: Vec3A, direction: Vec3A) -> i32 {
             return 0;
         }
     }
-    let mut sum = Expansion::new();
-    for &term in terms.iter() {
-        sum.grow(term);
-    }
-    sum.sign()
+    Expansion::of(terms).sign()
 }
 
 /// [`edge_sign`] by the exact sum alone (Shewchuk's expansion).
 #[cfg(test)]
 fn expansion_sign(p: Vec3A, q: Vec3A, origin: Vec3A, direction: Vec3A) -> i32 {
     let (terms, len) = product_terms(p, q, origin, direction);
-    let mut sum = Expansion::new();
-    for &term in &terms[..len] {
-        sum.grow(term);
-    }
-    sum.sign()
+    Expansion::of(&terms[..len]).sign()
 }
 
 #[cfg(test)]

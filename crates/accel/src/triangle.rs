@@ -335,7 +335,8 @@ fn exact_hit(
     if certain.contains(&1) && certain.contains(&-1) {
         return None;
     }
-    let [a, b, c] = v.map(|corner| corner.as_dvec3());
+    let corners = v.map(|corner| corner.as_dvec3());
+    let [a, b, c] = corners;
     let (origin, direction) = (o.as_dvec3(), d.as_dvec3());
     let normal = (b - a).cross(c - a);
     let along = direction.dot(normal);
@@ -348,7 +349,7 @@ fn exact_hit(
     }
     let mut signs = certain;
     for (i, &(p, q)) in edges.iter().enumerate() {
-        if uvw[i].abs() > bound {
+        if certain[i] != 0 {
             continue;
         }
         signs[i] = exact::edge_sign(v[p], v[q], o, d);
@@ -364,7 +365,7 @@ fn exact_hit(
     // (the signed volumes over the ray), zero where the sign is.
     let weights: [f64; 3] = std::array::from_fn(|i| {
         let (p, q) = edges[i];
-        let (p, q) = (v[p].as_dvec3() - origin, v[q].as_dvec3() - origin);
+        let (p, q) = (corners[p] - origin, corners[q] - origin);
         if signs[i] == 0 { 0.0 } else { (p.cross(q).dot(direction) * facing).max(0.0) }
     });
     let total = weights[0] + weights[1] + weights[2];

@@ -43,6 +43,15 @@ fn temporary_file() -> tempfile::Builder<'static, 'static> {
     builder
 }
 
+/// Why the folder of `path` cannot take a new file, when it does not exist
+/// or is not a folder ("…/dir does not exist"): checked before a long
+/// render, so the message names the folder rather than the file.
+pub fn unusable_folder(path: &Path) -> Option<String> {
+    let folder = path.parent().filter(|folder| !folder.as_os_str().is_empty() && !folder.is_dir())?;
+    let what = if folder.exists() { "is not a folder" } else { "does not exist" };
+    Some(format!("{} {what}", folder.display()))
+}
+
 /// [`write_atomically_with`] for bytes already in memory.
 pub fn write_atomically(path: &Path, bytes: &[u8]) -> io::Result<()> {
     write_atomically_with(path, |out| out.write_all(bytes))

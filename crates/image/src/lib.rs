@@ -31,7 +31,7 @@ mod exposure;
 mod tonemap;
 mod write;
 
-pub use atomic::{write_atomically, write_atomically_with};
+pub use atomic::{unusable_folder, write_atomically, write_atomically_with};
 pub use compare::{Difference, compare};
 pub use exposure::{Legibility, auto_exposure, legibility};
 pub use tonemap::{ToneMap, ToneOperator, heat_colour, linear_to_srgb, srgb_to_linear};

@@ -146,11 +146,10 @@ pub fn check_writable(path: &Path) -> Result<OutputFormat, ImageError> {
             source: std::io::Error::new(std::io::ErrorKind::IsADirectory, "is a directory"),
         });
     }
-    if let Some(folder) = path.parent().filter(|folder| !folder.as_os_str().is_empty() && !folder.is_dir()) {
-        let what = if folder.exists() { "is not a folder" } else { "does not exist" };
+    if let Some(why) = crate::unusable_folder(path) {
         return Err(ImageError::Io {
             path: path.to_owned(),
-            source: std::io::Error::new(std::io::ErrorKind::NotFound, format!("{} {what}", folder.display())),
+            source: std::io::Error::new(std::io::ErrorKind::NotFound, why),
         });
     }
     let probe = temporary_path(path);

@@ -92,13 +92,18 @@ pub fn score_view<A: Accel + ?Sized>(accel: &A, camera: &Camera, aspect: f32, po
     ViewScore { in_frame: in_frame as f32 / count, seen: seen as f32 / count }
 }
 
-/// The index of the file camera that sees most of the model, and its
-/// score; `None` for a scene without cameras. Ties go to the earlier camera.
-pub fn best_file_camera<A: Accel + ?Sized>(scene: &Scene, accel: &A, aspect: f32) -> Option<(usize, ViewScore)> {
-    let points = surface_points(scene);
+/// The index of the file camera that sees most of the model's `points`
+/// ([`surface_points`]), and its score; `None` for a scene without
+/// cameras. Ties go to the earlier camera.
+pub fn best_file_camera<A: Accel + ?Sized>(
+    scene: &Scene,
+    accel: &A,
+    aspect: f32,
+    points: &[(u32, Vec3)],
+) -> Option<(usize, ViewScore)> {
     let mut best: Option<(usize, ViewScore)> = None;
     for (index, camera) in scene.cameras.iter().enumerate() {
-        let score = score_view(accel, camera, aspect, &points);
+        let score = score_view(accel, camera, aspect, points);
         if best.is_none_or(|(_, most)| score.seen > most.seen) {
             best = Some((index, score));
         }

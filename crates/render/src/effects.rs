@@ -208,6 +208,27 @@ fn count(n: usize, what: &str) -> String {
     format!("{n} {what}{}", if n == 1 { "" } else { "s" })
 }
 
+/// The materials that some triangle uses: an unused material needs nothing.
+pub(crate) fn materials_in_use(scene: &Scene) -> Vec<&Material> {
+    let mut used = vec![false; scene.materials.len()];
+    for t in &scene.triangles {
+        if let Some(u) = used.get_mut(t.material as usize) {
+            *u = true;
+        }
+    }
+    scene.materials.iter().zip(&used).filter(|(_, u)| **u).map(|(m, _)| m).collect()
+}
+
+/// Whether a material shows its surroundings: a specular lobe, metal, or
+/// smooth (stricter than [`is_glossy`], for which every metallic-roughness
+/// material has a lobe besides diffuse).
+pub(crate) fn reflects_surroundings(m: &Material) -> bool {
+    match m.model {
+        SurfaceModel::DiffuseSpecular => m.specular.max_element() > 0.0,
+        SurfaceModel::MetallicRoughness => m.metallic >= 0.5 || m.roughness < 0.5,
+    }
+}
+
 /// Whether a material has a lobe besides diffuse reflection.
 pub(crate) fn is_glossy(m: &Material) -> bool {
     match m.model {
@@ -271,14 +292,7 @@ fn default_sky_power(scene: &Scene) -> f32 {
 impl EffectPlan {
     /// Plans a render of `scene` with `settings`.
     pub fn new(scene: &Scene, settings: &RenderSettings) -> Self {
-        // Materials that some triangle uses: an unused material needs nothing.
-        let mut used = vec![false; scene.materials.len()];
-        for t in &scene.triangles {
-            if let Some(u) = used.get_mut(t.material as usize) {
-                *u = true;
-            }
-        }
-        let used: Vec<&Material> = scene.materials.iter().zip(&used).filter(|(_, u)| **u).map(|(m, _)| m).collect();
+        let used = materials_in_use(scene);
         let with =
             |test: fn(&Material) -> bool| -> Vec<&Material> { used.iter().copied().filter(|m| test(m)).collect() };
         let lighting = settings.integrator.simulates_light();

@@ -13,6 +13,7 @@ use rtgi_math::Vec3;
 use rtgi_scene::{Camera, Light, Scene};
 
 use crate::camera_choice::{ViewScore, best_file_camera, score_view, surface_points};
+use crate::effects::{materials_in_use, reflects_surroundings};
 use crate::view_lighting::{REFLECTED_SHARE, UNLIT_VIEW, view_light};
 use crate::{
     DEFAULT_VERTICAL_FOV_DEGREES, DefaultLighting, DirectStrategy, ENCLOSED, EffectOverrides, EffectPlan,
@@ -125,7 +126,7 @@ pub fn choose_camera(
     choice: &CameraChoice,
     aspect: f32,
 ) -> Result<ChosenCamera, RecipeError> {
-    let mut file_choice = None;
+    let (mut file_choice, mut automatic_view) = (None, None);
     let chosen = match choice.index {
         Some(index) if index >= scene.cameras.len() => {
             return Err(RecipeError::CameraIndex { index, count: scene.cameras.len() });
@@ -135,15 +136,23 @@ pub fn choose_camera(
         // automatic view when none frames it whole and that view sees more.
         None if scene.cameras.len() > 1 => {
             let count = scene.cameras.len();
-            let (best, score) = best_file_camera(scene, accel, aspect).expect("the scene has cameras");
-            let automatic_view = frame_scene(scene, accel, DEFAULT_VERTICAL_FOV_DEGREES.to_radians(), aspect);
-            let automatic = score_view(accel, &automatic_view, aspect, &surface_points(scene));
-            if !score.sees_it_whole() && automatic.seen > score.seen {
-                file_choice = Some(FileCameraChoice::Automatic { count, best, best_score: score, automatic });
-                None
-            } else {
-                file_choice = Some(FileCameraChoice::SeesMost { index: best, count, score });
-                scene.cameras.get(best)
+            let points = surface_points(scene);
+            let (best, score) = best_file_camera(scene, accel, aspect, &points).expect("the scene has cameras");
+            let automatic = (!score.sees_it_whole()).then(|| {
+                let view = frame_scene(scene, accel, DEFAULT_VERTICAL_FOV_DEGREES.to_radians(), aspect);
+                let seen = score_view(accel, &view, aspect, &points);
+                (view, seen)
+            });
+            match automatic {
+                Some((view, automatic)) if automatic.seen > score.seen => {
+                    file_choice = Some(FileCameraChoice::Automatic { count, best, best_score: score, automatic });
+                    automatic_view = Some(view);
+                    None
+                }
+                _ => {
+                    file_choice = Some(FileCameraChoice::SeesMost { index: best, count, score });
+                    scene.cameras.get(best)
+                }
             }
         }
         None => scene.cameras.first(),
@@ -156,11 +165,12 @@ pub fn choose_camera(
     let automatic = chosen.is_none() && choice.at.is_none();
     let mut camera = match chosen {
         Some(camera) => *camera,
-        // No camera in the file, or none worth taking: the automatic view.
-        None if choice.fov_degrees.is_none() => {
-            frame_scene(scene, accel, DEFAULT_VERTICAL_FOV_DEGREES.to_radians(), aspect)
-        }
-        None => frame_scene(scene, accel, fov, aspect),
+        // No camera in the file, or none worth taking: the automatic view
+        // (already framed, at the default field of view, when it was
+        // compared with the file's).
+        None => automatic_view
+            .filter(|_| choice.fov_degrees.is_none())
+            .unwrap_or_else(|| frame_scene(scene, accel, fov, aspect)),
     };
     camera.vertical_fov = fov;
     if let Some(up) = choice.up {
@@ -272,18 +282,10 @@ pub fn judge_view_lighting(
         settings.default_lighting = DefaultLighting::ViewUnlit(fraction);
         return;
     }
-    let mut used = vec![false; scene.materials.len()];
-    for triangle in &scene.triangles {
-        used[triangle.material as usize] = true;
-    }
-    let in_use = || scene.materials.iter().zip(&used).filter(|&(_, &used)| used).map(|(m, _)| m);
+    let in_use = materials_in_use(scene);
     // Emission through a texture is glowing detail, not light (as the plan judges it).
-    let emits = in_use().any(|m| m.is_emissive() && m.emission_texture.is_none());
-    // Surfaces that show their surroundings: a specular lobe, metal, or smooth.
-    let glossy = in_use().any(|m| match m.model {
-        rtgi_scene::SurfaceModel::DiffuseSpecular => m.specular.max_element() > 0.0,
-        rtgi_scene::SurfaceModel::MetallicRoughness => m.metallic >= 0.5 || m.roughness < 0.5,
-    });
+    let emits = in_use.iter().any(|m| m.is_emissive() && m.emission_texture.is_none());
+    let glossy = in_use.iter().any(|m| reflects_surroundings(m));
     if !scene.lights.is_empty() && !emits && glossy && view.own > 0.0 {
         let radiance = REFLECTED_SHARE * view.own / std::f32::consts::PI;
         settings.environment = Some(crate::Environment::Uniform(Vec3::splat(radiance)));
