@@ -4,7 +4,7 @@ use std::process::ExitCode;
 
 use clap::builder::{PossibleValue, PossibleValuesParser, TypedValueParser};
 use clap::{Args, Parser, Subcommand, ValueEnum};
-use rtgi_accel::{AccelKind, BuildError, BuildParams, Intersector, Traversal};
+use rtgi_accel::{AccelKind, BuildError, BuildParams, Intersector, SahAxes, Traversal};
 use rtgi_image::ToneOperator;
 use rtgi_math::Vec3;
 use rtgi_render::{DirectStrategy, EffectOverrides, EnvironmentSpec, EnvironmentSpecError, Integrator, PixelSampler};
@@ -726,6 +726,11 @@ pub(crate) struct BuildArgs {
     #[arg(long, default_value_t = BuildParams::default().sah_bins as u32, value_parser = clap::value_parser!(u32).range(2..=256))]
     pub(crate) sah_bins: u32,
 
+    /// Axes the binned SAH build tries planes on: all three, or only the longest (the course's
+    /// SAH, with --sah-bins minus one planes)
+    #[arg(long, value_enum, default_value_t = SahAxes::All)]
+    pub(crate) sah_axes: SahAxes,
+
     /// Cost of a BVH traversal step relative to a ray/triangle test, for the SAH [default: 1; 4 for the wide BVHs]
     #[arg(long, value_parser = parse_positive, allow_negative_numbers = true)]
     pub(crate) traversal_cost: Option<f32>,
@@ -748,6 +753,7 @@ impl BuildArgs {
         BuildParams {
             max_leaf_size: self.leaf_size.map_or(defaults.max_leaf_size, |size| size as usize),
             sah_bins: self.sah_bins as usize,
+            sah_axes: self.sah_axes,
             traversal_cost: self.traversal_cost.unwrap_or(defaults.traversal_cost),
             intersector: self.intersector,
             traversal: self.traversal,

@@ -29,6 +29,30 @@ pub enum AccelKind {
     Embree,
 }
 
+/// The axes on which the binned SAH build places its candidate planes.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
+pub enum SahAxes {
+    /// All three axes, at every bin border: the best split the bins allow.
+    #[default]
+    All,
+    /// Only the longest axis of the node's centroids, at every bin border
+    /// (`sah_bins - 1` evenly spaced planes), with no exhaustive sweep of
+    /// small nodes: the SAH as taught in the course this toolkit comes
+    /// from (`bbvh sah N`), cheaper to build and worse to trace.
+    Longest,
+}
+
+impl SahAxes {
+    /// The name on command lines and in reports (`all`, `longest`).
+    pub fn name(self) -> &'static str {
+        match self {
+            SahAxes::All => "all",
+            SahAxes::Longest => "longest",
+        }
+    }
+}
+
 /// Parameters of a build; structures ignore those that do not apply to them.
 #[derive(Clone, Debug, PartialEq)]
 pub struct BuildParams {
@@ -36,6 +60,8 @@ pub struct BuildParams {
     pub max_leaf_size: usize,
     /// Bins per axis of the binned SAH build (2 to 256).
     pub sah_bins: usize,
+    /// Which axes the binned SAH build tries splits on.
+    pub sah_axes: SahAxes,
     /// Cost of a traversal step relative to one ray/triangle test, for the SAH.
     pub traversal_cost: f32,
     /// The ray/triangle test every query uses.
@@ -49,6 +75,7 @@ impl Default for BuildParams {
         Self {
             max_leaf_size: 4,
             sah_bins: 16,
+            sah_axes: SahAxes::All,
             traversal_cost: 1.0,
             intersector: Intersector::default(),
             traversal: Traversal::default(),
@@ -246,6 +273,10 @@ impl AccelKind {
                     for sah_bins in [2, 32] {
                         configurations.push((kind, BuildParams { sah_bins, ..base.clone() }));
                     }
+                    // The course's SAH: a few planes on the longest axis, leaves of one.
+                    let course =
+                        BuildParams { sah_bins: 5, sah_axes: SahAxes::Longest, max_leaf_size: 1, ..base.clone() };
+                    configurations.push((kind, course));
                 }
             }
         }

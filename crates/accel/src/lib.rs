@@ -119,7 +119,7 @@ pub use counters::{Counter, NoCounter, TraversalCounters};
 #[cfg(feature = "embree")]
 pub use embree::{EmbreeBackend, EmbreeError};
 pub use indexed_mesh::{IndexedMesh, IndexedMeshError};
-pub use kind::{AccelKind, BuildError, BuildParams};
+pub use kind::{AccelKind, BuildError, BuildParams, SahAxes};
 pub use linear::LinearScan;
 pub use primitive::{Primitive, PrimitiveHit, intersect_primitive};
 pub use triangle::{Intersector, TriangleHit};

@@ -120,6 +120,7 @@ fn build_over<R: BuildRef>(mut prims: Vec<R>, method: SplitMethod, params: &Buil
         method,
         max_leaf_size: params.max_leaf_size.max(1),
         sah_bins: params.sah_bins.clamp(2, 256),
+        sah_axes: params.sah_axes,
         traversal_cost: params.traversal_cost.max(0.0),
     };
     let mut slots = vec![Slot::default(); 2 * n - 1];

@@ -7,6 +7,7 @@ use rtgi_math::Vec3A;
 
 use super::median::{by_centroid, object_median};
 use super::split::{BuildRef, Context, RangeBounds, Split};
+use crate::SahAxes;
 use crate::boxa::BoxA;
 
 /// Decides between the best split found (its summed `A · N` over both
@@ -82,7 +83,7 @@ impl Binning {
 /// at bin borders. The children's bounds are gathered while partitioning,
 /// so no extra pass measures them.
 pub(crate) fn binned<R: BuildRef>(ctx: &Context, prims: &mut [R], range: &RangeBounds) -> Option<Split> {
-    if prims.len() <= SMALL_RANGE {
+    if prims.len() <= SMALL_RANGE && ctx.sah_axes == SahAxes::All {
         return small(ctx, prims, range);
     }
     let bins = ctx.sah_bins.min(prims.len()).max(2);
@@ -124,7 +125,11 @@ fn binned_core<R: BuildRef>(
     let origin = range.centroids.min;
     let extent = range.centroids.max - origin;
     // Slightly less than bins / extent, so that the largest centroid lands in the last bin.
-    let usable = extent.cmpgt(Vec3A::ZERO) & extent.is_finite_mask();
+    let mut usable = extent.cmpgt(Vec3A::ZERO) & extent.is_finite_mask();
+    if ctx.sah_axes == SahAxes::Longest {
+        let longest = Vec3A::select(usable, extent, Vec3A::ZERO).max_position();
+        usable &= Vec3A::AXES[longest].cmpgt(Vec3A::ZERO);
+    }
     let scale = Vec3A::select(usable, Vec3A::splat(bins as f32 * (1.0 - 1e-6)) / extent, Vec3A::ZERO);
     let binning = Binning { origin, scale, last: bins as u32 - 1 };
 
@@ -292,4 +297,38 @@ pub(crate) fn sweep<R: BuildRef>(ctx: &Context, prims: &mut [R], range: &RangeBo
     let (_, axis, left_count) = best;
     prims.copy_from_slice(&sorted[axis]);
     Some(Split::measured(prims, left_count))
+}
+
+#[cfg(test)]
+mod tests {
+    use rtgi_math::Vec3;
+
+    use crate::{BuildParams, Bvh, SahAxes, SplitMethod};
+
+    /// Two rows of small triangles, long along x and far apart along y:
+    /// the SAH over all axes separates the rows (a split along y), the
+    /// course's SAH may only cut the longest axis, x.
+    #[test]
+    fn longest_axis_only_splits_the_longest_axis() {
+        let mut triangles = Vec::new();
+        for row in [0.0f32, 6.0] {
+            for i in 0..64 {
+                let corner = Vec3::new(i as f32 * 0.25, row, 0.0);
+                triangles.push([corner, corner + Vec3::new(0.1, 0.0, 0.0), corner + Vec3::new(0.0, 0.1, 0.0)]);
+            }
+        }
+        let children = |sah_axes| {
+            let params = BuildParams { sah_bins: 8, sah_axes, ..BuildParams::default() };
+            let boxes = Bvh::new(&triangles, SplitMethod::BinnedSah, &params).boxes_at_depths(&[1]);
+            assert_eq!(boxes.len(), 2);
+            (boxes[0].1, boxes[1].1)
+        };
+        let apart = |(a, b): (rtgi_math::Aabb, rtgi_math::Aabb), axis: usize| {
+            a.max[axis] < b.min[axis] || b.max[axis] < a.min[axis]
+        };
+        let all = children(SahAxes::All);
+        assert!(apart(all, 1) && !apart(all, 0), "all axes: the rows are split apart ({all:?})");
+        let longest = children(SahAxes::Longest);
+        assert!(apart(longest, 0) && !apart(longest, 1), "longest axis: x is cut ({longest:?})");
+    }
 }

@@ -120,6 +120,7 @@ pub(crate) struct Context {
     pub(crate) method: SplitMethod,
     pub(crate) max_leaf_size: usize,
     pub(crate) sah_bins: usize,
+    pub(crate) sah_axes: crate::SahAxes,
     pub(crate) traversal_cost: f32,
 }
 
