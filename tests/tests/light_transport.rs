@@ -9,8 +9,8 @@ use rtgi_accel::{AccelKind, BuildParams};
 use rtgi_image::HdrImage;
 use rtgi_math::{Vec2, Vec3};
 use rtgi_render::{
-    CameraRays, DirectStrategy, Effect, EffectOverrides, EffectPlan, EffectSet, Environment, Integrator, PixelSampler,
-    RenderSettings, render,
+    BounceSampling, CameraRays, DirectStrategy, Effect, EffectOverrides, EffectPlan, EffectSet, Environment,
+    Integrator, PixelSampler, ROULETTE_START, RenderSettings, render,
 };
 use rtgi_scene::{Camera, Light, LightKind, Material, MeshBuilder, Scene, SurfaceModel};
 
@@ -44,7 +44,17 @@ fn white_furnace_converges_to_emission_over_one_minus_albedo() {
     };
     let scene = sphere_scene(wall, true);
     let camera = Camera::look_at(Vec3::new(0.1, -0.2, 0.05), Vec3::new(1.0, 0.3, -2.0), Vec3::Y, 1.2);
-    for strategy in DirectStrategy::ALL.iter().copied() {
+    // Every direct-light strategy with every way of drawing bounces (the
+    // hemisphere ones weigh MIS by their own density), and the roulette
+    // started late: all unbiased, so all converge to the same radiance.
+    let mut cases: Vec<(DirectStrategy, BounceSampling, u32)> = Vec::new();
+    for &strategy in DirectStrategy::ALL {
+        for &sampling in BounceSampling::ALL {
+            cases.push((strategy, sampling, ROULETTE_START));
+        }
+    }
+    cases.push((DirectStrategy::Bsdf, BounceSampling::Bsdf, 6));
+    for (strategy, bounce_sampling, roulette_start) in cases {
         let settings = RenderSettings {
             width: 24,
             height: 24,
@@ -52,13 +62,16 @@ fn white_furnace_converges_to_emission_over_one_minus_albedo() {
             sampler: PixelSampler::Stratified,
             max_depth: 1000,
             direct_strategy: strategy,
+            bounce_sampling,
+            roulette_start,
             ..RenderSettings::default()
         };
+        let case = format!("{strategy}, bounces from {bounce_sampling}, roulette from bounce {roulette_start}");
         let (mean, min, max) = mean_and_extremes(&render_scene(&scene, &camera, &settings));
-        println!("furnace, {strategy}: mean {mean}, pixels {min}..{max}, expected {expected}");
-        assert!((mean - expected).abs() < 0.01 * expected, "{strategy}: mean {mean}, expected {expected}");
+        println!("furnace, {case}: mean {mean}, pixels {min}..{max}, expected {expected}");
+        assert!((mean - expected).abs() < 0.01 * expected, "{case}: mean {mean}, expected {expected}");
         // Single pixels are noisy (64 samples); the check is for gross failures (black, NaN, doubled).
-        assert!(min > 0.6 * expected && max < 1.4 * expected, "{strategy}: pixels {min}..{max}");
+        assert!(min > 0.6 * expected && max < 1.4 * expected, "{case}: pixels {min}..{max}");
     }
 }
 
@@ -118,6 +131,55 @@ fn every_bsdf_passes_a_furnace_under_a_white_sky() {
         assert!(mean >= lowest && mean <= highest, "{name}: mean {mean}, expected {lowest}..{highest}");
         // Single pixels of 32 samples are noisy; this catches gross failures.
         assert!(min > lowest - 0.35 && max < highest + 0.35, "{name}: pixels {min}..{max}");
+    }
+}
+
+#[test]
+fn hemisphere_bounces_converge_to_what_bsdf_sampling_gives() {
+    // Drawing bounces from the cosine or uniform hemisphere instead of the
+    // BSDF changes the noise, never the mean: under a white sky, diffuse
+    // and glossy spheres come out as bright whichever is used, at every
+    // sample count (the tolerance shrinks with the noise).
+    let glossy = |model, roughness| Material {
+        model,
+        base_color: Vec3::splat(0.7),
+        specular: Vec3::splat(0.25),
+        metallic: if model == SurfaceModel::MetallicRoughness { 1.0 } else { 0.0 },
+        roughness,
+        ..Material::default()
+    };
+    let cases = [
+        ("lambert", Material { base_color: Vec3::splat(0.7), ..Material::default() }),
+        ("diffuse and glossy (MTL)", glossy(SurfaceModel::DiffuseSpecular, 0.6)),
+        ("rough metal", glossy(SurfaceModel::MetallicRoughness, 0.7)),
+    ];
+    let camera = Camera::look_at(Vec3::new(0.0, 0.5, 4.0), Vec3::ZERO, Vec3::Y, 0.6);
+    for (name, material) in cases {
+        let scene = sphere_scene(material, false);
+        for (spp, tolerance) in [(16, 0.03), (128, 0.012)] {
+            let mean = |bounce_sampling| {
+                let settings = RenderSettings {
+                    width: 24,
+                    height: 24,
+                    samples_per_pixel: spp,
+                    sampler: PixelSampler::Stratified,
+                    max_depth: 16,
+                    bounce_sampling,
+                    environment: Some(Environment::Uniform(Vec3::ONE)),
+                    ..RenderSettings::default()
+                };
+                mean_and_extremes(&render_scene(&scene, &camera, &settings)).0
+            };
+            let reference = mean(BounceSampling::Bsdf);
+            for sampling in [BounceSampling::Cosine, BounceSampling::Uniform] {
+                let m = mean(sampling);
+                println!("{name}, {spp} spp: {sampling} {m}, bsdf {reference}");
+                assert!(
+                    (m - reference).abs() < tolerance * reference,
+                    "{name}, {spp} spp: {sampling} {m}, bsdf {reference}"
+                );
+            }
+        }
     }
 }
 

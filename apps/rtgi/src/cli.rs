@@ -7,7 +7,9 @@ use clap::{Args, Parser, Subcommand, ValueEnum};
 use rtgi_accel::{AccelKind, BuildError, BuildParams, Intersector, SahAxes, Traversal};
 use rtgi_image::ToneOperator;
 use rtgi_math::Vec3;
-use rtgi_render::{DirectStrategy, EffectOverrides, EnvironmentSpec, EnvironmentSpecError, Integrator, PixelSampler};
+use rtgi_render::{
+    BounceSampling, DirectStrategy, EffectOverrides, EnvironmentSpec, EnvironmentSpecError, Integrator, PixelSampler,
+};
 use rtgi_scene::{Light, LightSpecError};
 
 /// Largest image side accepted: beyond this a typo (an extra zero) would
@@ -248,9 +250,20 @@ pub(crate) struct LightingArgs {
     #[arg(long, value_enum, default_value_t = Integrator::Path)]
     pub(crate) integrator: Integrator,
 
-    /// Bounces a path may take after the camera ray (path integrator)
-    #[arg(long, default_value_t = 8, value_parser = clap::value_parser!(u32).range(1..=1024))]
+    /// Bounces a path may take after the camera ray (path integrator; 0 sees only what the camera
+    /// rays hit)
+    #[arg(long, default_value_t = 8, value_parser = clap::value_parser!(u32).range(0..=1024))]
     pub(crate) max_depth: u32,
+
+    /// The bounce from which Russian roulette may end dim paths (path integrator); a start
+    /// beyond --max-depth turns it off
+    #[arg(long, default_value_t = rtgi_render::ROULETTE_START, value_name = "BOUNCE")]
+    pub(crate) roulette_start: u32,
+
+    /// Where bounce directions and the bsdf strategy's light rays come from: the BSDF, or the
+    /// cosine or uniform hemisphere (noisier; mirrors and glass always sample the BSDF)
+    #[arg(long, value_enum, default_value_t = BounceSampling::Bsdf)]
+    pub(crate) bounce_sampling: BounceSampling,
 
     /// How direct light is sampled
     #[arg(long, value_enum, default_value_t = DirectStrategy::Mis)]

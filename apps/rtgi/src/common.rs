@@ -93,6 +93,8 @@ impl LightingArgs {
             lights: self.lights.clone(),
             integrator: self.integrator,
             max_depth: self.max_depth,
+            roulette_start: self.roulette_start,
+            bounce_sampling: self.bounce_sampling,
             direct_strategy: self.direct_strategy,
             indirect_clamp: self.clamp_indirect,
             environment: self.environment.clone(),

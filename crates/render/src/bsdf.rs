@@ -252,6 +252,12 @@ impl Bsdf {
     pub fn is_delta(&self) -> bool {
         matches!(self, Bsdf::Mirror { .. } | Bsdf::Dielectric { .. } | Bsdf::ThinDielectric { .. })
     }
+
+    /// Whether light may pass through the surface (the dielectrics); the
+    /// other models only reflect.
+    pub fn transmits(&self) -> bool {
+        matches!(self, Bsdf::Dielectric { .. } | Bsdf::ThinDielectric { .. } | Bsdf::RoughThinDielectric { .. })
+    }
 }
 
 /// Fresnel reflectance of unpolarised light at a smooth dielectric boundary;

@@ -16,7 +16,7 @@ use crate::effects::{Effect, EffectPlan, is_glossy, transmits};
 use crate::lights::{Environment, LightSet};
 use crate::shade::{alpha_accepts, closest_hit};
 use crate::shading_normal::bent_towards_view;
-use crate::{EffectSet, PathStart, RenderSettings};
+use crate::{BounceSampling, EffectSet, PathStart, RenderSettings};
 
 /// What the renderer computes for each pixel.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -136,8 +136,9 @@ impl std::fmt::Display for DirectStrategy {
     }
 }
 
-/// Bounces after which Russian roulette may end a path.
-const ROULETTE_AFTER: u32 = 2;
+/// Bounces after which Russian roulette may end a path, unless the
+/// settings say otherwise ([`RenderSettings::roulette_start`]).
+pub const ROULETTE_START: u32 = 2;
 
 /// GGX widths below this are treated as perfect mirrors (metals) or clamped
 /// (dielectrics): narrower lobes only add fireflies in f32.
@@ -176,6 +177,8 @@ pub(crate) struct Transport<'a, A: Accel + ?Sized> {
     strategy: DirectStrategy,
     indirect_clamp: Option<f32>,
     russian_roulette: bool,
+    roulette_start: u32,
+    bounce_sampling: BounceSampling,
     glossy: bool,
     refraction: bool,
     normal_maps: bool,
@@ -235,6 +238,8 @@ impl<'a, A: Accel + ?Sized> Transport<'a, A> {
             strategy: settings.direct_strategy,
             indirect_clamp: settings.indirect_clamp,
             russian_roulette: settings.russian_roulette,
+            roulette_start: settings.roulette_start,
+            bounce_sampling: settings.bounce_sampling,
             glossy: plan.has(Effect::Glossy),
             refraction: plan.has(Effect::Refraction),
             normal_maps: plan.has(Effect::NormalMaps),
@@ -319,10 +324,7 @@ impl<'a, A: Accel + ?Sized> Transport<'a, A> {
             let interaction = self.interact::<S>(&hit, triangle, material, wo, u[dim::LOBE]);
             let (frame, bsdf) = (&interaction.frame, &interaction.bsdf);
             let wo_local = frame.to_local(wo);
-            let reflects_only = !matches!(
-                bsdf,
-                Bsdf::Dielectric { .. } | Bsdf::ThinDielectric { .. } | Bsdf::RoughThinDielectric { .. }
-            );
+            let reflects_only = !bsdf.transmits();
             let geometric = interaction.point.normal;
             let wo_side = wo.dot(geometric);
 
@@ -340,7 +342,7 @@ impl<'a, A: Accel + ?Sized> Transport<'a, A> {
                             let weight = if light.delta || self.strategy == DirectStrategy::Light {
                                 1.0
                             } else {
-                                power_heuristic(light.pdf, bsdf.pdf(wo_local, wi_local))
+                                power_heuristic(light.pdf, self.bounce_sampling.pdf(bsdf, wo_local, wi_local))
                             };
                             let contribution = throughput
                                 * interaction.weight
@@ -353,7 +355,8 @@ impl<'a, A: Accel + ?Sized> Transport<'a, A> {
                 }
             }
 
-            let Some(sample) = bsdf.sample(wo_local, Vec2::new(u[dim::BSDF], u[dim::BSDF + 1])) else { break };
+            let u_bsdf = Vec2::new(u[dim::BSDF], u[dim::BSDF + 1]);
+            let Some(sample) = self.bounce_sampling.sample(bsdf, wo_local, u_bsdf) else { break };
             let wi = frame.to_world(sample.wi);
             // Reflection must stay on the side it came from, by the true
             // surface as well as by the shading normal.
@@ -369,7 +372,7 @@ impl<'a, A: Accel + ?Sized> Transport<'a, A> {
             // Russian roulette ends paths that carry little, in proportion;
             // paths that lose nothing (mirrors, glass) are left to the depth limit.
             let survival = (throughput * radiance_scale).max_element();
-            if self.russian_roulette && depth >= ROULETTE_AFTER && survival < 1.0 {
+            if self.russian_roulette && depth >= self.roulette_start && survival < 1.0 {
                 if u[dim::ROULETTE] >= survival {
                     break;
                 }

@@ -30,6 +30,7 @@ pub struct ReadmeDoctests;
 
 mod accumulation;
 mod accumulation_file;
+mod bounce_sampling;
 pub mod bsdf;
 mod camera;
 pub mod camera_choice;
@@ -51,6 +52,7 @@ pub mod view_lighting;
 
 pub use accumulation::{Accumulation, FIXED_POINT_BITS, MergeError, PartSpan, PixelSum, SAMPLE_LIMIT};
 pub use accumulation_file::{AccumulationFileError, MergeFilesError};
+pub use bounce_sampling::BounceSampling;
 pub use camera::CameraRays;
 pub use default_lighting::{ENCLOSED, default_sky, default_sun, room_light, sky_visibility};
 pub use distribution::Distribution1D;
@@ -58,7 +60,7 @@ pub use effect_set::EffectSet;
 pub use effects::{Effect, EffectOverrides, EffectPlan, PlannedEffect, Reversal};
 pub use framing::{DEFAULT_VERTICAL_FOV_DEGREES, camera_blocked, default_camera, frame_scene, three_quarter_view};
 pub use identity::{Difference, RenderIdentity, scene_fingerprint};
-pub use integrator::{DirectStrategy, Integrator};
+pub use integrator::{DirectStrategy, Integrator, ROULETTE_START};
 pub use lights::{Environment, EnvironmentMap, EnvironmentSpec, EnvironmentSpecError, LightSet};
 pub use sampler::{PixelSample, PixelSampler, VertexNumbers};
 pub use shade::{albedo, alpha_accepts, has_alpha, shade_primary, shading_normal};
@@ -113,6 +115,12 @@ pub struct RenderSettings {
     /// light with a probability that grows as they dim, and weigh the
     /// survivors up. Unbiased; off, every path runs to `max_depth`.
     pub russian_roulette: bool,
+    /// The bounce from which Russian roulette may end paths (after the
+    /// second, [`ROULETTE_START`], by default).
+    pub roulette_start: u32,
+    /// Where bounce directions (and the BSDF strategy's direct-light rays)
+    /// come from: the BSDF, or the cosine or uniform hemisphere.
+    pub bounce_sampling: BounceSampling,
     /// Light from far away; `None` leaves it to the planner (a white sky
     /// when the scene has no light of its own).
     pub environment: Option<Environment>,
@@ -159,6 +167,8 @@ impl Default for RenderSettings {
             direct_strategy: DirectStrategy::Mis,
             indirect_clamp: None,
             russian_roulette: true,
+            roulette_start: ROULETTE_START,
+            bounce_sampling: BounceSampling::Bsdf,
             environment: None,
             effects: EffectOverrides::default(),
             default_lighting: DefaultLighting::Auto,

@@ -16,8 +16,9 @@ use crate::camera_choice::{ViewScore, best_file_camera, score_view, surface_poin
 use crate::effects::{materials_in_use, reflects_surroundings};
 use crate::view_lighting::{REFLECTED_SHARE, UNLIT_VIEW, view_light};
 use crate::{
-    DEFAULT_VERTICAL_FOV_DEGREES, DefaultLighting, DirectStrategy, ENCLOSED, EffectOverrides, EffectPlan,
-    EnvironmentSpec, Integrator, PixelSampler, RenderSettings, camera_blocked, frame_scene, room_light, sky_visibility,
+    BounceSampling, DEFAULT_VERTICAL_FOV_DEGREES, DefaultLighting, DirectStrategy, ENCLOSED, EffectOverrides,
+    EffectPlan, EnvironmentSpec, Integrator, PixelSampler, RenderSettings, camera_blocked, frame_scene, room_light,
+    sky_visibility,
 };
 
 /// Why a render cannot be prepared; the messages name the option.
@@ -202,6 +203,10 @@ pub struct Lighting {
     pub integrator: Integrator,
     /// The most bounces a path takes.
     pub max_depth: u32,
+    /// The bounce from which Russian roulette may end paths.
+    pub roulette_start: u32,
+    /// Where bounce directions come from.
+    pub bounce_sampling: BounceSampling,
     /// How direct light is sampled.
     pub direct_strategy: DirectStrategy,
     /// The indirect-light clamp, if any.
@@ -223,6 +228,8 @@ pub fn apply_lighting(
     scene.lights.extend(lighting.lights.iter().cloned());
     settings.integrator = lighting.integrator;
     settings.max_depth = lighting.max_depth;
+    settings.roulette_start = lighting.roulette_start;
+    settings.bounce_sampling = lighting.bounce_sampling;
     settings.direct_strategy = lighting.direct_strategy;
     settings.indirect_clamp = lighting.indirect_clamp;
     settings.effects = lighting.effects.clone();
