@@ -276,9 +276,14 @@ pub(crate) struct LightingArgs {
     #[arg(long, visible_alias = "clamp", value_parser = parse_positive, allow_negative_numbers = true)]
     pub(crate) clamp_indirect: Option<f32>,
 
-    /// Light from far away: a radiance R,G,B or an equirectangular .exr image
+    /// Light from far away: a radiance R,G,B, an equirectangular .exr image or a .floats sky of
+    /// the course framework
     #[arg(long, value_parser = parse_environment, allow_hyphen_values = true)]
     pub(crate) environment: Option<EnvironmentSpec>,
+
+    /// Multiplies the --environment's radiance
+    #[arg(long, default_value_t = 1.0, value_parser = parse_positive, requires = "environment")]
+    pub(crate) environment_scale: f32,
 
     /// Add a light (repeatable): point:X,Y,Z:INTENSITY[:R,G,B],
     /// directional:DX,DY,DZ:IRRADIANCE[:R,G,B] (the direction light travels),

@@ -98,6 +98,7 @@ impl LightingArgs {
             direct_strategy: self.direct_strategy,
             indirect_clamp: self.clamp_indirect,
             environment: self.environment.clone(),
+            environment_scale: self.environment_scale,
             effects: self.effects.clone(),
             no_default_lighting: self.no_default_lighting,
         }

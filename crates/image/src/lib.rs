@@ -28,6 +28,7 @@ pub struct ReadmeDoctests;
 mod atomic;
 mod compare;
 mod exposure;
+mod floats;
 mod tonemap;
 mod write;
 

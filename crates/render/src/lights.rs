@@ -41,7 +41,8 @@ pub struct EnvironmentMap {
 
 /// An environment as a specification string names it (the `rtgi`
 /// command's `--environment`), before any file is read: a uniform radiance
-/// `R,G,B` or the path of an equirectangular `.exr` image.
+/// `R,G,B` or the path of an equirectangular `.exr` image (or a `.floats`
+/// sky of the course framework).
 ///
 /// ```
 /// use rtgi_render::EnvironmentSpec;
@@ -66,8 +67,8 @@ pub enum EnvironmentSpecError {
     /// A radiance with a negative component.
     #[error("environment radiance must not be negative (got '{0}')")]
     NegativeRadiance(String),
-    /// Neither three numbers nor a path ending in `.exr`.
-    #[error("expected a radiance R,G,B or an .exr file (got '{0}')")]
+    /// Neither three numbers nor a path ending in `.exr` or `.floats`.
+    #[error("expected a radiance R,G,B or an .exr or .floats file (got '{0}')")]
     Unrecognised(String),
     /// The `.exr` file could not be read or is no environment map.
     #[error(transparent)]
@@ -85,7 +86,7 @@ impl FromStr for EnvironmentSpec {
             return Ok(EnvironmentSpec::Uniform(radiance));
         }
         let path = PathBuf::from(text);
-        if path.extension().is_some_and(|e| e.eq_ignore_ascii_case("exr")) {
+        if has_extension(&path, "exr") || has_extension(&path, "floats") {
             Ok(EnvironmentSpec::File(path))
         } else {
             Err(EnvironmentSpecError::Unrecognised(text.to_owned()))
@@ -105,14 +106,19 @@ impl EnvironmentSpec {
 
 impl Environment {
     /// The environment a specification names (see [`EnvironmentSpec`]): a
-    /// uniform radiance `R,G,B`, or an `.exr` file, which is read.
+    /// uniform radiance `R,G,B`, or an `.exr` or `.floats` file, which is read.
     pub fn from_spec(text: &str) -> Result<Self, EnvironmentSpecError> {
         Ok(text.parse::<EnvironmentSpec>()?.load()?)
     }
 
-    /// Reads an equirectangular environment from an OpenEXR file.
+    /// Reads an equirectangular environment from an OpenEXR file, or from
+    /// a `.floats` sky of the course framework ([`HdrImage::read_floats`]).
     pub fn load(path: &Path) -> Result<Self, ImageError> {
-        let image = HdrImage::read_exr(path)?;
+        let image = if has_extension(path, "floats") {
+            from_course_longitudes(HdrImage::read_floats(path)?)
+        } else {
+            HdrImage::read_exr(path)?
+        };
         if image.width() < 2 || image.height() < 1 {
             return Err(ImageError::Read {
                 path: path.to_owned(),
@@ -126,6 +132,18 @@ impl Environment {
             });
         }
         Ok(Environment::Map(EnvironmentMap::new(image)))
+    }
+
+    /// This environment with its radiance multiplied by `scale` (≥ 0).
+    pub fn scaled(self, scale: f32) -> Self {
+        match self {
+            Environment::Uniform(radiance) => Environment::Uniform(radiance * scale),
+            Environment::Map(map) => {
+                let (w, h) = (map.image.width(), map.image.height());
+                let pixels = map.image.pixels().iter().map(|p| *p * scale).collect();
+                Environment::Map(EnvironmentMap::new(HdrImage::from_pixels(w, h, pixels).expect("the map's size")))
+            }
+        }
     }
 
     /// The radiance arriving from `direction` (unit).
@@ -223,6 +241,28 @@ impl EnvironmentMap {
 
 /// Equirectangular coordinates of a unit direction: u from the azimuth
 /// (0.5 looks along -Z), v from the polar angle (0 straight up).
+/// Whether `path` ends in `.extension`, in any case.
+fn has_extension(path: &Path, extension: &str) -> bool {
+    path.extension().is_some_and(|e| e.eq_ignore_ascii_case(extension))
+}
+
+/// The course framework's skies put longitude φ = atan2(z, x) at u = φ / 2π;
+/// ours ([`uv_of`]) put it at u = φ / 2π + 3/4. Its columns are turned a
+/// quarter of the way round, so that a sky lights the scene from the same
+/// side in both (exactly when the width is a multiple of 4, else to the
+/// nearest column).
+fn from_course_longitudes(image: HdrImage) -> HdrImage {
+    let (w, h) = (image.width(), image.height());
+    let shift = ((3 * w as u64 + 2) / 4) as u32 % w.max(1);
+    let mut turned = HdrImage::new(w, h);
+    for y in 0..h {
+        for x in 0..w {
+            turned.set((x + shift) % w, y, image.get(x, y));
+        }
+    }
+    turned
+}
+
 fn uv_of(d: Vec3) -> Vec2 {
     let u = 0.5 + d.x.atan2(-d.z) / (2.0 * PI);
     let v = d.y.clamp(-1.0, 1.0).acos() / PI;
@@ -579,6 +619,29 @@ mod tests {
             }
         }
         Environment::Map(EnvironmentMap::new(image))
+    }
+
+    /// A course sky lights the same side of the scene as in the course:
+    /// its texel at longitude φ = atan2(z, x) and colatitude θ from +Y
+    /// is what our map returns for that direction, after the quarter turn.
+    #[test]
+    fn course_skies_keep_their_directions() {
+        let (w, h) = (16u32, 8u32);
+        let dir = std::env::temp_dir().join(format!("rtgi-course-sky-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("sky.floats");
+        for (x, y) in [(0u32, 1u32), (5, 3), (11, 6), (15, 0)] {
+            let mut image = HdrImage::new(w, h);
+            image.set(x, y, Vec3::new(9.0, 8.0, 7.0));
+            std::fs::write(&path, image.encode_floats()).unwrap();
+            let sky = Environment::load(&path).unwrap().scaled(2.0);
+            // The course's direction at the texel's centre.
+            let (phi, theta) = (2.0 * PI * (x as f32 + 0.5) / w as f32, PI * (y as f32 + 0.5) / h as f32);
+            let d = Vec3::new(theta.sin() * phi.cos(), theta.cos(), theta.sin() * phi.sin());
+            assert_eq!(sky.radiance(d), Vec3::new(18.0, 16.0, 14.0), "texel {x},{y}");
+            assert_eq!(sky.radiance(-d), Vec3::ZERO, "texel {x},{y}, opposite");
+        }
+        std::fs::remove_dir_all(&dir).unwrap();
     }
 
     #[test]

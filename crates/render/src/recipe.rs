@@ -213,6 +213,8 @@ pub struct Lighting {
     pub indirect_clamp: Option<f32>,
     /// The environment (a colour or a map's file), if any.
     pub environment: Option<EnvironmentSpec>,
+    /// Multiplies the environment's radiance.
+    pub environment_scale: f32,
     /// Effects forced on or off.
     pub effects: EffectOverrides,
     /// Never add the default sky and sun, nor the lamp of an enclosed camera.
@@ -233,7 +235,14 @@ pub fn apply_lighting(
     settings.direct_strategy = lighting.direct_strategy;
     settings.indirect_clamp = lighting.indirect_clamp;
     settings.effects = lighting.effects.clone();
-    settings.environment = lighting.environment.as_ref().map(EnvironmentSpec::load).transpose()?;
+    settings.environment = lighting
+        .environment
+        .as_ref()
+        .map(|spec| {
+            spec.load()
+                .map(|e| if lighting.environment_scale == 1.0 { e } else { e.scaled(lighting.environment_scale) })
+        })
+        .transpose()?;
     if lighting.no_default_lighting {
         settings.default_lighting = DefaultLighting::Off;
     }
