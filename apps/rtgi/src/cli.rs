@@ -61,6 +61,11 @@ pub(crate) enum Command {
     /// What accuracy costs in time: vary one knob (or all) and write a table (KNOB.md), every
     /// measurement (KNOB.json) and SVG plots
     Experiment(ExperimentArgs),
+    /// Run scripts in the command language of the course framework (at, load, raytracer, algo,
+    /// commit, run, ...); with no script, open a prompt
+    Script(crate::script::ScriptArgs),
+    /// Open a prompt that takes the course framework's commands (after running any scripts given)
+    Repl(crate::script::ScriptArgs),
 }
 
 /// `rtgi experiment`: one knob measured as time against error.

@@ -134,6 +134,22 @@ pub(crate) fn apply_lighting(args: &LightingArgs, scene: &mut Scene, settings: &
     Ok(recipe::apply_lighting(&args.lighting(), scene, settings)?)
 }
 
+/// The structure a render traces: built for it, or built before by a
+/// script's `commit` over the same triangles.
+pub(crate) enum Structure<'a> {
+    Built(Box<dyn Accel>),
+    Committed(&'a dyn Accel),
+}
+
+impl<'a> AsRef<dyn Accel + 'a> for Structure<'a> {
+    fn as_ref(&self) -> &(dyn Accel + 'a) {
+        match self {
+            Structure::Built(built) => built.as_ref(),
+            Structure::Committed(committed) => *committed,
+        }
+    }
+}
+
 /// Everything from loaded options to a scene ready to render, as `rtgi
 /// render` prepares it: lighting applied, structure built (in `pool`),
 /// camera chosen and the lamp of an enclosed camera added. `settings` holds
@@ -148,9 +164,21 @@ pub(crate) fn prepare_render(
 ) -> Result<(Box<dyn Accel>, Prepared)> {
     apply_lighting(lighting, scene, settings)?;
     let built = pool.install(|| accel.build(scene))?;
-    let prepared = recipe::prepare(scene, built.as_ref(), settings, &camera.choice())?;
-    report_camera(&prepared.camera);
+    let prepared = prepare_view(scene, built.as_ref(), settings, camera)?;
     Ok((built, prepared))
+}
+
+/// The camera chosen and the lamp of an enclosed camera added, once the
+/// lighting options are applied and the structure is built.
+pub(crate) fn prepare_view(
+    scene: &mut Scene,
+    accel: &dyn Accel,
+    settings: &mut RenderSettings,
+    camera: &CameraArgs,
+) -> Result<Prepared> {
+    let prepared = recipe::prepare(scene, accel, settings, &camera.choice())?;
+    report_camera(&prepared.camera);
+    Ok(prepared)
 }
 
 /// Whether `a` and `b` name the same file, following links; a file that

@@ -3,7 +3,7 @@
 use std::fmt::Write as _;
 
 use anyhow::{Result, bail};
-use rtgi_accel::{Accel, Bvh, Bvh4, Bvh8};
+use rtgi_accel::{Accel, AccelKind, BuildParams, Bvh, Bvh4, Bvh8};
 use rtgi_image::{HdrImage, OutputFormat, ToneMap, check_writable, heat_colour};
 use rtgi_render::render_traversal_cost;
 
@@ -17,29 +17,45 @@ use crate::output::outln;
 pub(crate) fn boxes(args: &BvhBoxesArgs) -> Result<()> {
     let output = args.output.or_named_after(args.scene.as_deref(), ".boxes.obj");
     check_output_folder(&output)?;
-    let Some(method) = args.accel.accel.split_method() else {
+    if args.accel.accel.split_method().is_none() {
         bail!("--accel {}: only BVH variants have boxes to export", args.accel.accel);
-    };
+    }
     let LoadedScene { scene, .. } = load_scene(args.scene.as_deref())?;
     let kind = args.accel.accel;
-    let (triangles, params) = (scene.triangle_positions(), args.accel.build.params_for(kind));
+    let (obj, count) = boxes_obj(kind, &scene.triangle_positions(), &args.accel.build.params_for(kind), &args.levels)?;
+    write_atomically(&output, obj.as_bytes())?;
+    outln!("wrote {count} boxes of levels {:?} to {}", args.levels, output.display())?;
+    Ok(())
+}
+
+/// The boxes of a BVH's nodes at `levels` (the root is 0) as an OBJ file,
+/// a group `level_N` for each level, and how many boxes it holds.
+pub(crate) fn boxes_obj(
+    kind: AccelKind,
+    triangles: &[[rtgi_math::Vec3; 3]],
+    params: &BuildParams,
+    levels: &[usize],
+) -> Result<(String, usize)> {
+    let Some(method) = kind.split_method() else {
+        bail!("{kind}: only BVH variants have boxes to export");
+    };
     let (boxes, stats) = match kind.node_width() {
         Some(4) => {
-            let bvh = Bvh4::new(&triangles, method, &params);
-            (bvh.boxes_at_depths(&args.levels), bvh.build_stats().clone())
+            let bvh = Bvh4::new(triangles, method, params);
+            (bvh.boxes_at_depths(levels), bvh.build_stats().clone())
         }
         Some(8) => {
-            let bvh = Bvh8::new(&triangles, method, &params);
-            (bvh.boxes_at_depths(&args.levels), bvh.build_stats().clone())
+            let bvh = Bvh8::new(triangles, method, params);
+            (bvh.boxes_at_depths(levels), bvh.build_stats().clone())
         }
         _ => {
-            let bvh = Bvh::new(&triangles, method, &params);
-            (bvh.boxes_at_depths(&args.levels), bvh.build_stats().clone())
+            let bvh = Bvh::new(triangles, method, params);
+            (bvh.boxes_at_depths(levels), bvh.build_stats().clone())
         }
     };
     let mut obj = format!(
         "# BVH boxes of levels {:?}, {} ({} build, {} nodes, depth {}), written by rtgi\n",
-        args.levels,
+        levels,
         kind,
         method.name(),
         stats.nodes,
@@ -60,9 +76,7 @@ pub(crate) fn boxes(args: &BvhBoxesArgs) -> Result<()> {
             let _ = writeln!(obj, "f {} {} {} {}", base + face[0], base + face[1], base + face[2], base + face[3]);
         }
     }
-    write_atomically(&output, obj.as_bytes())?;
-    outln!("wrote {} boxes of levels {:?} to {}", boxes.len(), args.levels, output.display())?;
-    Ok(())
+    Ok((obj, boxes.len()))
 }
 
 /// Renders nodes visited (or triangles tested) per pixel in false colour.

@@ -19,6 +19,7 @@ mod progress;
 mod rays_cmd;
 mod render_cmd;
 mod render_job;
+mod script;
 mod trace_cmd;
 mod verify_cmd;
 
@@ -47,6 +48,8 @@ pub fn main() -> ExitCode {
         cli::Command::Merge(args) => merge_cmd::run(&args),
         cli::Command::Gallery(args) => gallery_cmd::run(&args),
         cli::Command::Rays(args) => rays_cmd::run(&args),
+        cli::Command::Script(args) => script::run(&args),
+        cli::Command::Repl(args) => script::run(&crate::script::ScriptArgs { interactive: true, ..args }),
     };
     // Whatever the command printed last may still sit in the buffer.
     let result = result.and_then(|()| output::flush());
@@ -72,7 +75,7 @@ pub fn main() -> ExitCode {
 
 /// An error and its causes on one line, leaving out causes that the
 /// messages before them already quote (library errors name their cause).
-fn one_line(error: &anyhow::Error) -> String {
+pub(crate) fn one_line(error: &anyhow::Error) -> String {
     let mut line = error.to_string();
     for cause in error.chain().skip(1) {
         let cause = cause.to_string();

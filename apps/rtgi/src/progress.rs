@@ -37,6 +37,9 @@ pub(crate) struct Progress {
     bar: Option<ProgressBar>,
     last_line: Mutex<Instant>,
     line_every: Duration,
+    /// Say, once every pixel has its first sample, how long the whole
+    /// render will take (the course framework's "Will take around").
+    forecast: std::sync::atomic::AtomicBool,
 }
 
 impl Progress {
@@ -64,12 +67,24 @@ impl Progress {
             bar,
             last_line,
             line_every: line_every(),
+            forecast: std::sync::atomic::AtomicBool::new(false),
         }
+    }
+
+    /// Says, once every pixel has a sample, how long the render will take.
+    pub(crate) fn with_forecast(self) -> Self {
+        self.forecast.store(true, Ordering::Relaxed);
+        self
     }
 
     /// `count` more pixel samples are done (called from the workers).
     pub(crate) fn add(&self, count: u64) {
         let done = self.done.fetch_add(count, Ordering::Relaxed) + count;
+        if done >= self.pixels && self.forecast.swap(false, Ordering::Relaxed) {
+            let seconds = self.start.elapsed().as_secs_f64();
+            let whole = seconds * self.total as f64 / done as f64;
+            self.say(&format!("Will take around {} to complete", short_duration(whole)));
+        }
         if let Some(bar) = &self.bar {
             bar.set_position(done);
             return;
@@ -114,6 +129,11 @@ impl Progress {
             bar.finish_and_clear();
         }
     }
+}
+
+/// Seconds as "0.42 s" under a minute, else as [`duration`] says them.
+pub(crate) fn short_duration(seconds: f64) -> String {
+    if seconds < 60.0 { format!("{seconds:.2} s") } else { duration(seconds) }
 }
 
 /// Seconds as "1 h 02 min", "3 min 20 s" or "12 s".

@@ -9,7 +9,10 @@ use rtgi_render::{
 
 use crate::cli::ToneArgs;
 use crate::cli::{RenderArgs, reshaped};
-use crate::common::{LoadedScene, check_output_folder, load_scene, prepare_render, refuse_inputs_as_outputs};
+use crate::common::{
+    LoadedScene, Structure, apply_lighting, check_output_folder, load_scene, prepare_render, prepare_view,
+    refuse_inputs_as_outputs,
+};
 use crate::interrupt;
 use crate::output::{out, outln};
 use crate::progress::Progress;
@@ -44,10 +47,27 @@ pub(crate) fn run(args: &RenderArgs) -> Result<()> {
 /// (`None` when no sample finished).
 pub(crate) struct Rendered {
     pub(crate) image: Option<(HdrImage, ToneMap)>,
+    /// Seconds spent rendering (not loading or building).
+    pub(crate) seconds: f64,
+    /// Rays traced.
+    pub(crate) rays: u64,
+}
+
+/// A scene a script loaded and edited, with the structure its `commit`
+/// built: rendered in place of the file `args.scene` names.
+pub(crate) struct Given<'a> {
+    pub(crate) scene: LoadedScene,
+    pub(crate) accel: &'a dyn rtgi_accel::Accel,
 }
 
 /// `rtgi render`, returning the image it wrote.
 pub(crate) fn render_image(args: &RenderArgs) -> Result<Rendered> {
+    render_given(args, None)
+}
+
+/// `rtgi render` of `given`'s scene and structure when there is one, else
+/// of the file `args.scene` names; returns the image it wrote.
+pub(crate) fn render_given(args: &RenderArgs, given: Option<Given<'_>>) -> Result<Rendered> {
     let started = Instant::now();
     // From the start: a Ctrl-C while the scene loads then stops the render
     // before its first pass (a second one ends the process at once).
@@ -87,7 +107,11 @@ pub(crate) fn render_image(args: &RenderArgs) -> Result<Rendered> {
     let resumed = job.resume.as_deref().map(Accumulation::read).transpose()?;
     check_memory(width, height)?;
 
-    let LoadedScene { mut scene, name: scene_name, load_ms } = load_scene(args.scene.as_deref())?;
+    let from_script = given.is_some();
+    let (LoadedScene { mut scene, name: scene_name, load_ms }, committed) = match given {
+        Some(Given { scene, accel }) => (scene, Some(accel)),
+        None => (load_scene(args.scene.as_deref())?, None),
+    };
     // The files the scene read (textures, material libraries, buffers) are inputs too.
     let sources: Vec<(String, &Path)> = scene
         .sources
@@ -107,8 +131,17 @@ pub(crate) fn render_image(args: &RenderArgs) -> Result<Rendered> {
         ..RenderSettings::default()
     };
     let pool = args.threads.pool()?;
-    let (accel, prepared) =
-        prepare_render(&mut scene, &mut settings, &args.lighting, &args.camera, &args.accel, &pool)?;
+    let (accel, prepared) = match committed {
+        None => {
+            let (built, prepared) =
+                prepare_render(&mut scene, &mut settings, &args.lighting, &args.camera, &args.accel, &pool)?;
+            (Structure::Built(built), prepared)
+        }
+        Some(committed) => {
+            apply_lighting(&args.lighting, &mut scene, &mut settings)?;
+            (Structure::Committed(committed), prepare_view(&mut scene, committed, &mut settings, &args.camera)?)
+        }
+    };
     let (camera, room_light) = (prepared.camera.camera, prepared.room_light);
     // A file camera's aspect ratio shapes the image unless its size was given.
     if let Some(aspect) = camera.aspect.filter(|&a| a.is_finite() && a > 0.0 && !args.size.given()) {
@@ -174,6 +207,7 @@ pub(crate) fn render_image(args: &RenderArgs) -> Result<Rendered> {
     let before = accumulation.samples().end;
     let pixels = rows.len() as u64 * settings.width as u64;
     let progress = Progress::new(pixels, before, samples.end);
+    let progress = if from_script { progress.with_forecast() } else { progress };
     let renderer = Renderer { scene: &scene, accel: accel.as_ref(), camera: &camera, settings: &settings };
     let (ending, totals) =
         pool.install(|| run_passes(&renderer, job, started, &mut accumulation, samples.end, &progress))?;
@@ -210,7 +244,7 @@ pub(crate) fn render_image(args: &RenderArgs) -> Result<Rendered> {
         }
     }
 
-    let build = accel.build_stats();
+    let build = accel.as_ref().build_stats();
     say!("scene       {scene_name}");
     say!("triangles   {}", scene.triangles.len());
     say!("load        {load_ms:.1} ms");
@@ -260,7 +294,11 @@ pub(crate) fn render_image(args: &RenderArgs) -> Result<Rendered> {
     match ending {
         Ending::Signal(signal) => Err(StoppedBySignal(signal).into()),
         Ending::TimeLimit if !wrote_output => bail!("no sample finished within the time limit"),
-        _ => printed.map(|()| Rendered { image: image.map(|image| (image, tone_map)) }),
+        _ => printed.map(|()| Rendered {
+            image: image.map(|image| (image, tone_map)),
+            seconds: totals.render_seconds,
+            rays: totals.rays,
+        }),
     }
 }
 

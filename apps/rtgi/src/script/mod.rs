@@ -1,0 +1,109 @@
+//! `rtgi script` and `rtgi repl`: the command language of the course
+//! framework this toolkit comes from (`at`, `load`, `raytracer`, `algo`,
+//! `commit`, `run`, ...), as scripts and at a prompt.
+//!
+//! - [`parse`] turns a line into a command, or says what it expects;
+//! - [`session`] holds what the commands set up and runs them, rendering
+//!   through `rtgi render`'s own code;
+//! - [`brdf`] realises the course's BRDF names as our materials;
+//! - this file reads scripts line by line and runs the prompt.
+
+mod brdf;
+mod parse;
+mod session;
+
+use std::path::PathBuf;
+
+use anyhow::{Result, bail};
+use clap::Args;
+
+use crate::cli::{SeedArgs, ThreadArgs};
+use session::{Flow, Session, SessionOptions};
+
+/// Options of `rtgi script` and `rtgi repl`.
+#[derive(Debug, Args)]
+pub(crate) struct ScriptArgs {
+    /// Scripts to run, one after the other in one session; none opens the prompt
+    pub(crate) scripts: Vec<PathBuf>,
+
+    /// Where `run` writes until a script's `outfile` says otherwise (.png, or .exr for the
+    /// linear floats)
+    #[arg(short, long, default_value = "out.png")]
+    pub(crate) output: PathBuf,
+
+    /// A folder `load` also looks in, after the current folder and the script's (repeatable)
+    #[arg(long = "modelpath", value_name = "DIR")]
+    pub(crate) model_paths: Vec<PathBuf>,
+
+    /// After the scripts, open the prompt in the session they set up
+    #[arg(short = 'l', long)]
+    pub(crate) interactive: bool,
+
+    #[command(flatten)]
+    pub(crate) seed: SeedArgs,
+
+    #[command(flatten)]
+    pub(crate) threads: ThreadArgs,
+}
+
+/// `rtgi script`: runs the scripts, then the prompt if asked (or if there were none).
+pub(crate) fn run(args: &ScriptArgs) -> Result<()> {
+    let mut session = Session::new(SessionOptions {
+        output: Some(args.output.clone()),
+        seed: args.seed.value,
+        threads: args.threads.count,
+        model_paths: args.model_paths.clone(),
+    });
+    for script in &args.scripts {
+        if run_file(&mut session, script)? == Flow::Quit {
+            return Ok(());
+        }
+    }
+    if args.scripts.is_empty() || args.interactive {
+        prompt(&mut session)?;
+    }
+    Ok(())
+}
+
+/// Runs a script to its end or its `quit`; stops at the first bad line
+/// with an error naming the file, the line and the command.
+fn run_file(session: &mut Session, script: &std::path::Path) -> Result<Flow> {
+    let text =
+        std::fs::read_to_string(script).map_err(|e| anyhow::anyhow!("{}: cannot read: {e}", script.display()))?;
+    session
+        .set_script_folder(script.parent().map(|p| if p.as_os_str().is_empty() { ".".into() } else { p.to_owned() }));
+    for (index, line) in text.lines().enumerate() {
+        match session.execute(line) {
+            Ok(Flow::Continue) => {}
+            Ok(Flow::Quit) => return Ok(Flow::Quit),
+            Err(error) => {
+                bail!("{}:{}: '{}': {}", script.display(), index + 1, line.trim(), crate::one_line(&error));
+            }
+        }
+    }
+    session.set_script_folder(None);
+    Ok(Flow::Continue)
+}
+
+/// The prompt: line editing and history; a bad line is reported and the
+/// session goes on.
+fn prompt(session: &mut Session) -> Result<()> {
+    let mut editor = rustyline::DefaultEditor::new()?;
+    loop {
+        match editor.readline("rtgi > ") {
+            Ok(line) => {
+                if !line.trim().is_empty() {
+                    let _ = editor.add_history_entry(line.as_str());
+                }
+                match session.execute(&line) {
+                    Ok(Flow::Continue) => {}
+                    Ok(Flow::Quit) => return Ok(()),
+                    Err(error) => eprintln!("error: '{}': {}", line.trim(), crate::one_line(&error)),
+                }
+                crate::output::flush()?;
+            }
+            Err(rustyline::error::ReadlineError::Interrupted | rustyline::error::ReadlineError::Eof) => return Ok(()),
+            Err(error) => return Err(error.into()),
+        }
+    }
+}

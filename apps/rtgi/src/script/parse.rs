@@ -1,0 +1,612 @@
+//! The course framework's command language, one line at a time: each line
+//! becomes a [`Command`] or an error saying what the command expects. The
+//! parser knows only the syntax; what the commands do is the session's
+//! business ([`super::session`]).
+
+use std::path::PathBuf;
+
+use rtgi_accel::AccelKind;
+use rtgi_math::{Mat4, Vec3};
+use rtgi_render::BounceSampling;
+
+use super::brdf::CourseBrdf;
+
+/// One line of a script.
+#[derive(Clone, Debug, PartialEq)]
+pub(crate) enum Command {
+    /// A blank line or a comment (`#`, `//`).
+    Nothing,
+    /// `at [X Y Z]`: the camera's position, or print it.
+    At(Option<Vec3>),
+    /// `look [X Y Z]`: the camera's direction, or print it.
+    Look(Option<Vec3>),
+    /// `up [X Y Z]`: the scene's up (and the camera's, unless `camup` set it), or print it.
+    Up(Option<Vec3>),
+    /// `camup [X Y Z]`: the camera's up, or print it.
+    CamUp(Option<Vec3>),
+    /// `print-cam`.
+    PrintCam,
+    /// `load FILE [NAME]`: adds a file's meshes to the scene.
+    Load { file: PathBuf, name: Option<String> },
+    /// `modelpath DIR`: a folder `load` also looks in.
+    ModelPath(PathBuf),
+    /// `modelmatrix` with 16 numbers, row by row: the transform of later loads.
+    ModelMatrix(Mat4),
+    /// `modeltrafo ...`: multiplies the transform of later loads.
+    ModelTrafo(Mat4),
+    /// `resolution W H`.
+    Resolution(u32, u32),
+    /// `sppx N`: samples per pixel.
+    Sppx(u32),
+    /// `outfile FILE`: where `run` writes.
+    Outfile(PathBuf),
+    /// `commit`: builds the acceleration structure over the scene.
+    Commit,
+    /// `run`: renders and writes the image.
+    Run,
+    /// `raytracer NAME ...`.
+    Raytracer(Tracer),
+    /// `bvh ...`: the BVH plug-in's settings and reports.
+    Bvh(BvhCommand),
+    /// `algo NAME`.
+    Algo(Algo),
+    /// `is uniform|cosine|light|brdf`: how `algo direct` samples.
+    Is(DirectSampling),
+    /// `path ...`: the path tracers' settings.
+    Path(PathSetting),
+    /// `material ...`.
+    Material(MaterialCommand),
+    /// `default-brdf NAME`: the BRDF of materials loaded later.
+    DefaultBrdf(CourseBrdf),
+    /// `pointlight [replace] pos X Y Z col R G B`.
+    PointLight { replace: bool, position: Vec3, colour: Vec3 },
+    /// `skylight load FILE SCALE`.
+    SkylightLoad { file: PathBuf, scale: f32 },
+    /// `skylight scale S`.
+    SkylightScale(f32),
+    /// `echo TEXT`.
+    Echo(String),
+    /// `stats print`.
+    StatsPrint,
+    /// `stats clear`.
+    StatsClear,
+    /// `mem-stats`.
+    MemStats,
+    /// `history`.
+    History,
+    /// `quit` or `exit`.
+    Quit,
+    /// `omp on|off`: all cores, or one thread.
+    Omp(bool),
+    /// `platform [NAME]`: only `cpu` and `none` (the same here) exist.
+    Platform(Option<String>),
+    /// `denoise on|off`.
+    Denoise(bool),
+    /// `disable FEATURE`: `with FEATURE { }` blocks are then skipped.
+    Disable(String),
+    /// `with gl|cuda|optix {`: a block for a feature.
+    With(String),
+    /// `}`: the end of a `with` block.
+    EndBlock,
+    /// A command of the framework's for something rtgi does not have (the
+    /// preview window, wavefront steps, the sky's debug output): said in
+    /// one line, and the script goes on.
+    Unavailable { command: &'static str, feature: &'static str },
+}
+
+/// `raytracer NAME`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) enum Tracer {
+    /// `seq`: the linear scan.
+    Seq,
+    /// `naive-bvh`: object median, one triangle a leaf.
+    NaiveBvh,
+    /// `bbvh [om|sm|sah [NPLANES]]` (and the framework's `indexed`/`esc`
+    /// layouts, which change nothing here): the binary BVH.
+    Bbvh(Option<(CourseSplit, Option<u32>)>),
+    /// `embree` (and `embree-alpha`).
+    Embree,
+    /// One of ours by its own name: `bvh4`, `bvh8`, `sah`, `sah-sweep`, ...
+    Ours(AccelKind),
+}
+
+/// The course's split methods.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum CourseSplit {
+    ObjectMedian,
+    SpatialMedian,
+    Sah,
+}
+
+/// `bvh ...`.
+#[derive(Clone, Debug, PartialEq)]
+pub(crate) enum BvhCommand {
+    /// `bvh om|sm|sah [NPLANES]`.
+    Split(CourseSplit, Option<u32>),
+    /// `bvh triangles single|multiple N`: the most triangles a leaf holds.
+    LeafSize(u32),
+    /// `bvh statistics`.
+    Statistics,
+    /// `bvh export DEPTH FILE.obj`.
+    Export { depth: usize, file: PathBuf },
+}
+
+/// `algo NAME`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Algo {
+    Primary,
+    Info,
+    Local,
+    Direct,
+    DirectMis,
+    SimplePt,
+    Pt,
+}
+
+impl Algo {
+    /// The name the course gives it.
+    pub(crate) fn name(self) -> &'static str {
+        match self {
+            Algo::Primary => "primary",
+            Algo::Info => "info",
+            Algo::Local => "local",
+            Algo::Direct => "direct",
+            Algo::DirectMis => "direct/mis",
+            Algo::SimplePt => "simple-pt",
+            Algo::Pt => "pt",
+        }
+    }
+}
+
+/// `is uniform|cosine|light|brdf`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum DirectSampling {
+    Uniform,
+    Cosine,
+    Light,
+    Brdf,
+}
+
+/// `path ...`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum PathSetting {
+    /// `path len N`: rays a path traces at most.
+    Length(u32),
+    /// `path rr-start N`: bounces before Russian roulette.
+    RouletteStart(u32),
+    /// `path bounce uniform|cosine|brdf`.
+    Bounce(BounceSampling),
+    /// `path mis on|off`.
+    Mis(bool),
+}
+
+/// `material ...`.
+#[derive(Clone, Debug, PartialEq)]
+pub(crate) enum MaterialCommand {
+    List,
+    Select(String),
+    Blacklist(String),
+    Albedo(Vec3),
+    Emissive(Vec3),
+    Roughness(f32),
+    Ior(f32),
+    /// `texture FILE` or `texture drop` (`None`).
+    Texture(Option<PathBuf>),
+    Brdf(CourseBrdf),
+    Show,
+}
+
+/// Parses one line. The error says what the command expects; the caller
+/// adds the file, the line and the command's name.
+pub(crate) fn parse(line: &str) -> Result<Command, String> {
+    let line = line.trim();
+    let mut words = line.split_whitespace();
+    let Some(name) = words.next() else { return Ok(Command::Nothing) };
+    if name.starts_with('#') || name.starts_with("//") {
+        return Ok(Command::Nothing);
+    }
+    let words: Vec<&str> = words.collect();
+    // The text after the command's name, as typed (names may hold spaces).
+    let rest = line[name.len()..].trim();
+    let none = |command: Command| if words.is_empty() { Ok(command) } else { Err("takes no arguments".to_owned()) };
+    match name {
+        "at" => optional_vec3(&words).map(Command::At),
+        "look" => optional_vec3(&words).map(Command::Look),
+        "up" => optional_vec3(&words).map(Command::Up),
+        "camup" => optional_vec3(&words).map(Command::CamUp),
+        "print-cam" => none(Command::PrintCam),
+        "load" => match words[..] {
+            [file] => Ok(Command::Load { file: file.into(), name: None }),
+            [file, name] => Ok(Command::Load { file: file.into(), name: Some(name.to_owned()) }),
+            _ => Err("expects a file name (no spaces) and, optionally, a name".to_owned()),
+        },
+        "modelpath" => match words[..] {
+            [dir] => Ok(Command::ModelPath(dir.into())),
+            _ => Err("expects one folder (no spaces)".to_owned()),
+        },
+        "modelmatrix" => {
+            let values = numbers(&words, 16).map_err(|_| "expects 16 numbers, the matrix row by row".to_owned())?;
+            // Rows as typed; glam's matrices are built from columns.
+            Ok(Command::ModelMatrix(Mat4::from_cols_slice(&values).transpose()))
+        }
+        "modeltrafo" => model_trafo(&words).map(Command::ModelTrafo),
+        "resolution" => match words[..] {
+            [w, h] => match (positive_int(w), positive_int(h)) {
+                (Some(w), Some(h)) => Ok(Command::Resolution(w, h)),
+                _ => Err(format!("expects two positive whole numbers, W H (got '{rest}')")),
+            },
+            _ => Err("expects two positive whole numbers, W H".to_owned()),
+        },
+        "sppx" => one_positive(&words).map(Command::Sppx),
+        "outfile" => match words[..] {
+            [file] => Ok(Command::Outfile(file.into())),
+            _ => Err("expects one file name (no spaces)".to_owned()),
+        },
+        "commit" => none(Command::Commit),
+        "run" => none(Command::Run),
+        "raytracer" => tracer(&words).map(Command::Raytracer),
+        "bvh" => bvh(&words).map(Command::Bvh),
+        "algo" => algo(&words),
+        "is" => match words[..] {
+            ["uniform"] => Ok(Command::Is(DirectSampling::Uniform)),
+            ["cosine"] => Ok(Command::Is(DirectSampling::Cosine)),
+            ["light"] => Ok(Command::Is(DirectSampling::Light)),
+            ["brdf"] => Ok(Command::Is(DirectSampling::Brdf)),
+            _ => Err(format!("expects one of uniform, cosine, light, brdf (got '{rest}')")),
+        },
+        "path" => path(&words).map(Command::Path),
+        "material" => material(&words, rest).map(Command::Material),
+        "default-brdf" => match words[..] {
+            [name] => CourseBrdf::from_name(name).map(Command::DefaultBrdf),
+            _ => Err(format!("expects one BRDF name: {}", CourseBrdf::NAMES)),
+        },
+        "pointlight" => point_light(&words),
+        "skylight" => match words[..] {
+            ["load", file, scale] => match scale.parse::<f32>() {
+                Ok(scale) if scale.is_finite() && scale > 0.0 => Ok(Command::SkylightLoad { file: file.into(), scale }),
+                _ => Err(format!("load: the intensity scale must be a number above 0 (got '{scale}')")),
+            },
+            ["load", ..] => Err("load expects a file name (no spaces) and an intensity scale".to_owned()),
+            ["scale", scale] => match scale.parse::<f32>() {
+                Ok(scale) if scale.is_finite() && scale > 0.0 => Ok(Command::SkylightScale(scale)),
+                _ => Err(format!("scale: the intensity scale has to be a value above 0 (got '{scale}')")),
+            },
+            _ => Err("expects 'load FILE SCALE' or 'scale S'".to_owned()),
+        },
+        "skytest" => Ok(Command::Unavailable { command: "skytest", feature: "the sky distribution's debug images" }),
+        "echo" => Ok(Command::Echo(rest.to_owned())),
+        "stats" => match words[..] {
+            ["print"] => Ok(Command::StatsPrint),
+            ["clear"] => Ok(Command::StatsClear),
+            _ => Err("expects 'print' or 'clear'".to_owned()),
+        },
+        "mem-stats" => none(Command::MemStats),
+        "history" => none(Command::History),
+        "quit" | "exit" => none(Command::Quit),
+        "omp" => on_off(&words).map(Command::Omp),
+        "platform" => match words[..] {
+            [] => Ok(Command::Platform(None)),
+            [name, ..] => Ok(Command::Platform(Some(name.to_owned()))),
+        },
+        "denoise" => match words[..] {
+            ["on"] => Ok(Command::Denoise(true)),
+            ["off"] => Ok(Command::Denoise(false)),
+            _ => Err("expects 'on' or 'off'".to_owned()),
+        },
+        "disable" => match words[..] {
+            [feature] => Ok(Command::Disable(feature.to_owned())),
+            _ => Err("expects one feature to disable".to_owned()),
+        },
+        "with" => match words[..] {
+            [feature, "{"] if ["gl", "cuda", "optix"].contains(&feature) => Ok(Command::With(feature.to_owned())),
+            [feature, "{"] => Err(format!("expects one of gl, cuda, optix (got '{feature}')")),
+            _ => Err("expects 'with gl|cuda|optix {' on a line of its own".to_owned()),
+        },
+        "}" => none(Command::EndBlock).map_err(|_| "} must be on an otherwise empty line".to_owned()),
+        "preview-offset" => {
+            one_positive(&words)?;
+            Ok(Command::Unavailable { command: "preview-offset", feature: "the preview window" })
+        }
+        "move-speed" => Ok(Command::Unavailable { command: "move-speed", feature: "the preview window" }),
+        "add-scene-step" => Ok(Command::Unavailable { command: "add-scene-step", feature: "wavefront steps" }),
+        _ => Err("unknown command".to_owned()),
+    }
+}
+
+fn optional_vec3(words: &[&str]) -> Result<Option<Vec3>, String> {
+    if words.is_empty() {
+        return Ok(None);
+    }
+    let values = numbers(words, 3).map_err(|got| format!("expects 3 numbers, X Y Z (got '{got}')"))?;
+    Ok(Some(Vec3::from_slice(&values)))
+}
+
+/// Exactly `count` finite numbers, or the words as typed.
+fn numbers(words: &[&str], count: usize) -> Result<Vec<f32>, String> {
+    let values: Vec<f32> = words.iter().filter_map(|w| w.parse::<f32>().ok().filter(|v| v.is_finite())).collect();
+    if words.len() == count && values.len() == count { Ok(values) } else { Err(words.join(" ")) }
+}
+
+fn positive_int(word: &str) -> Option<u32> {
+    word.parse::<u32>().ok().filter(|&n| n > 0)
+}
+
+fn one_positive(words: &[&str]) -> Result<u32, String> {
+    match words[..] {
+        [n] => positive_int(n).ok_or_else(|| format!("expects one positive whole number (got '{n}')")),
+        _ => Err("expects one positive whole number".to_owned()),
+    }
+}
+
+fn on_off(words: &[&str]) -> Result<bool, String> {
+    match words[..] {
+        ["on"] => Ok(true),
+        ["off"] => Ok(false),
+        _ => Err("expects 'on' or 'off'".to_owned()),
+    }
+}
+
+fn model_trafo(words: &[&str]) -> Result<Mat4, String> {
+    match words {
+        [kind @ ("shift" | "translate"), xyz @ ..] => {
+            let v = numbers(xyz, 3).map_err(|got| format!("{kind} expects 3 numbers, X Y Z (got '{got}')"))?;
+            Ok(Mat4::from_translation(Vec3::from_slice(&v)))
+        }
+        ["rotate", axis, degrees] => {
+            let axis = match *axis {
+                "x" | "X" => Vec3::X,
+                "y" | "Y" => Vec3::Y,
+                "z" | "Z" => Vec3::Z,
+                other => return Err(format!("rotate: invalid axis of rotation '{other}' (x, y or z)")),
+            };
+            let degrees =
+                numbers(&[degrees], 1).map_err(|got| format!("rotate expects an angle in degrees (got '{got}')"))?;
+            Ok(Mat4::from_axis_angle(axis, degrees[0].to_radians()))
+        }
+        ["rotate", ..] => Err("rotate expects an axis (x, y or z) and an angle in degrees".to_owned()),
+        ["scale", xyz @ ..] => {
+            let v = numbers(xyz, 3).map_err(|got| format!("scale expects 3 numbers, X Y Z (got '{got}')"))?;
+            Ok(Mat4::from_scale(Vec3::from_slice(&v)))
+        }
+        [other, ..] => Err(format!("unsupported trafo '{other}' (shift, translate, rotate or scale)")),
+        [] => Err("expects shift|translate X Y Z, rotate x|y|z DEGREES or scale X Y Z".to_owned()),
+    }
+}
+
+fn split(word: &str) -> Option<CourseSplit> {
+    match word {
+        "om" => Some(CourseSplit::ObjectMedian),
+        "sm" => Some(CourseSplit::SpatialMedian),
+        "sah" => Some(CourseSplit::Sah),
+        _ => None,
+    }
+}
+
+fn tracer(words: &[&str]) -> Result<Tracer, String> {
+    let ours: Vec<&str> = AccelKind::ALL.iter().map(|k| k.name()).filter(|n| *n != "linear").collect();
+    let known =
+        || format!("seq, naive-bvh, bbvh [om|sm|sah [NPLANES]], embree, or one of rtgi's own: {}", ours.join(", "));
+    match words {
+        ["seq"] => Ok(Tracer::Seq),
+        ["naive-bvh"] => Ok(Tracer::NaiveBvh),
+        ["embree" | "embree-alpha"] => Ok(Tracer::Embree),
+        ["bbvh", tags @ ..] => {
+            // The framework's triangle layouts and escape indices change
+            // its memory layout, not the tree: here they change nothing.
+            let tags: Vec<&str> = tags.iter().copied().filter(|t| !matches!(*t, "indexed" | "flat" | "esc")).collect();
+            match tags[..] {
+                [] => Ok(Tracer::Bbvh(None)),
+                [method] => split(method)
+                    .map(|s| Tracer::Bbvh(Some((s, None))))
+                    .ok_or_else(|| format!("there is no such bbvh variant '{method}' (om, sm or sah)")),
+                ["sah", planes] => positive_int(planes)
+                    .filter(|&n| n <= 255)
+                    .map(|n| Tracer::Bbvh(Some((CourseSplit::Sah, Some(n)))))
+                    .ok_or_else(|| format!("sah expects a number of planes from 1 to 255 (got '{planes}')")),
+                _ => Err("bbvh expects om, sm or sah [NPLANES]".to_owned()),
+            }
+        }
+        [name] => match name.parse::<AccelKind>() {
+            Ok(kind) if kind != AccelKind::Linear => Ok(Tracer::Ours(kind)),
+            _ => Err(format!("there is no ray tracer called '{name}' ({})", known())),
+        },
+        _ => Err(format!("expects one ray tracer: {}", known())),
+    }
+}
+
+fn bvh(words: &[&str]) -> Result<BvhCommand, String> {
+    match words {
+        [method] if split(method).is_some() => Ok(BvhCommand::Split(split(method).expect("checked"), None)),
+        ["sah", planes] => positive_int(planes)
+            .filter(|&n| n <= 255)
+            .map(|n| BvhCommand::Split(CourseSplit::Sah, Some(n)))
+            .ok_or_else(|| format!("sah expects a number of planes from 1 to 255 (got '{planes}')")),
+        ["triangles", "single"] => Ok(BvhCommand::LeafSize(1)),
+        ["triangles", "multiple", n] => positive_int(n)
+            .filter(|&n| n <= 255)
+            .map(BvhCommand::LeafSize)
+            .ok_or_else(|| format!("triangles multiple expects a leaf size from 1 to 255 (got '{n}')")),
+        ["statistics"] => Ok(BvhCommand::Statistics),
+        ["export", depth, file] => depth
+            .parse::<usize>()
+            .map(|depth| BvhCommand::Export { depth, file: file.into() })
+            .map_err(|_| format!("export expects a depth (a whole number) and an .obj file (got '{depth}')")),
+        _ => {
+            Err("expects om|sm|sah [NPLANES], triangles single|multiple N, statistics or export DEPTH FILE.obj"
+                .to_owned())
+        }
+    }
+}
+
+fn algo(words: &[&str]) -> Result<Command, String> {
+    let algo = match words {
+        ["primary"] => Algo::Primary,
+        ["info"] => Algo::Info,
+        ["local"] => Algo::Local,
+        ["direct"] => Algo::Direct,
+        ["direct/mis"] => Algo::DirectMis,
+        ["simple-pt"] => Algo::SimplePt,
+        ["pt"] => Algo::Pt,
+        ["primary-wf" | "direct-wf"] => {
+            return Ok(Command::Unavailable { command: "algo", feature: "wavefront algorithms" });
+        }
+        [name] => {
+            return Err(format!(
+                "there is no gi algorithm called '{name}' (primary, info, local, direct, direct/mis, simple-pt, pt)"
+            ));
+        }
+        _ => return Err("expects one algorithm: primary, info, local, direct, direct/mis, simple-pt or pt".to_owned()),
+    };
+    Ok(Command::Algo(algo))
+}
+
+fn path(words: &[&str]) -> Result<PathSetting, String> {
+    match words {
+        ["len", n] => positive_int(n)
+            .filter(|&n| n <= 1025)
+            .map(PathSetting::Length)
+            .ok_or_else(|| format!("len expects a positive whole number up to 1025 (got '{n}')")),
+        ["rr-start", n] => positive_int(n)
+            .map(PathSetting::RouletteStart)
+            .ok_or_else(|| format!("rr-start expects a positive whole number (got '{n}')")),
+        ["bounce", "uniform"] => Ok(PathSetting::Bounce(BounceSampling::Uniform)),
+        ["bounce", "cosine"] => Ok(PathSetting::Bounce(BounceSampling::Cosine)),
+        ["bounce", "brdf"] => Ok(PathSetting::Bounce(BounceSampling::Bsdf)),
+        ["bounce", other] => Err(format!("invalid kind of path bounce '{other}' (uniform, cosine or brdf)")),
+        ["mis", "on"] => Ok(PathSetting::Mis(true)),
+        ["mis", "off"] => Ok(PathSetting::Mis(false)),
+        ["mis", ..] => Err("usage: path mis on|off".to_owned()),
+        [other, ..] => Err(format!("unknown subcommand to path '{other}' (len, rr-start, bounce, mis)")),
+        [] => Err("expects len N, rr-start N, bounce uniform|cosine|brdf or mis on|off".to_owned()),
+    }
+}
+
+fn material(words: &[&str], rest: &str) -> Result<MaterialCommand, String> {
+    let Some((&sub, args)) = words.split_first() else {
+        return Err("expects list, select NAME, blacklist NAME, or a setting of the selected material".to_owned());
+    };
+    // The name is the rest of the line after the subcommand, spaces and all.
+    let name = rest[sub.len()..].trim();
+    let colour = |what: &str| {
+        numbers(args, 3)
+            .map(|v| Vec3::from_slice(&v))
+            .ok()
+            .filter(|c| c.min_element() >= 0.0)
+            .ok_or_else(|| format!("{what} expects a colour triplet R G B of numbers of at least 0"))
+    };
+    let number = |what: &str, accept: fn(f32) -> bool, allowed: &str| {
+        numbers(args, 1)
+            .ok()
+            .map(|v| v[0])
+            .filter(|&v| accept(v))
+            .ok_or_else(|| format!("{what} expects {allowed} (got '{}')", args.join(" ")))
+    };
+    match sub {
+        "list" if args.is_empty() => Ok(MaterialCommand::List),
+        "select" if !name.is_empty() => Ok(MaterialCommand::Select(name.to_owned())),
+        "blacklist" if !name.is_empty() => Ok(MaterialCommand::Blacklist(name.to_owned())),
+        "select" | "blacklist" => Err(format!("{sub} expects a material name")),
+        "albedo" => colour("albedo").map(MaterialCommand::Albedo),
+        "emissive" => colour("emissive").map(MaterialCommand::Emissive),
+        "roughness" => number("roughness", |v| v >= 0.0, "a number of at least 0").map(MaterialCommand::Roughness),
+        "ior" => number("ior", |v| v > 0.0, "a number above 0").map(MaterialCommand::Ior),
+        "texture" => match args {
+            ["drop"] => Ok(MaterialCommand::Texture(None)),
+            [file] => Ok(MaterialCommand::Texture(Some(file.into()))),
+            _ => Err("texture expects one file name (no spaces) or 'drop'".to_owned()),
+        },
+        "brdf" => match args {
+            [name] => CourseBrdf::from_name(name).map(MaterialCommand::Brdf),
+            _ => Err(format!("brdf expects one BRDF name: {}", CourseBrdf::NAMES)),
+        },
+        "show" if args.is_empty() => Ok(MaterialCommand::Show),
+        "list" | "show" => Err(format!("{sub} takes no further arguments")),
+        other => Err(format!(
+            "unknown subcommand '{other}' (list, select, blacklist, albedo, emissive, roughness, ior, texture, brdf, show)"
+        )),
+    }
+}
+
+fn point_light(words: &[&str]) -> Result<Command, String> {
+    let usage = "usage: pointlight [replace] pos X Y Z col R G B";
+    let (replace, words) = match words.split_first() {
+        Some((&"replace", rest)) => (true, rest),
+        _ => (false, words),
+    };
+    match words {
+        ["pos", x, y, z, "col", r, g, b] => {
+            let position =
+                numbers(&[x, y, z], 3).map_err(|got| format!("pos expects 3 numbers (got '{got}'); {usage}"))?;
+            let colour = numbers(&[r, g, b], 3)
+                .ok()
+                .filter(|c| c.iter().all(|&v| v >= 0.0))
+                .ok_or_else(|| format!("col expects 3 numbers of at least 0; {usage}"))?;
+            Ok(Command::PointLight {
+                replace,
+                position: Vec3::from_slice(&position),
+                colour: Vec3::from_slice(&colour),
+            })
+        }
+        _ => Err(usage.to_owned()),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn reads_the_course_commands() {
+        assert_eq!(parse("  # a comment").unwrap(), Command::Nothing);
+        assert_eq!(parse("// another").unwrap(), Command::Nothing);
+        assert_eq!(parse("").unwrap(), Command::Nothing);
+        assert_eq!(parse("at -13 -12 0").unwrap(), Command::At(Some(Vec3::new(-13.0, -12.0, 0.0))));
+        assert_eq!(parse("at").unwrap(), Command::At(None));
+        assert_eq!(
+            parse("raytracer bbvh sah 8").unwrap(),
+            Command::Raytracer(Tracer::Bbvh(Some((CourseSplit::Sah, Some(8)))))
+        );
+        assert_eq!(parse("raytracer bbvh indexed esc").unwrap(), Command::Raytracer(Tracer::Bbvh(None)));
+        assert_eq!(parse("raytracer bvh8").unwrap(), Command::Raytracer(Tracer::Ours(AccelKind::Bvh8)));
+        assert_eq!(
+            parse("material select kamen zid").unwrap(),
+            Command::Material(MaterialCommand::Select("kamen zid".into()))
+        );
+        assert_eq!(parse("echo  >>>> WITH RR").unwrap(), Command::Echo(">>>> WITH RR".into()));
+        assert_eq!(
+            parse("pointlight replace pos 7 -8 0 col 7 4 2").unwrap(),
+            Command::PointLight {
+                replace: true,
+                position: Vec3::new(7.0, -8.0, 0.0),
+                colour: Vec3::new(7.0, 4.0, 2.0)
+            }
+        );
+        let rows = "modelmatrix 1 0 0 5  0 1 0 6  0 0 1 7  0 0 0 1";
+        assert_eq!(parse(rows).unwrap(), Command::ModelMatrix(Mat4::from_translation(Vec3::new(5.0, 6.0, 7.0))));
+        assert_eq!(parse("path bounce cosine").unwrap(), Command::Path(PathSetting::Bounce(BounceSampling::Cosine)));
+        assert_eq!(parse("with cuda {").unwrap(), Command::With("cuda".into()));
+    }
+
+    #[test]
+    fn says_what_a_command_expects() {
+        for (line, expected) in [
+            ("at 1 2", "expects 3 numbers, X Y Z (got '1 2')"),
+            ("resolution 640", "two positive whole numbers"),
+            ("sppx -3", "one positive whole number (got '-3')"),
+            ("raytracer kd-tree", "no ray tracer called 'kd-tree'"),
+            ("raytracer bbvh median", "no such bbvh variant 'median'"),
+            ("algo photon-map", "no gi algorithm called 'photon-map'"),
+            ("is importance", "uniform, cosine, light, brdf (got 'importance')"),
+            ("material roughness x", "roughness expects a number of at least 0 (got 'x')"),
+            ("material brdf velvet", "No such brdf defined: velvet"),
+            ("pointlight pos 1 2 3", "usage: pointlight [replace] pos X Y Z col R G B"),
+            ("skylight scale 0", "above 0"),
+            ("} x", "} must be on an otherwise empty line"),
+            ("commit now", "takes no arguments"),
+            ("teleport", "unknown command"),
+        ] {
+            let error = parse(line).unwrap_err();
+            assert!(error.contains(expected), "{line}: {error}");
+        }
+    }
+}
