@@ -273,7 +273,7 @@ pub(crate) fn parse(line: &str) -> Result<Command, String> {
             },
             _ => Err("expects 'load FILE SCALE' or 'scale S'".to_owned()),
         },
-        "skytest" => Ok(Command::Unavailable { command: "skytest", feature: "the sky distribution's debug images" }),
+        "skytest" => Ok(Command::Unavailable { command: "skytest", feature: "debug images of the sky's distribution" }),
         "echo" => Ok(Command::Echo(rest.to_owned())),
         "stats" => match words[..] {
             ["print"] => Ok(Command::StatsPrint),
@@ -305,9 +305,9 @@ pub(crate) fn parse(line: &str) -> Result<Command, String> {
         "}" => none(Command::EndBlock).map_err(|_| "} must be on an otherwise empty line".to_owned()),
         "preview-offset" => {
             one_positive(&words)?;
-            Ok(Command::Unavailable { command: "preview-offset", feature: "the preview window" })
+            Ok(Command::Unavailable { command: "preview-offset", feature: "preview window" })
         }
-        "move-speed" => Ok(Command::Unavailable { command: "move-speed", feature: "the preview window" }),
+        "move-speed" => Ok(Command::Unavailable { command: "move-speed", feature: "preview window" }),
         "add-scene-step" => Ok(Command::Unavailable { command: "add-scene-step", feature: "wavefront steps" }),
         _ => Err("unknown command".to_owned()),
     }

@@ -220,10 +220,12 @@ impl Session {
             }
             return Ok(Flow::Continue);
         }
-        let command = super::parse::parse(line).map_err(|e| anyhow!(e))?;
-        if command != Command::Nothing && command != Command::History {
-            self.history.push(line.trim().to_owned());
+        // The framework keeps every line in the history, bad ones too.
+        let trimmed = line.trim();
+        if !trimmed.is_empty() && trimmed != "history" {
+            self.history.push(trimmed.to_owned());
         }
+        let command = super::parse::parse(line).map_err(|e| anyhow!(e))?;
         self.clock.now += 1;
         self.apply(command)
     }
@@ -344,7 +346,7 @@ impl Session {
                 outln!("Skipping a block due to missing {feature} (rtgi has no {feature})")?;
             }
             Command::Unavailable { command, feature } => {
-                self.say_once(command, &format!("{command}: rtgi has no {feature}; the script goes on"))
+                self.say_once(feature, &format!("{command}: rtgi has no {feature}; the script goes on"))
             }
         }
         Ok(Flow::Continue)
