@@ -56,6 +56,10 @@ fn a_script_writes_the_bytes_of_the_render_command_it_prints_for_every_algorithm
             panic!("{name}: the script prints its rtgi render command: {run:?}");
         });
         let script_image = std::fs::read(dir.join("script.png")).unwrap();
+        let rays = |stdout: &str| {
+            stdout.lines().find_map(|l| l.strip_prefix("rays")).map(|r| r.split_whitespace().next().unwrap().to_owned())
+        };
+        let script_rays = rays(&run.stdout);
         // The printed command, writing elsewhere.
         let cli_output = dir.join(format!("{name}-cli.png"));
         let mut args: Vec<String> = line.split_whitespace().map(str::to_owned).collect();
@@ -64,6 +68,11 @@ fn a_script_writes_the_bytes_of_the_render_command_it_prints_for_every_algorithm
         let run = run_cli(RTGI, &args.iter().map(String::as_str).collect::<Vec<_>>());
         assert!(run.success, "{name}: {run:?}");
         assert!(script_image == std::fs::read(&cli_output).unwrap(), "{name}: the script and `rtgi {line}` differ");
+        // And what it measures is the same work: the rays it traced.
+        assert!(
+            script_rays.is_some() && script_rays == rays(&run.stdout),
+            "{name}: rays {script_rays:?} against {run:?}"
+        );
     }
 }
 
