@@ -132,6 +132,24 @@ pub fn run_cli(program: &str, args: &[&str]) -> Run {
         .into()
 }
 
+/// Runs the `rtgi` command (the binary at `program`) with `args` in the
+/// workspace root, writing `stdin` to its standard input.
+pub fn run_cli_with_input(program: &str, args: &[&str], stdin: &[u8]) -> Run {
+    use std::io::Write as _;
+    use std::process::Stdio;
+    let mut child = Command::new(program)
+        .args(args)
+        .current_dir(workspace_root())
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("cannot start the rtgi binary");
+    // A command that stops reading early closes the pipe: that is its answer, not an error here.
+    let _ = child.stdin.take().expect("piped").write_all(stdin);
+    child.wait_with_output().expect("cannot wait for the rtgi binary").into()
+}
+
 /// Runs `check` on every acceleration structure variant with a spread of
 /// build parameters ([`AccelKind::all_configurations`]), built over
 /// `triangles` (a soup, an indexed mesh or any [`TriangleSource`]); the

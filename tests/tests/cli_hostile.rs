@@ -2,7 +2,7 @@
 //! standard output whose reader goes away, ray files that are not ray
 //! files. It must never panic, and its errors must say what to do instead.
 
-use std::io::{BufRead, BufReader, Write};
+use std::io::{BufRead, BufReader};
 use std::path::Path;
 use std::process::{Command, Stdio};
 
@@ -11,7 +11,7 @@ use rtgi_image::HdrImage;
 use rtgi_math::{Ray, Rng, Vec3};
 use rtgi_render::rays::uniform_sphere;
 use rtgi_scene::Scene;
-use rtgi_tests::{Run, run_cli, scratch_dir, workspace_root};
+use rtgi_tests::{Run, run_cli, run_cli_with_input, scratch_dir, workspace_root};
 
 const RTGI: &str = env!("CARGO_BIN_EXE_rtgi-under-test");
 const BOX: &str = "scenes/cornell-box.toml";
@@ -291,16 +291,7 @@ fn trace_refuses_a_stream_that_ends_inside_a_record() {
     let out = dir.join("hits.bin");
     let mut bytes = encode(&random_rays(2));
     bytes.extend_from_slice(&[0; 8]);
-    let mut child = Command::new(RTGI)
-        .args(["trace", BOX, "--rays", "/dev/stdin", "--out", s(&out)])
-        .current_dir(workspace_root())
-        .stdin(Stdio::piped())
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
-    child.stdin.take().unwrap().write_all(&bytes).unwrap();
-    let run: Run = child.wait_with_output().unwrap().into();
+    let run = run_cli_with_input(RTGI, &["trace", BOX, "--rays", "/dev/stdin", "--out", s(&out)], &bytes);
     assert_refused(&run, &["72 bytes", "multiple of 32"], &out);
 }
 

@@ -5,11 +5,10 @@
 //! understood; and the scripts of the course's stages, in `scenes/course/`,
 //! run on the shared scenes.
 
-use std::io::Write as _;
 use std::path::{Path, PathBuf};
-use std::process::{Command, Stdio};
+use std::process::Command;
 
-use rtgi_tests::{Run, run_cli, scratch_dir, shared_scenes, workspace_root};
+use rtgi_tests::{Run, run_cli, run_cli_with_input, scratch_dir, shared_scenes, workspace_root};
 
 const RTGI: &str = env!("CARGO_BIN_EXE_rtgi-under-test");
 /// The team's Cornell box (millimetres), from the workspace root.
@@ -203,16 +202,8 @@ fn features_rtgi_lacks_are_said_in_one_line_and_the_script_goes_on() {
 
 #[test]
 fn the_prompt_reports_a_bad_line_and_goes_on() {
-    let mut child = Command::new(RTGI)
-        .arg("repl")
-        .current_dir(workspace_root())
-        .stdin(Stdio::piped())
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
-    child.stdin.take().unwrap().write_all(b"at 1\necho still here\nat 1 2 3\nat\nhistory\nquit\necho gone\n").unwrap();
-    let run: Run = child.wait_with_output().unwrap().into();
+    let input = b"at 1\necho still here\nat 1 2 3\nat\nhistory\nquit\necho gone\n";
+    let run = run_cli_with_input(RTGI, &["repl"], input);
     assert!(run.success, "{run:?}");
     assert!(run.stderr.contains("error: 'at 1': expects 3 numbers"), "{run:?}");
     assert!(run.stdout.contains("still here\n1 2 3\n"), "{run:?}");
