@@ -57,8 +57,8 @@ pub fn default_camera<A: Accel + ?Sized>(scene: &Scene, accel: &A, aspect: f32) 
 /// The candidates, in order of preference:
 /// - a three-quarter view, like a product shot: from the front (+Z, the
 ///   side glTF models face and scanned models usually do) turned 35
-///   degrees towards +X and raised 25 degrees, centred on the bounds and
-///   close enough that they fill 90% of the frame; for a model much longer
+///   degrees towards +X and raised 25 degrees, moved until the model's
+///   vertices fill 90% of the frame, centred ([`framed_tightly`]); for a model much longer
 ///   along Z than along X (a vehicle facing +X or -X), the same view taken
 ///   from its long side;
 /// - the bounds seen straight from +Z (the classic view into a Cornell box);
@@ -86,7 +86,7 @@ pub fn frame_scene<A: Accel + ?Sized>(scene: &Scene, accel: &A, vertical_fov: f3
     let extent = bounds.extent();
     let along_room = if extent.x > extent.z { -Vec3::X } else { -Vec3::Z };
     let inside = Camera::look_at(centre, centre + along_room, Vec3::Y, vertical_fov);
-    let product = three_quarter_view(&bounds, vertical_fov, aspect);
+    let product = framed_tightly(scene, &three_quarter_view(&bounds, vertical_fov, aspect), aspect);
     // A room closed on all sides is seen from a corner; an open courtyard
     // keeps the views that show its sky.
     let enclosed = crate::sky_visibility(accel, centre) < crate::ENCLOSED;
@@ -152,6 +152,55 @@ pub fn three_quarter_view(bounds: &Aabb, vertical_fov: f32, aspect: f32) -> Came
     Camera::look_at(centre + towards_camera * distance, centre, Vec3::Y, vertical_fov)
 }
 
+/// `camera` moved along its own axes, its direction kept, to the closest
+/// position from which every vertex of the scene's triangles lies within
+/// [`FILL`] of the frame, centred: the model's silhouette, not its bounding
+/// box, fills the view (a box's corners, seen three-quarter on, leave a
+/// round model a fifth of the frame). Every vertex stays in front of the
+/// camera. A scene without vertices keeps the camera as it is.
+pub fn framed_tightly(scene: &Scene, camera: &Camera, aspect: f32) -> Camera {
+    let forward = camera.direction.normalize();
+    let right = forward.cross(camera.up).normalize();
+    let up = right.cross(forward);
+    if !(forward.is_finite() && right.is_finite()) {
+        return *camera;
+    }
+    let tan_vertical = FILL * (0.5 * camera.vertical_fov).tan();
+    let tan_horizontal = tan_vertical * aspect;
+    // In the camera's axes, a point p is in frame from position c when
+    // |p_r - c_r| <= T (p_f - c_f) on each side: c_r - T c_f >= max(p_r - T p_f)
+    // and c_r + T c_f <= min(p_r + T p_f). The largest c_f (the closest
+    // camera) meets both with c_r half-way between.
+    let (mut low_r, mut high_r, mut low_u, mut high_u) =
+        (f32::NEG_INFINITY, f32::INFINITY, f32::NEG_INFINITY, f32::INFINITY);
+    let mut used = vec![false; scene.vertices.len()];
+    for triangle in &scene.triangles {
+        for &v in &triangle.vertices {
+            used[v as usize] = true;
+        }
+    }
+    for (vertex, _) in scene.vertices.iter().zip(&used).filter(|(v, used)| **used && v.position.is_finite()) {
+        let p = vertex.position;
+        let (pr, pu, pf) = (p.dot(right), p.dot(up), p.dot(forward));
+        low_r = low_r.max(pr - tan_horizontal * pf);
+        high_r = high_r.min(pr + tan_horizontal * pf);
+        low_u = low_u.max(pu - tan_vertical * pf);
+        high_u = high_u.min(pu + tan_vertical * pf);
+    }
+    if !(low_r.is_finite() && high_r.is_finite() && low_u.is_finite() && high_u.is_finite()) {
+        return *camera;
+    }
+    let along = ((high_r - low_r) / (2.0 * tan_horizontal)).min((high_u - low_u) / (2.0 * tan_vertical));
+    let across = 0.5 * (low_r + high_r);
+    let height = 0.5 * (low_u + high_u);
+    let position = right * across + up * height + forward * along;
+    // As long as the way to the model's centre, so that position + direction is the point looked at.
+    let depth = (scene.bounds().centroid() - position).dot(forward);
+    let direction = forward * if depth > 0.0 { depth } else { camera.direction.length() };
+    let moved = Camera { position, direction, ..*camera };
+    if moved.is_valid() && position.is_finite() { moved } else { *camera }
+}
+
 /// Whether `camera` looks out from inside geometry: more than half of a
 /// grid of rays through the view hit a surface from behind (a back face) or
 /// within a ten-thousandth of the scene's size. Returns the fraction of
@@ -201,6 +250,44 @@ fn probe_rays(camera: &Camera, aspect: f32) -> Vec<rtgi_math::Ray> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The tight framing puts every vertex inside the frame's fill and
+    /// touches its edge on both sides of the limiting axis: the model's
+    /// silhouette, not its box, decides. A lopsided model (a long thin
+    /// arm off a small block) is framed by what it has, not by its corners.
+    #[test]
+    fn tight_framing_fills_the_frame_with_the_model() {
+        let obj = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nv 4 3 0.2\nv 4.1 3 0.2\nv 4 3.1 0.2\n\
+                   f 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\nf 2 5 6\nf 3 7 5\n";
+        let scene = Scene::load_from_bytes("lopsided.obj", obj.as_bytes(), &|_| None).unwrap();
+        for aspect in [1.0, 16.0 / 9.0, 0.5] {
+            let fov = 40f32.to_radians();
+            let loose = three_quarter_view(&scene.bounds(), fov, aspect);
+            let camera = framed_tightly(&scene, &loose, aspect);
+            let forward = camera.direction.normalize();
+            let right = forward.cross(camera.up).normalize();
+            let up = right.cross(forward);
+            let (tan_v, tan_h) = (FILL * (0.5 * fov).tan(), FILL * (0.5 * fov).tan() * aspect);
+            let (mut lo, mut hi) = (Vec2::splat(f32::INFINITY), Vec2::splat(f32::NEG_INFINITY));
+            for v in &scene.vertices {
+                let offset = v.position - camera.position;
+                let depth = offset.dot(forward);
+                assert!(depth > 0.0, "every vertex in front of the camera");
+                let p = Vec2::new(offset.dot(right) / (depth * tan_h), offset.dot(up) / (depth * tan_v));
+                (lo, hi) = (lo.min(p), hi.max(p));
+            }
+            assert!(lo.min_element() >= -1.0 - 1e-4 && hi.max_element() <= 1.0 + 1e-4, "{aspect}: {lo} {hi}");
+            // Centred on the limiting axis, and touching the fill there.
+            let limiting = if hi.x - lo.x > hi.y - lo.y { 0 } else { 1 };
+            assert!((lo[limiting] + 1.0).abs() < 1e-3 && (hi[limiting] - 1.0).abs() < 1e-3, "{aspect}: {lo} {hi}");
+            // Closer than the box's framing, looking the same way.
+            assert!(
+                camera.position.distance(scene.bounds().centroid())
+                    < loose.position.distance(scene.bounds().centroid())
+            );
+            assert!(forward.dot(loose.direction.normalize()) > 0.99999);
+        }
+    }
 
     /// A room 10 x 3 x 8 with its faces wound inwards, a table in the
     /// middle, chairs along it and a picture on one wall, each its own

@@ -58,7 +58,9 @@ pub use default_lighting::{ENCLOSED, default_sky, default_sun, room_light, sky_v
 pub use distribution::Distribution1D;
 pub use effect_set::EffectSet;
 pub use effects::{Effect, EffectOverrides, EffectPlan, PlannedEffect, Reversal};
-pub use framing::{DEFAULT_VERTICAL_FOV_DEGREES, camera_blocked, default_camera, frame_scene, three_quarter_view};
+pub use framing::{
+    DEFAULT_VERTICAL_FOV_DEGREES, camera_blocked, default_camera, frame_scene, framed_tightly, three_quarter_view,
+};
 pub use identity::{Difference, RenderIdentity, scene_fingerprint};
 pub use integrator::{DirectStrategy, Integrator, ROULETTE_START};
 pub use lights::{Environment, EnvironmentMap, EnvironmentSpec, EnvironmentSpecError, LightSet};
