@@ -162,15 +162,25 @@ fn a_bad_line_names_the_file_the_line_and_the_command_and_stops_the_script() {
         ("skylight scale 2", "there is no skylight to scale"),
         ("up 0 1 0\nup 0 0 1", "cannot set the scene's up vector twice; did you mean camup?"),
         ("material brdf velvet", "No such brdf defined: velvet"),
+        ("laod scenes/cornell-box.toml", "unknown command; did you mean 'load'?"),
+        ("algo direct/mis\nis light", "algo direct/mis samples the light and the BRDF and weighs them"),
+        (
+            "raytracer naive-bvh\nbvh triangles multiple 4",
+            "naive-bvh splits at the object median with one triangle a leaf",
+        ),
+        ("camup 0 0 0", "the direction must not be 0 0 0"),
+        ("with optix {\necho skipped", "the block has no closing '}' on a line of its own"),
     ] {
         let text = format!("echo first\n{line}\necho never\n");
         let run = script(&dir, "bad", &text, &[]);
         assert_eq!(run.code, Some(1), "{line}: {run:?}");
-        let last = line.lines().last().unwrap();
+        // The line at fault: the last, or the block that never closes.
+        let last = line.lines().find(|l| l.starts_with("with")).unwrap_or_else(|| line.lines().last().unwrap());
         let number = text.lines().position(|l| l == last).unwrap() + 1;
         let named = format!("bad.rtgi:{number}: '{last}': ");
         assert!(run.stderr.contains(&named) && run.stderr.contains(expected), "{line}: {run:?}");
         assert!(run.stdout.contains("first") && !run.stdout.contains("never"), "{line}: the script stops there");
+        assert!(!run.stderr.contains("panicked"), "{line}: {run:?}");
     }
     let run = run_cli(RTGI, &["script", "no-such-script.rtgi"]);
     assert_eq!(run.code, Some(1), "{run:?}");
@@ -190,7 +200,7 @@ fn features_rtgi_lacks_are_said_in_one_line_and_the_script_goes_on() {
     for said in [
         "platform opengl: rtgi has no GPU or wavefront platforms",
         "preview-offset: rtgi has no preview window",
-        "algo: rtgi has no wavefront algorithms",
+        "algo primary-wf: rtgi has no wavefront algorithms; algo primary renders what it renders",
         "skytest: rtgi has no debug images of the sky's distribution",
         "add-scene-step: rtgi has no wavefront steps",
     ] {
@@ -210,6 +220,46 @@ fn the_prompt_reports_a_bad_line_and_goes_on() {
     // History holds the lines that ran, bad ones too (the framework's).
     assert!(run.stdout.contains("at 1\necho still here\nat 1 2 3\nat\n"), "{run:?}");
     assert!(!run.stdout.contains("gone"), "{run:?}");
+}
+
+#[test]
+fn older_and_other_spellings_of_the_course_are_taken_as_it_meant_them() {
+    let dir = scratch_dir("script-spellings");
+    // `is mis` (older scripts), a wavefront algorithm, a byte-order mark.
+    let text =
+        format!("{}# saved by an editor that marks UTF-8\n{}", "\u{feff}", boxed(&dir, "algo direct-wf\nis mis"));
+    let run = script(&dir, "older", &text, &[]);
+    assert!(run.success, "{run:?}");
+    assert!(run.stderr.contains("algo direct-wf: rtgi has no wavefront algorithms; algo direct renders"), "{run:?}");
+    assert!(run.stderr.contains("is mis: algo direct now weighs light and BRDF samples"), "{run:?}");
+    assert!(run.stdout.contains("--direct-strategy mis"), "{run:?}");
+    // Under direct/mis, `is mis` says what it already does.
+    let run = script(&dir, "mis", &boxed(&dir, "algo direct/mis\nis mis"), &[]);
+    assert!(run.success && !run.stderr.contains("is mis:"), "{run:?}");
+}
+
+#[test]
+fn a_script_error_before_the_prompt_is_reported_and_the_prompt_opens() {
+    let dir = scratch_dir("script-then-prompt");
+    let path = dir.join("bad.rtgi");
+    std::fs::write(&path, "at 1 2 3\nat 1 2\n").unwrap();
+    let run = run_cli_with_input(RTGI, &["script", path.to_str().unwrap(), "-l"], b"at\nquit\n");
+    assert!(run.success, "{run:?}");
+    assert!(run.stderr.contains("bad.rtgi:2: 'at 1 2': expects 3 numbers"), "{run:?}");
+    assert!(run.stdout.contains("1 2 3"), "the prompt goes on in the script's session: {run:?}");
+}
+
+#[test]
+fn warnings_in_a_script_name_its_commands() {
+    let dir = scratch_dir("script-phrasing");
+    // The box's lamp switched off, no other light: black.
+    let run = script(&dir, "dark", &boxed(&dir, "material select light\nmaterial emissive 0 0 0\nalgo direct"), &[]);
+    assert!(run.success, "{run:?}");
+    assert!(
+        run.stderr.contains("almost black") && run.stderr.contains("add light (pointlight or skylight load)"),
+        "{run:?}"
+    );
+    assert!(run.stderr.contains("move the camera (at (and look))") && !run.stderr.contains("--"), "{run:?}");
 }
 
 #[test]

@@ -105,17 +105,44 @@ impl LightingArgs {
     }
 }
 
+/// Whose words the hints of warnings use: the command line's options, or
+/// the commands of a script in the course framework's language.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Phrasing {
+    Options,
+    Script,
+}
+
+impl Phrasing {
+    /// How to move the camera.
+    pub(crate) fn move_camera(self) -> &'static str {
+        match self {
+            Phrasing::Options => "--at (and --look)",
+            Phrasing::Script => "at (and look)",
+        }
+    }
+
+    /// How to add light.
+    pub(crate) fn add_light(self) -> &'static str {
+        match self {
+            Phrasing::Options => "--environment 1,1,1 or --light",
+            Phrasing::Script => "pointlight or skylight load",
+        }
+    }
+}
+
 /// Says which of several file cameras was used, and warns that a camera
 /// from the file or the options seems to be inside geometry.
-pub(crate) fn report_camera(chosen: &ChosenCamera) {
+pub(crate) fn report_camera(chosen: &ChosenCamera, phrasing: Phrasing) {
     if let Some(choice) = &chosen.file_choice {
         eprintln!("note: the view is {choice}");
     }
     if let Some(fraction) = chosen.blocked {
         eprintln!(
             "warning: the camera seems to be inside geometry: {:.0}% of the rays through its view hit the back of a \
-             surface or start against one; move it with --at (and --look)",
-            100.0 * fraction
+             surface or start against one; move it with {}",
+            100.0 * fraction,
+            phrasing.move_camera()
         );
     }
 }
@@ -125,7 +152,7 @@ pub(crate) fn report_camera(chosen: &ChosenCamera) {
 /// when a given camera seems buried.
 pub(crate) fn choose_camera(scene: &Scene, accel: &dyn Accel, options: &CameraArgs, aspect: f32) -> Result<Camera> {
     let chosen = recipe::choose_camera(scene, accel, &options.choice(), aspect)?;
-    report_camera(&chosen);
+    report_camera(&chosen, Phrasing::Options);
     Ok(chosen.camera)
 }
 
@@ -164,7 +191,7 @@ pub(crate) fn prepare_render(
 ) -> Result<(Box<dyn Accel>, Prepared)> {
     apply_lighting(lighting, scene, settings)?;
     let built = pool.install(|| accel.build(scene))?;
-    let prepared = prepare_view(scene, built.as_ref(), settings, camera)?;
+    let prepared = prepare_view(scene, built.as_ref(), settings, camera, Phrasing::Options)?;
     Ok((built, prepared))
 }
 
@@ -175,9 +202,10 @@ pub(crate) fn prepare_view(
     accel: &dyn Accel,
     settings: &mut RenderSettings,
     camera: &CameraArgs,
+    phrasing: Phrasing,
 ) -> Result<Prepared> {
     let prepared = recipe::prepare(scene, accel, settings, &camera.choice())?;
-    report_camera(&prepared.camera);
+    report_camera(&prepared.camera, phrasing);
     Ok(prepared)
 }
 

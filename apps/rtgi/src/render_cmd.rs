@@ -10,7 +10,7 @@ use rtgi_render::{
 use crate::cli::ToneArgs;
 use crate::cli::{RenderArgs, reshaped};
 use crate::common::{
-    LoadedScene, Structure, apply_lighting, check_output_folder, load_scene, prepare_render, prepare_view,
+    LoadedScene, Phrasing, Structure, apply_lighting, check_output_folder, load_scene, prepare_render, prepare_view,
     refuse_inputs_as_outputs,
 };
 use crate::interrupt;
@@ -139,7 +139,8 @@ pub(crate) fn render_given(args: &RenderArgs, given: Option<Given<'_>>) -> Resul
         }
         Some(committed) => {
             apply_lighting(&args.lighting, &mut scene, &mut settings)?;
-            (Structure::Committed(committed), prepare_view(&mut scene, committed, &mut settings, &args.camera)?)
+            let view = prepare_view(&mut scene, committed, &mut settings, &args.camera, Phrasing::Script)?;
+            (Structure::Committed(committed), view)
         }
     };
     let (camera, room_light) = (prepared.camera.camera, prepared.room_light);
@@ -279,7 +280,8 @@ pub(crate) fn render_given(args: &RenderArgs, given: Option<Given<'_>>) -> Resul
             say!("exposure    {:+.1} stops ({how}), {} tone map", tone_map.exposure, tone_map.operator);
         }
         if let Some(image) = &image {
-            warn_if_illegible(image, &tone_map, args.tone.exposure.is_some());
+            let phrasing = if from_script { Phrasing::Script } else { Phrasing::Options };
+            warn_if_illegible(image, &tone_map, args.tone.exposure.is_some(), phrasing);
         }
     } else {
         say!("wrote       nothing: no sample finished");
@@ -304,24 +306,27 @@ pub(crate) fn render_given(args: &RenderArgs, given: Option<Given<'_>>) -> Resul
 
 /// Says so when the image came out almost black or almost white, with the
 /// options that help.
-fn warn_if_illegible(image: &HdrImage, tone_map: &ToneMap, exposure_given: bool) {
+fn warn_if_illegible(image: &HdrImage, tone_map: &ToneMap, exposure_given: bool, phrasing: Phrasing) {
     match legibility(image, tone_map) {
         Some(Legibility::AlmostBlack(fraction)) => {
-            let exposure = if exposure_given { "raise --exposure, or " } else { "" };
+            // A script's images are not exposed (as the course's are not).
+            let exposure = if exposure_given && phrasing == Phrasing::Options { "raise --exposure, or " } else { "" };
             eprintln!(
                 "warning: the image is almost black ({:.0}% of its pixels): the scene's lights may be too weak \
-                 or hidden from the view, or the camera inside geometry; {exposure}add light (--environment \
-                 1,1,1 or --light), or move the camera (--at, --look)",
-                100.0 * fraction
+                 or hidden from the view, or the camera inside geometry; {exposure}add light ({}), or move the \
+                 camera ({})",
+                100.0 * fraction,
+                phrasing.add_light(),
+                phrasing.move_camera()
             );
         }
         Some(Legibility::AlmostWhite(fraction)) => {
-            let exposure =
-                if exposure_given { "lower --exposure or leave it out (automatic)" } else { "lower --exposure" };
-            eprintln!(
-                "warning: the image is almost white ({:.0}% of its pixels): {exposure}, or use --tonemap aces",
-                100.0 * fraction
-            );
+            let what = match phrasing {
+                Phrasing::Script => "the light is too strong for an image that is not exposed: dim the lights (pointlight col, skylight scale, material emissive)".to_owned(),
+                Phrasing::Options if exposure_given => "lower --exposure or leave it out (automatic), or use --tonemap aces".to_owned(),
+                Phrasing::Options => "lower --exposure, or use --tonemap aces".to_owned(),
+            };
+            eprintln!("warning: the image is almost white ({:.0}% of its pixels): {what}", 100.0 * fraction);
         }
         None => {}
     }

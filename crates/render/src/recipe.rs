@@ -169,9 +169,16 @@ pub fn choose_camera(
         // No camera in the file, or none worth taking: the automatic view
         // (already framed, at the default field of view, when it was
         // compared with the file's).
-        None => automatic_view
-            .filter(|_| choice.fov_degrees.is_none())
-            .unwrap_or_else(|| frame_scene(scene, accel, fov, aspect)),
+        None => automatic_view.filter(|_| choice.fov_degrees.is_none()).unwrap_or_else(|| {
+            // A position given replaces everything the automatic view would
+            // choose but its up (+Y): its probe rays would cost seconds
+            // through a slow structure (the linear scan) for nothing.
+            if choice.at.is_some() {
+                Camera::framing(&scene.bounds(), fov, aspect)
+            } else {
+                frame_scene(scene, accel, fov, aspect)
+            }
+        }),
     };
     camera.vertical_fov = fov;
     if let Some(up) = choice.up {

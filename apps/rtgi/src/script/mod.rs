@@ -55,8 +55,16 @@ pub(crate) fn run(args: &ScriptArgs) -> Result<()> {
         model_paths: args.model_paths.clone(),
     });
     for script in &args.scripts {
-        if run_file(&mut session, script)? == Flow::Quit {
-            return Ok(());
+        match run_file(&mut session, script) {
+            Ok(Flow::Continue) => {}
+            Ok(Flow::Quit) => return Ok(()),
+            // With the prompt to come, a bad line is reported and the
+            // prompt opens on the session as the script left it.
+            Err(error) if args.interactive => {
+                eprintln!("error: {}", crate::one_line(&error));
+                break;
+            }
+            Err(error) => return Err(error),
         }
     }
     if args.scripts.is_empty() || args.interactive {
@@ -70,9 +78,14 @@ pub(crate) fn run(args: &ScriptArgs) -> Result<()> {
 fn run_file(session: &mut Session, script: &std::path::Path) -> Result<Flow> {
     let text =
         std::fs::read_to_string(script).map_err(|e| anyhow::anyhow!("{}: cannot read: {e}", script.display()))?;
+    // Editors on some systems start a file with a byte-order mark.
+    let text = text.strip_prefix('\u{feff}').unwrap_or(&text);
     session
         .set_script_folder(script.parent().map(|p| if p.as_os_str().is_empty() { ".".into() } else { p.to_owned() }));
+    // The `with` block being skipped, if any: its line, to name it when it never ends.
+    let mut block = None;
     for (index, line) in text.lines().enumerate() {
+        let skipping = session.in_skipped_block();
         match session.execute(line) {
             Ok(Flow::Continue) => {}
             Ok(Flow::Quit) => return Ok(Flow::Quit),
@@ -80,6 +93,18 @@ fn run_file(session: &mut Session, script: &std::path::Path) -> Result<Flow> {
                 bail!("{}:{}: '{}': {}", script.display(), index + 1, line.trim(), crate::one_line(&error));
             }
         }
+        if !skipping && session.in_skipped_block() {
+            block = Some((index + 1, line.trim().to_owned()));
+        }
+    }
+    if session.in_skipped_block()
+        && let Some((number, line)) = block
+    {
+        bail!(
+            "{}:{number}: '{line}': the block has no closing '}}' on a line of its own, so the rest of the script \
+             was skipped",
+            script.display()
+        );
     }
     session.set_script_folder(None);
     Ok(Flow::Continue)

@@ -10,6 +10,7 @@ use rtgi_math::{Mat4, Vec3};
 use rtgi_render::BounceSampling;
 
 use super::brdf::CourseBrdf;
+use crate::cli::MAX_IMAGE_SIDE as MAX_SIDE;
 
 /// One line of a script.
 #[derive(Clone, Debug, PartialEq)]
@@ -92,6 +93,9 @@ pub(crate) enum Command {
     /// preview window, wavefront steps, the sky's debug output): said in
     /// one line, and the script goes on.
     Unavailable { command: &'static str, feature: &'static str },
+    /// `algo primary-wf|direct-wf`: a wavefront algorithm, rendered by its
+    /// CPU counterpart.
+    WavefrontAlgo { name: &'static str, instead: Algo },
 }
 
 /// `raytracer NAME`.
@@ -165,6 +169,21 @@ pub(crate) enum DirectSampling {
     Cosine,
     Light,
     Brdf,
+    /// Light and BRDF samples weighed (older scripts of the course say
+    /// `is mis` for what `algo direct/mis` does).
+    Mis,
+}
+
+impl DirectSampling {
+    pub(crate) fn name(self) -> &'static str {
+        match self {
+            DirectSampling::Uniform => "uniform",
+            DirectSampling::Cosine => "cosine",
+            DirectSampling::Light => "light",
+            DirectSampling::Brdf => "brdf",
+            DirectSampling::Mis => "mis",
+        }
+    }
 }
 
 /// `path ...`.
@@ -212,8 +231,8 @@ pub(crate) fn parse(line: &str) -> Result<Command, String> {
     match name {
         "at" => optional_vec3(&words).map(Command::At),
         "look" => optional_vec3(&words).map(Command::Look),
-        "up" => optional_vec3(&words).map(Command::Up),
-        "camup" => optional_vec3(&words).map(Command::CamUp),
+        "up" => optional_direction(&words).map(Command::Up),
+        "camup" => optional_direction(&words).map(Command::CamUp),
         "print-cam" => none(Command::PrintCam),
         "load" => match words[..] {
             [file] => Ok(Command::Load { file: file.into(), name: None }),
@@ -232,8 +251,8 @@ pub(crate) fn parse(line: &str) -> Result<Command, String> {
         "modeltrafo" => model_trafo(&words).map(Command::ModelTrafo),
         "resolution" => match words[..] {
             [w, h] => match (positive_int(w), positive_int(h)) {
-                (Some(w), Some(h)) => Ok(Command::Resolution(w, h)),
-                _ => Err(format!("expects two positive whole numbers, W H (got '{rest}')")),
+                (Some(w), Some(h)) if w <= MAX_SIDE && h <= MAX_SIDE => Ok(Command::Resolution(w, h)),
+                _ => Err(format!("expects two whole numbers from 1 to {MAX_SIDE}, W H (got '{rest}')")),
             },
             _ => Err("expects two positive whole numbers, W H".to_owned()),
         },
@@ -252,6 +271,7 @@ pub(crate) fn parse(line: &str) -> Result<Command, String> {
             ["cosine"] => Ok(Command::Is(DirectSampling::Cosine)),
             ["light"] => Ok(Command::Is(DirectSampling::Light)),
             ["brdf"] => Ok(Command::Is(DirectSampling::Brdf)),
+            ["mis"] => Ok(Command::Is(DirectSampling::Mis)),
             _ => Err(format!("expects one of uniform, cosine, light, brdf (got '{rest}')")),
         },
         "path" => path(&words).map(Command::Path),
@@ -309,7 +329,72 @@ pub(crate) fn parse(line: &str) -> Result<Command, String> {
         }
         "move-speed" => Ok(Command::Unavailable { command: "move-speed", feature: "preview window" }),
         "add-scene-step" => Ok(Command::Unavailable { command: "add-scene-step", feature: "wavefront steps" }),
-        _ => Err("unknown command".to_owned()),
+        _ => Err(match similar_command(name) {
+            Some(known) => format!("unknown command; did you mean '{known}'?"),
+            None => "unknown command".to_owned(),
+        }),
+    }
+}
+
+/// Every command's name, for suggestions.
+const COMMANDS: &[&str] = &[
+    "at",
+    "look",
+    "up",
+    "camup",
+    "print-cam",
+    "load",
+    "modelpath",
+    "modelmatrix",
+    "modeltrafo",
+    "resolution",
+    "sppx",
+    "outfile",
+    "commit",
+    "run",
+    "raytracer",
+    "bvh",
+    "algo",
+    "is",
+    "path",
+    "material",
+    "default-brdf",
+    "pointlight",
+    "skylight",
+    "skytest",
+    "echo",
+    "stats",
+    "mem-stats",
+    "history",
+    "quit",
+    "exit",
+    "omp",
+    "platform",
+    "denoise",
+    "disable",
+    "with",
+    "preview-offset",
+    "move-speed",
+    "add-scene-step",
+];
+
+/// The command `typed` is most likely a misspelling of: at most two edits
+/// away (one for short names, a swap of neighbours counting one), the nearest.
+fn similar_command(typed: &str) -> Option<&'static str> {
+    let allowed = if typed.len() <= 3 { 1 } else { 2 };
+    COMMANDS
+        .iter()
+        .map(|&known| (strsim::damerau_levenshtein(typed, known), known))
+        .filter(|&(distance, _)| distance <= allowed)
+        .min()
+        .map(|(_, known)| known)
+}
+
+/// A direction: three numbers, not all zero.
+fn optional_direction(words: &[&str]) -> Result<Option<Vec3>, String> {
+    match optional_vec3(words)? {
+        Some(v) if v == Vec3::ZERO => Err("the direction must not be 0 0 0".to_owned()),
+        v => Ok(v),
     }
 }
 
@@ -447,9 +532,8 @@ fn algo(words: &[&str]) -> Result<Command, String> {
         ["direct/mis"] => Algo::DirectMis,
         ["simple-pt"] => Algo::SimplePt,
         ["pt"] => Algo::Pt,
-        ["primary-wf" | "direct-wf"] => {
-            return Ok(Command::Unavailable { command: "algo", feature: "wavefront algorithms" });
-        }
+        ["primary-wf"] => return Ok(Command::WavefrontAlgo { name: "primary-wf", instead: Algo::Primary }),
+        ["direct-wf"] => return Ok(Command::WavefrontAlgo { name: "direct-wf", instead: Algo::Direct }),
         [name] => {
             return Err(format!(
                 "there is no gi algorithm called '{name}' (primary, info, local, direct, direct/mis, simple-pt, pt)"
@@ -463,9 +547,9 @@ fn algo(words: &[&str]) -> Result<Command, String> {
 fn path(words: &[&str]) -> Result<PathSetting, String> {
     match words {
         ["len", n] => positive_int(n)
-            .filter(|&n| n <= 1025)
+            .filter(|&n| n <= 1024)
             .map(PathSetting::Length)
-            .ok_or_else(|| format!("len expects a positive whole number up to 1025 (got '{n}')")),
+            .ok_or_else(|| format!("len expects a whole number from 1 to 1024 (got '{n}')")),
         ["rr-start", n] => positive_int(n)
             .map(PathSetting::RouletteStart)
             .ok_or_else(|| format!("rr-start expects a positive whole number (got '{n}')")),
@@ -488,11 +572,9 @@ fn material(words: &[&str], rest: &str) -> Result<MaterialCommand, String> {
     // The name is the rest of the line after the subcommand, spaces and all.
     let name = rest[sub.len()..].trim();
     let colour = |what: &str| {
-        numbers(args, 3)
-            .map(|v| Vec3::from_slice(&v))
-            .ok()
-            .filter(|c| c.min_element() >= 0.0)
-            .ok_or_else(|| format!("{what} expects a colour triplet R G B of numbers of at least 0"))
+        numbers(args, 3).map(|v| Vec3::from_slice(&v)).ok().filter(|c| c.min_element() >= 0.0).ok_or_else(|| {
+            format!("{what} expects a colour triplet R G B of finite numbers of at least 0 (got '{}')", args.join(" "))
+        })
     };
     let number = |what: &str, accept: fn(f32) -> bool, allowed: &str| {
         numbers(args, 1)
@@ -604,6 +686,11 @@ mod tests {
             ("} x", "} must be on an otherwise empty line"),
             ("commit now", "takes no arguments"),
             ("teleport", "unknown command"),
+            ("laod scene.obj", "unknown command; did you mean 'load'?"),
+            ("raytraser seq", "did you mean 'raytracer'?"),
+            ("camup 0 0 0", "must not be 0 0 0"),
+            ("resolution 100000 10", "from 1 to 16384"),
+            ("path len 1025", "from 1 to 1024"),
         ] {
             let error = parse(line).unwrap_err();
             assert!(error.contains(expected), "{line}: {error}");

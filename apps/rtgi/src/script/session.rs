@@ -166,6 +166,13 @@ pub(crate) struct Session {
 }
 
 impl Session {
+    /// Whether a `with` block is being skipped (its `}` not yet seen).
+    pub(crate) fn in_skipped_block(&self) -> bool {
+        self.skipping
+    }
+}
+
+impl Session {
     pub(crate) fn new(options: SessionOptions) -> Self {
         let outfile = options.output.clone().unwrap_or_else(|| PathBuf::from("out.png"));
         Self {
@@ -283,13 +290,42 @@ impl Session {
                 }
                 self.algo = Some(AlgoSetup::new(algo));
             }
-            Command::Is(sampling) => match &mut self.algo {
-                Some(setup) if setup.algo == Algo::Direct => setup.sampling = sampling,
+            Command::Is(DirectSampling::Mis) => match &mut self.algo {
+                Some(setup) if setup.algo == Algo::DirectMis => {}
+                Some(setup) if setup.algo == Algo::Direct => {
+                    *setup = AlgoSetup::new(Algo::DirectMis);
+                    self.say_once(
+                        "is mis",
+                        "is mis: algo direct now weighs light and BRDF samples, as algo direct/mis does",
+                    );
+                }
                 other => bail!(
                     "unknown command for {}: 'is' chooses how algo direct samples (select it first)",
                     algo_name(other.as_ref())
                 ),
             },
+            Command::Is(sampling) => match &mut self.algo {
+                Some(setup) if setup.algo == Algo::Direct => setup.sampling = sampling,
+                Some(setup) if setup.algo == Algo::DirectMis => bail!(
+                    "algo direct/mis samples the light and the BRDF and weighs them; 'is {}' chooses one strategy \
+                     for algo direct",
+                    sampling.name()
+                ),
+                other => bail!(
+                    "unknown command for {}: 'is' chooses how algo direct samples (select it first)",
+                    algo_name(other.as_ref())
+                ),
+            },
+            Command::WavefrontAlgo { name, instead } => {
+                self.say_once(
+                    name,
+                    &format!(
+                        "algo {name}: rtgi has no wavefront algorithms; algo {} renders what it renders",
+                        instead.name()
+                    ),
+                );
+                self.algo = Some(AlgoSetup::new(instead));
+            }
             Command::Path(setting) => self.path(setting)?,
             Command::Material(command) => self.material(command)?,
             Command::DefaultBrdf(brdf) => {
@@ -493,6 +529,12 @@ impl Session {
                 self.tracer.map_or("no ray tracer", |t| t.name)
             );
         };
+        if setup.name == "naive-bvh" && matches!(command, BvhCommand::Split(..) | BvhCommand::LeafSize(_)) {
+            bail!(
+                "naive-bvh splits at the object median with one triangle a leaf; raytracer bbvh takes the split and \
+                 leaf size"
+            );
+        }
         match command {
             BvhCommand::Split(method, planes) => {
                 setup.set_split(method, planes);
@@ -702,6 +744,9 @@ impl Session {
         }
         let accel = self.current_structure()?;
         let (algo, tracer) = (self.algo.expect("checked"), self.tracer.expect("checked"));
+        if self.camera.direction.cross(self.camera.up).length_squared() <= 0.0 {
+            bail!("the camera looks along its up vector ({}): change look or camup", triple(self.camera.direction));
+        }
         if algo.algo == Algo::Local && self.point_lights.is_empty() {
             bail!("algo local shades with a point light: add one (pointlight pos X Y Z col R G B)");
         }
@@ -752,6 +797,7 @@ impl Session {
             Algo::Local => ("direct", Some("light"), None, None, None),
             Algo::Direct => match algo.sampling {
                 DirectSampling::Light => ("direct", Some("light"), None, None, None),
+                DirectSampling::Mis => ("direct", Some("mis"), None, None, None),
                 DirectSampling::Brdf => ("direct", Some("bsdf"), None, None, None),
                 DirectSampling::Cosine => ("direct", Some("bsdf"), Some(BounceSampling::Cosine), None, None),
                 DirectSampling::Uniform => ("direct", Some("bsdf"), Some(BounceSampling::Uniform), None, None),
