@@ -41,8 +41,9 @@ fn lamps_that_light_nothing_in_view_get_the_default_sky_and_say_so() {
 
 #[test]
 fn lamps_that_light_the_view_keep_it_to_themselves() {
-    // The same lamps turned round to face the box: its front is lit.
-    let facing = CAR.replace("f 12 11 10 9\nf 16 15 14 13", "f 9 10 11 12\nf 13 14 15 16");
+    // The same lamps turned round to face the box, a little way off so
+    // that they light its side, not only the patches right behind them.
+    let facing = CAR.replace("f 12 11 10 9\nf 16 15 14 13", "f 9 10 11 12\nf 13 14 15 16").replace("v 2.01 ", "v 2.5 ");
     let mut scene = rtgi_scene::obj::load_from_text(&facing, CAR_MTL, "car.obj").unwrap();
     let mut settings = RenderSettings::default();
     let plan = prepared(&mut scene, &mut settings);
@@ -103,4 +104,34 @@ f 9 12 11 10
     let (image, _) = rtgi_render::render(&scene, accel.as_ref(), &prepared.camera.camera, &settings, &|_| {});
     let missed = (0..32).flat_map(|x| (0..32).map(move |y| (x, y))).filter(|&(x, y)| image.get(x, y) == background);
     assert!(missed.count() > 10, "no pixel shows the background");
+}
+
+/// `rtgi info` prints the plan `rtgi render` follows, probe of the view
+/// included: the headlamp box gets the default sky in both, with and
+/// without a camera placed by options.
+#[test]
+fn info_prints_the_plan_the_render_follows() {
+    let dir = rtgi_tests::scratch_dir("info-plan");
+    std::fs::write(dir.join("car.obj"), CAR).unwrap();
+    std::fs::write(dir.join("car.mtl"), CAR_MTL).unwrap();
+    let scene = dir.join("car.obj");
+    let scene = scene.to_str().unwrap();
+    let rtgi = env!("CARGO_BIN_EXE_rtgi-under-test");
+    let plan = |stdout: &str| -> String {
+        let start = stdout.find("plan:").expect("a plan");
+        stdout[start..]
+            .lines()
+            .take_while(|l| l.starts_with("plan:") || l.starts_with("  "))
+            .collect::<Vec<_>>()
+            .join("\n")
+    };
+    for camera in [&[][..], &["--at", "8,2,1"][..]] {
+        let info = rtgi_tests::run_cli(rtgi, &[&["info", scene][..], camera].concat());
+        let out = dir.join("car.png");
+        let args = [&["render", scene, "-o", out.to_str().unwrap(), "--quick"][..], camera].concat();
+        let render = rtgi_tests::run_cli(rtgi, &args);
+        assert!(info.success && render.success, "{info:?} {render:?}");
+        assert_eq!(plan(&info.stdout), plan(&render.stdout), "{camera:?}");
+        assert!(plan(&info.stdout).contains("the scene's own lights give the surfaces in view"), "{info:?}");
+    }
 }

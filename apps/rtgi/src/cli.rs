@@ -246,6 +246,10 @@ pub(crate) struct InfoArgs {
     /// The render options the printed plan is for
     #[command(flatten)]
     pub(crate) lighting: LightingArgs,
+
+    /// The view the plan is for: the lights a render adds depend on what the camera sees
+    #[command(flatten)]
+    pub(crate) camera: CameraArgs,
 }
 
 /// How light is simulated: shared by `render` and `info` (which prints the plan).

@@ -3,6 +3,7 @@
 use std::path::Path;
 
 use anyhow::{Context, Result, bail};
+use rtgi_accel::AccelKind;
 use rtgi_image::HdrImage;
 use rtgi_render::{EffectPlan, RenderSettings};
 use rtgi_scene::{AlphaMode, LightKind, SUPPORTED_GLTF_EXTENSIONS};
@@ -73,7 +74,6 @@ pub(crate) fn run(args: &InfoArgs) -> Result<()> {
     let LoadedScene { mut scene, name, .. } = load_scene(args.scene.as_deref())?;
     let mut settings = RenderSettings::default();
     apply_lighting(&args.lighting, &mut scene, &mut settings)?;
-    let plan = EffectPlan::new(&scene, &settings);
     let mut per_material = vec![0usize; scene.materials.len()];
     for t in &scene.triangles {
         per_material[t.material as usize] += 1;
@@ -143,8 +143,15 @@ pub(crate) fn run(args: &InfoArgs) -> Result<()> {
             .collect(),
         extensions_used: scene.extensions_used.clone(),
         warnings: scene.warnings.clone(),
-        plan,
+        plan: EffectPlan::new(&scene, &settings),
     };
+    // The plan of the render: the lights it adds for the view it takes
+    // (a probe of the view, a lamp over an enclosed room) count, as `rtgi
+    // render` prints them; the scene's own lights are listed above.
+    let accel = AccelKind::Bvh8.build(&scene.triangle_positions(), &AccelKind::Bvh8.default_params());
+    let mut info = info;
+    rtgi_render::recipe::prepare(&mut scene, accel.as_ref(), &mut settings, &args.camera.choice())?;
+    info.plan = EffectPlan::new(&scene, &settings);
     if args.json {
         outln!("{}", serde_json::to_string_pretty(&info)?)?;
     } else {
