@@ -92,7 +92,7 @@ fn lights_and_environments_from_the_command_line() {
         ("--light", "lamp:1,2,3:5", "expected point:"),
         ("--light", "spot:0,0,0:0,-1,0:5:40:30", "inner <= outer"),
         ("--light", "directional:0,0,0:1", "the direction is zero"),
-        ("--environment", "sky.hdr", "an .exr file"),
+        ("--environment", "sky.hdr", "an .exr or .floats file"),
         ("--effects", "+shiny", "unknown effect 'shiny'"),
         ("--effects", "glossy", "+effect"),
         (
