@@ -154,7 +154,7 @@ pub fn three_quarter_view(bounds: &Aabb, vertical_fov: f32, aspect: f32) -> Came
 
 /// `camera` moved along its own axes, its direction kept, to the closest
 /// position from which every vertex of the scene's triangles lies within
-/// [`FILL`] of the frame, centred: the model's silhouette, not its bounding
+/// 90% of the frame, centred: the model's silhouette, not its bounding
 /// box, fills the view (a box's corners, seen three-quarter on, leave a
 /// round model a fifth of the frame). Every vertex stays in front of the
 /// camera. A scene without vertices keeps the camera as it is.
