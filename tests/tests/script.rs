@@ -444,6 +444,13 @@ fn material_edits_and_model_transforms_change_what_is_rendered() {
     let (moved, run) = render("moved", "modeltrafo shift 0 5000 0", "");
     assert!(moved < 0.05 * plain, "{moved} against {plain}");
     assert!(run.stdout.contains("(with model transforms, which no option expresses)"), "{run:?}");
+    // The same move as a matrix, column by column as the framework reads it.
+    let (matrix, _) = render("matrix", "modelmatrix 1 0 0 0  0 1 0 0  0 0 1 0  0 5000 0 1", "");
+    assert_eq!(matrix, moved);
+    // A quarter turn about y keeps the box in view, turned: another image.
+    let (turned, _) =
+        render("turned", "modeltrafo translate 278 0 280\nmodeltrafo rotate y 90\nmodeltrafo shift -278 0 -280", "");
+    assert!(turned > 0.2 * plain && turned != plain, "{turned} against {plain}");
     // The walls and blocks black: darker.
     let all_black = "material select white\nmaterial albedo 0 0 0\nmaterial select red\nmaterial albedo 0 0 0\n\
                      material select green\nmaterial albedo 0 0 0";

@@ -31,7 +31,8 @@ pub(crate) enum Command {
     Load { file: PathBuf, name: Option<String> },
     /// `modelpath DIR`: a folder `load` also looks in.
     ModelPath(PathBuf),
-    /// `modelmatrix` with 16 numbers, row by row: the transform of later loads.
+    /// `modelmatrix` with 16 numbers, column by column as the framework's
+    /// glm reads them (the translation last): the transform of later loads.
     ModelMatrix(Mat4),
     /// `modeltrafo ...`: multiplies the transform of later loads.
     ModelTrafo(Mat4),
@@ -244,9 +245,11 @@ pub(crate) fn parse(line: &str) -> Result<Command, String> {
             _ => Err("expects one folder (no spaces)".to_owned()),
         },
         "modelmatrix" => {
-            let values = numbers(&words, 16).map_err(|_| "expects 16 numbers, the matrix row by row".to_owned())?;
-            // Rows as typed; glam's matrices are built from columns.
-            Ok(Command::ModelMatrix(Mat4::from_cols_slice(&values).transpose()))
+            let values = numbers(&words, 16)
+                .map_err(|_| "expects 16 numbers, the matrix column by column (the translation last)".to_owned())?;
+            // The framework reads m[0][0], m[0][1], ... into a glm matrix,
+            // whose first index is the column: column-major, as glam's.
+            Ok(Command::ModelMatrix(Mat4::from_cols_slice(&values)))
         }
         "modeltrafo" => model_trafo(&words).map(Command::ModelTrafo),
         "resolution" => match words[..] {
@@ -663,8 +666,8 @@ mod tests {
                 colour: Vec3::new(7.0, 4.0, 2.0)
             }
         );
-        let rows = "modelmatrix 1 0 0 5  0 1 0 6  0 0 1 7  0 0 0 1";
-        assert_eq!(parse(rows).unwrap(), Command::ModelMatrix(Mat4::from_translation(Vec3::new(5.0, 6.0, 7.0))));
+        let columns = "modelmatrix 1 0 0 0  0 1 0 0  0 0 1 0  5 6 7 1";
+        assert_eq!(parse(columns).unwrap(), Command::ModelMatrix(Mat4::from_translation(Vec3::new(5.0, 6.0, 7.0))));
         assert_eq!(parse("path bounce cosine").unwrap(), Command::Path(PathSetting::Bounce(BounceSampling::Cosine)));
         assert_eq!(parse("with cuda {").unwrap(), Command::With("cuda".into()));
     }
