@@ -417,6 +417,7 @@ echo after exit
     // Said once each: BRDFs that differ from the course's, and algo info.
     assert_eq!(run.stderr.matches("brdf phong: rtgi has no Phong lobe").count(), 1, "{run:?}");
     assert!(run.stderr.contains("algo info: rtgi has no pixel inspector"), "{run:?}");
+    assert!(run.stderr.contains("algo local: rtgi shades with the point light's intensity"), "{run:?}");
 }
 
 #[test]

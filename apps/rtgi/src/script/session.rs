@@ -282,6 +282,14 @@ impl Session {
             }
             Command::Bvh(command) => self.bvh(command)?,
             Command::Algo(algo) => {
+                if algo == Algo::Local {
+                    self.say_once(
+                        "algo local",
+                        "algo local: rtgi shades with the point light's intensity, col / d² times the BRDF and the \
+                         cosine, as its direct light does; the course's local multiplies by the light's power \
+                         (4π col) instead, so its images are about 12.6 times brighter",
+                    );
+                }
                 if algo == Algo::Info {
                     self.say_once(
                         "algo info",
