@@ -487,10 +487,7 @@ fn tracer(words: &[&str]) -> Result<Tracer, String> {
                 [method] => split(method)
                     .map(|s| Tracer::Bbvh(Some((s, None))))
                     .ok_or_else(|| format!("there is no such bbvh variant '{method}' (om, sm or sah)")),
-                ["sah", planes] => positive_int(planes)
-                    .filter(|&n| n <= 255)
-                    .map(|n| Tracer::Bbvh(Some((CourseSplit::Sah, Some(n)))))
-                    .ok_or_else(|| format!("sah expects a number of planes from 1 to 255 (got '{planes}')")),
+                ["sah", planes] => sah_planes(planes).map(|n| Tracer::Bbvh(Some((CourseSplit::Sah, Some(n))))),
                 _ => Err("bbvh expects om, sm or sah [NPLANES]".to_owned()),
             }
         }
@@ -502,13 +499,17 @@ fn tracer(words: &[&str]) -> Result<Tracer, String> {
     }
 }
 
+/// The planes of the course's SAH: N + 1 bins, and we bin at most 256.
+fn sah_planes(word: &str) -> Result<u32, String> {
+    positive_int(word)
+        .filter(|&n| n <= 255)
+        .ok_or_else(|| format!("sah expects a number of planes from 1 to 255 (got '{word}')"))
+}
+
 fn bvh(words: &[&str]) -> Result<BvhCommand, String> {
     match words {
         [method] if split(method).is_some() => Ok(BvhCommand::Split(split(method).expect("checked"), None)),
-        ["sah", planes] => positive_int(planes)
-            .filter(|&n| n <= 255)
-            .map(|n| BvhCommand::Split(CourseSplit::Sah, Some(n)))
-            .ok_or_else(|| format!("sah expects a number of planes from 1 to 255 (got '{planes}')")),
+        ["sah", planes] => sah_planes(planes).map(|n| BvhCommand::Split(CourseSplit::Sah, Some(n))),
         ["triangles", "single"] => Ok(BvhCommand::LeafSize(1)),
         ["triangles", "multiple", n] => positive_int(n)
             .filter(|&n| n <= 255)

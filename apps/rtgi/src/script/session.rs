@@ -18,7 +18,7 @@ use rtgi_scene::{ColorEncoding, Scene, Texture, TextureId};
 
 use super::brdf::{CourseBrdf, course_roughness, our_roughness};
 use super::parse::{Algo, BvhCommand, Command, CourseSplit, DirectSampling, MaterialCommand, PathSetting, Tracer};
-use crate::cli::{Cli, Command as CliCommand, RenderArgs};
+use crate::cli::{Cli, Command as CliCommand};
 use crate::common::{LoadedScene, load_scene};
 use crate::output::outln;
 use crate::render_cmd::{Given, render_given};
@@ -152,24 +152,16 @@ pub(crate) struct Session {
     outfile: PathBuf,
     tracer: Option<TracerSetup>,
     algo: Option<AlgoSetup>,
-    point_lights: Vec<Vec3>,
-    point_colours: Vec<Vec3>,
+    /// Point lights: position and colour (the intensity, per channel).
+    point_lights: Vec<(Vec3, Vec3)>,
     sky: Option<(PathBuf, f32)>,
     one_thread: bool,
     committed: Option<Box<dyn Accel>>,
     clock: Clock,
     runs: Vec<RunRecord>,
     history: Vec<String>,
-    disabled: BTreeSet<String>,
     /// Inside a `with` block that is skipped.
     skipping: bool,
-}
-
-impl Session {
-    /// Whether a `with` block is being skipped (its `}` not yet seen).
-    pub(crate) fn in_skipped_block(&self) -> bool {
-        self.skipping
-    }
 }
 
 impl Session {
@@ -201,16 +193,19 @@ impl Session {
             tracer: None,
             algo: None,
             point_lights: Vec::new(),
-            point_colours: Vec::new(),
             sky: None,
             one_thread: false,
             committed: None,
             clock: Clock::default(),
             runs: Vec::new(),
             history: Vec::new(),
-            disabled: BTreeSet::new(),
             skipping: false,
         }
+    }
+
+    /// Whether a `with` block is being skipped (its `}` not yet seen).
+    pub(crate) fn in_skipped_block(&self) -> bool {
+        self.skipping
     }
 
     /// Sets the folder of the script being run, where `load` also looks.
@@ -342,15 +337,10 @@ impl Session {
                 }
                 self.default_brdf = Some(brdf);
             }
-            Command::PointLight { replace, position, colour } => {
-                if replace && !self.point_lights.is_empty() {
-                    self.point_lights[0] = position;
-                    self.point_colours[0] = colour;
-                } else {
-                    self.point_lights.push(position);
-                    self.point_colours.push(colour);
-                }
-            }
+            Command::PointLight { replace, position, colour } => match self.point_lights.first_mut() {
+                Some(first) if replace => *first = (position, colour),
+                _ => self.point_lights.push((position, colour)),
+            },
             Command::SkylightLoad { file, scale } => {
                 let path = self.find(&file).ok_or_else(|| anyhow!("{}: no such file", file.display()))?;
                 rtgi_render::Environment::load(&path)?;
@@ -381,10 +371,8 @@ impl Session {
             Command::Denoise(true) => {
                 self.say_once("denoise", "denoise on: rtgi has no denoiser; images stay as rendered")
             }
-            Command::Disable(feature) => {
-                outln!("DISABLING {feature}")?;
-                self.disabled.insert(feature);
-            }
+            // Every `with` block is skipped already: rtgi has none of the features.
+            Command::Disable(feature) => outln!("DISABLING {feature}")?,
             Command::With(feature) => {
                 self.skipping = true;
                 outln!("Skipping a block due to missing {feature} (rtgi has no {feature})")?;
@@ -403,14 +391,19 @@ impl Session {
         }
     }
 
+    /// Where files named relatively are looked for, after the current
+    /// folder: the script's, then `modelpath`'s, then `--modelpath`'s.
+    fn search_folders(&self) -> impl Iterator<Item = &PathBuf> {
+        self.script_folder.iter().chain(&self.model_paths).chain(&self.options.model_paths)
+    }
+
     /// A file as the script names it: as given, else in the script's
     /// folder, else in the model paths.
     fn find(&self, file: &Path) -> Option<PathBuf> {
         if file.is_absolute() || file.exists() {
             return file.exists().then(|| file.to_owned());
         }
-        let folders = self.script_folder.iter().chain(&self.model_paths).chain(&self.options.model_paths);
-        for folder in folders {
+        for folder in self.search_folders() {
             let candidate = folder.join(file);
             if candidate.exists() {
                 return Some(candidate);
@@ -427,13 +420,7 @@ impl Session {
 
     fn load(&mut self, file: &Path) -> Result<()> {
         let path = self.find(file).ok_or_else(|| {
-            let looked: Vec<String> = self
-                .script_folder
-                .iter()
-                .chain(&self.model_paths)
-                .chain(&self.options.model_paths)
-                .map(|p| p.display().to_string())
-                .collect();
+            let looked: Vec<String> = self.search_folders().map(|p| p.display().to_string()).collect();
             let where_ =
                 if looked.is_empty() { String::new() } else { format!(" (also looked in {})", looked.join(", ")) };
             anyhow!("{}: no such file{where_}; modelpath DIR adds a folder to look in", file.display())
@@ -505,28 +492,9 @@ impl Session {
                          structure, traces instead",
                     );
                 }
-                let kind = fastest.unwrap_or(AccelKind::Bvh8);
-                let defaults = kind.default_params();
-                TracerSetup {
-                    name: "embree",
-                    kind,
-                    leaf_size: defaults.max_leaf_size as u32,
-                    sah_bins: defaults.sah_bins as u32,
-                    sah_axes: SahAxes::All,
-                    course_bvh: false,
-                }
+                TracerSetup::own("embree", fastest.unwrap_or(AccelKind::Bvh8))
             }
-            Tracer::Ours(kind) => {
-                let defaults = kind.default_params();
-                TracerSetup {
-                    name: kind.name(),
-                    kind,
-                    leaf_size: defaults.max_leaf_size as u32,
-                    sah_bins: defaults.sah_bins as u32,
-                    sah_axes: SahAxes::All,
-                    course_bvh: false,
-                }
-            }
+            Tracer::Ours(kind) => TracerSetup::own(kind.name(), kind),
         }
     }
 
@@ -762,7 +730,6 @@ impl Session {
         let cli = Cli::try_parse_from(std::iter::once("rtgi".to_owned()).chain(arguments.iter().cloned()))
             .with_context(|| format!("the arguments made for rtgi {}", arguments.join(" ")))?;
         let CliCommand::Render(args) = cli.command else { unreachable!("the arguments start with 'render'") };
-        let args: RenderArgs = args;
         if self.edits.is_empty() {
             outln!("the same as  rtgi {}", shell_words(&arguments))?;
         } else {
@@ -858,8 +825,8 @@ impl Session {
         push("look", comma(camera.position + camera.direction));
         push("up", comma(camera.up));
         push("fov", COURSE_FOV_DEGREES.to_string());
-        for (position, colour) in self.point_lights.iter().zip(&self.point_colours) {
-            push("light", format!("point:{}:1:{}", comma(*position), comma(*colour)));
+        for &(position, colour) in &self.point_lights {
+            push("light", format!("point:{}:1:{}", comma(position), comma(colour)));
         }
         let lit_by_sky = !matches!(algo.algo, Algo::Primary | Algo::Info | Algo::Local);
         if let Some((file, scale)) = self.sky.as_ref().filter(|_| lit_by_sky) {
@@ -924,6 +891,19 @@ impl Session {
 }
 
 impl TracerSetup {
+    /// A structure by rtgi's (or a peer's) own name, with its own build parameters.
+    fn own(name: &'static str, kind: AccelKind) -> Self {
+        let defaults = kind.default_params();
+        Self {
+            name,
+            kind,
+            leaf_size: defaults.max_leaf_size as u32,
+            sah_bins: defaults.sah_bins as u32,
+            sah_axes: defaults.sah_axes,
+            course_bvh: false,
+        }
+    }
+
     fn set_split(&mut self, method: CourseSplit, planes: Option<u32>) {
         self.kind = match method {
             CourseSplit::ObjectMedian => AccelKind::ObjectMedian,
