@@ -113,6 +113,18 @@ fn every_bsdf_passes_a_furnace_under_a_white_sky() {
         ("smooth metal", gltf(1.0, 0.0, 0.0), lossless),
         ("rough metal", gltf(1.0, 0.5, 0.0), (0.9, 1.005)),
         ("rough dielectric", gltf(0.0, 0.5, 0.0), (0.95, 1.02)),
+        // MTL's Kd + Ks often exceed 1; summed as given, this one would
+        // look 15% brighter than the sky that lights it.
+        (
+            "mtl colours beyond one",
+            Material {
+                base_color: Vec3::splat(0.8),
+                specular: Vec3::splat(0.55),
+                roughness: 0.5,
+                ..Material::default()
+            },
+            (0.95, 1.005),
+        ),
     ];
     let camera = Camera::look_at(Vec3::new(0.0, 0.5, 4.0), Vec3::ZERO, Vec3::Y, 0.6);
     for (name, material, (lowest, highest)) in cases {
@@ -354,6 +366,16 @@ fn plans_name_what_each_scene_needs() {
     let plan = EffectPlan::new(&scene, &forced);
     assert!(plan.has(Effect::Glossy) && !plan.has(Effect::Indirect) && plan.max_depth == 1);
     assert!(plan.to_string().contains("+!glossy"), "{plan}");
+    // MTL colours that reflect more than all light are scaled down, and the plan names them.
+    let mut bright = scene.clone();
+    bright.materials[0].specular = Vec3::splat(0.5);
+    bright.materials[0].base_color = Vec3::new(0.9, 0.6, 0.3);
+    let plan = EffectPlan::new(&bright, &RenderSettings::default()).to_string();
+    let named = format!(
+        "1 of them reflects more than it receives (Kd + Ks up to 1.40), scaled down to reflect at most all: '{}'",
+        bright.materials[0].name
+    );
+    assert!(plan.contains(&named), "{plan}");
 }
 
 #[test]

@@ -444,11 +444,29 @@ impl EffectPlan {
         } else if glossy.is_empty() {
             decide(Effect::Glossy, false, "every material is diffuse".into());
         } else {
+            // MTL sums beyond 1 are scaled down as the surfaces are shaded (`energy_conserving`); say so.
+            let excess = |m: &Material| (m.base_color + m.specular).max_element();
+            let bright: Vec<&Material> = glossy
+                .iter()
+                .copied()
+                .filter(|m| m.model == SurfaceModel::DiffuseSpecular && excess(m) > 1.0)
+                .collect();
+            let scaled = match bright.iter().map(|m| excess(m)).reduce(f32::max) {
+                Some(most) => format!(
+                    "; {} of them {} more than {} {} (Kd + Ks up to {most:.2}), scaled down to reflect at most all: {}",
+                    bright.len(),
+                    agree(bright.len(), "reflects"),
+                    if bright.len() == 1 { "it" } else { "they" },
+                    agree(bright.len(), "receives"),
+                    names(&bright)
+                ),
+                None => String::new(),
+            };
             decide(
                 Effect::Glossy,
                 true,
                 format!(
-                    "{} {} specularly: {}",
+                    "{} {} specularly: {}{scaled}",
                     count(glossy.len(), "material"),
                     agree(glossy.len(), "reflects"),
                     names(&glossy)

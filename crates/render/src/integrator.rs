@@ -11,7 +11,7 @@ use rtgi_accel::{Accel, Hit};
 use rtgi_math::{Frame, Ray, Rng, SurfacePoint, TriangleShape, Vec2, Vec3, Vec4, luminance};
 use rtgi_scene::{Material, Scene, SurfaceModel, Triangle};
 
-use crate::bsdf::Bsdf;
+use crate::bsdf::{Bsdf, energy_conserving};
 use crate::effects::{Effect, EffectPlan, is_glossy, transmits};
 use crate::lights::{Environment, LightSet};
 use crate::shade::{alpha_accepts, closest_hit};
@@ -517,12 +517,13 @@ impl<'a, A: Accel + ?Sized> Transport<'a, A> {
                 }
             }
             SurfaceModel::DiffuseSpecular if alpha >= MIN_ALPHA => {
-                (Bsdf::DiffuseGlossy { albedo: base_color, reflectance: material.specular, alpha }, Vec3::ONE)
+                let (albedo, reflectance) = energy_conserving(base_color, material.specular);
+                (Bsdf::DiffuseGlossy { albedo, reflectance, alpha }, Vec3::ONE)
             }
             SurfaceModel::DiffuseSpecular => {
                 // A mirror is a delta: it cannot be summed with the diffuse
                 // lobe, so one of the two is chosen per hit.
-                let specular = material.specular;
+                let (base_color, specular) = energy_conserving(base_color, material.specular);
                 let p_specular = luminance(specular) / (luminance(specular) + luminance(base_color)).max(1e-12);
                 if u < p_specular {
                     (Bsdf::Mirror { reflectance: specular }, Vec3::splat(1.0 / p_specular))
