@@ -47,11 +47,30 @@ const GAP: u32 = 4;
 const SCALE_QUANTILE: f64 = 0.99;
 /// Height of the SVG's title band and of its label band under the tiles, in pixels.
 const TITLE_BAND: u32 = 30;
-const LABEL_BAND: u32 = 58;
+/// Height of one line of the labels under the tiles, in pixels (13-pixel text).
+const LABEL_LINE: u32 = 17;
+/// The average width of a character of the 13-pixel sans-serif labels, in
+/// pixels, a little generous: labels wider than their tile are wrapped.
+const LABEL_CHAR_WIDTH: f32 = 7.4;
 /// The narrowest a tile is shown in the SVG, in pixels: room for its label.
 const MIN_LABELLED_TILE: u32 = 170;
 /// Height of the colour bar band at the SVG's foot.
 const BAR_BAND: u32 = 40;
+
+/// `label` in lines of at most `width` characters where it can be, broken
+/// after its commas ("depth 32, roulette on, 55 spp" under a narrow tile
+/// becomes "depth 32, roulette on," and "55 spp"); a part longer than
+/// `width` keeps a line of its own.
+fn wrapped(label: &str, width: usize) -> Vec<String> {
+    let mut lines: Vec<String> = Vec::new();
+    for part in label.split_inclusive(", ") {
+        match lines.last_mut() {
+            Some(line) if line.chars().count() + part.trim_end().chars().count() <= width => line.push_str(part),
+            _ => lines.push(part.to_owned()),
+        }
+    }
+    lines.iter().map(|line| line.trim_end().to_owned()).collect()
+}
 
 /// The absolute error of each pixel (mean over channels).
 fn errors(image: &HdrImage, reference: &HdrImage) -> Vec<f32> {
@@ -224,7 +243,17 @@ impl Panel {
         let scale = MIN_LABELLED_TILE.div_ceil(self.crop.side * ZOOM).max(1);
         let (width, height) = (width * scale, height * scale);
         let (tile, gap) = (self.crop.side * ZOOM * scale, GAP * scale);
-        let total_height = TITLE_BAND + height + LABEL_BAND + BAR_BAND;
+        let columns: Vec<Vec<String>> = std::iter::once(vec!["reference".to_owned()])
+            .chain(self.entries.iter().map(|e| {
+                let mut lines = wrapped(&e.label, (tile as f32 / LABEL_CHAR_WIDTH) as usize);
+                lines.push(format!("{} ms", crate::report::format_ms(e.time_ms)));
+                lines.push(format!("RMSE {}", crate::report::format_number(e.rmse)));
+                lines
+            }))
+            .collect();
+        let label_lines = columns.iter().map(Vec::len).max().unwrap_or(1) as u32;
+        let label_band = 8 + LABEL_LINE * label_lines + 8;
+        let total_height = TITLE_BAND + height + label_band + BAR_BAND;
         let mut svg = String::new();
         let _ = writeln!(
             svg,
@@ -241,29 +270,20 @@ impl Panel {
             svg,
             r#"<image x="0" y="{TITLE_BAND}" width="{width}" height="{height}" style="image-rendering:pixelated" href="data:image/png;base64,{encoded}"/>"#
         );
-        let columns = std::iter::once(("reference".to_owned(), String::new(), String::new())).chain(
-            self.entries.iter().map(|e| {
-                (
-                    e.label.clone(),
-                    format!("{} ms", crate::report::format_ms(e.time_ms)),
-                    format!("RMSE {}", crate::report::format_number(e.rmse)),
-                )
-            }),
-        );
         let label_top = TITLE_BAND + height + 16;
-        for (column, (label, time, rmse)) in columns.enumerate() {
+        for (column, lines) in columns.iter().enumerate() {
             let centre = gap + column as u32 * (tile + gap) + tile / 2;
-            for (line, text) in [label, time, rmse].iter().enumerate() {
+            for (line, text) in lines.iter().enumerate() {
                 let _ = writeln!(
                     svg,
                     r#"<text x="{centre}" y="{}" font-size="13" text-anchor="middle">{}</text>"#,
-                    label_top + line as u32 * 17,
+                    label_top + line as u32 * LABEL_LINE,
                     xml_escaped(text)
                 );
             }
         }
         // The colour bar: the error scale from 0 to the saturating error, in steps.
-        let (bar_left, bar_width, bar_top, steps) = (width / 4, width / 2, TITLE_BAND + height + LABEL_BAND, 64u32);
+        let (bar_left, bar_width, bar_top, steps) = (width / 4, width / 2, TITLE_BAND + height + label_band, 64u32);
         for step in 0..steps {
             let colour = heat_colour((step as f32 + 0.5) / steps as f32).to_array();
             let [r, g, b] = colour.map(|c| (rtgi_image::linear_to_srgb(c) * 255.0 + 0.5) as u8);
@@ -297,6 +317,15 @@ impl Panel {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn long_labels_break_after_commas_to_fit_their_tile() {
+        assert_eq!(wrapped("depth 32, roulette on, 55 spp", 23), ["depth 32, roulette on,", "55 spp"]);
+        assert_eq!(wrapped("depth 32, roulette on, 55 spp", 40), ["depth 32, roulette on, 55 spp"]);
+        assert_eq!(wrapped("stratified, 16 spp", 23), ["stratified, 16 spp"]);
+        assert_eq!(wrapped("a-very-long-single-part-label", 10), ["a-very-long-single-part-label"]);
+        assert_eq!(wrapped("a, b, c", 1), ["a,", "b,", "c"]);
+    }
 
     fn flat(value: f32) -> HdrImage {
         HdrImage::from_pixels(16, 16, vec![Vec3::splat(value); 256]).unwrap()

@@ -277,7 +277,7 @@ pub(super) fn run(
         file: "accel-total.svg".into(),
         title: "Build plus trace time against the rays traced (incoherent, one at a time)".into(),
         x_label: "incoherent rays traced".into(),
-        y_label: "build + trace time (ms)".into(),
+        y_label: "build + rays × measured time per ray (ms)".into(),
         log_x: true,
         log_y: true,
         curves: totals,
