@@ -564,9 +564,13 @@ pub(crate) struct RenderArgs {
     #[arg(long)]
     pub(crate) quick: bool,
 
-    /// Samples per pixel [default: 16 for the direct and path integrators, 1 otherwise]
+    /// Samples per pixel [default: 16 for the direct and path integrators, 1 otherwise]; with
+    /// --noise or --time, the most a pixel takes [default: 1024]
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1_048_576))]
     pub(crate) spp: Option<u32>,
+
+    #[command(flatten)]
+    pub(crate) adaptive: AdaptiveArgs,
 
     #[command(flatten)]
     pub(crate) lighting: LightingArgs,
@@ -611,15 +615,59 @@ impl RenderArgs {
         self.output.or_named_after(self.scene.as_deref(), ".png")
     }
 
-    /// Image width, height and samples per pixel, after `--quick`.
+    /// Image width, height and samples per pixel (the most a pixel takes,
+    /// when sampling adapts), after `--quick`.
     pub(crate) fn resolution(&self) -> (u32, u32, u32) {
-        let spp = self.spp.unwrap_or(if self.lighting.integrator.simulates_light() { 16 } else { 1 });
+        let default = if self.adaptive.sampling().is_some() {
+            ADAPTIVE_SPP
+        } else if self.lighting.integrator.simulates_light() {
+            16
+        } else {
+            1
+        };
+        let spp = self.spp.unwrap_or(default);
         if self.quick {
             ((self.size.width() / 4).max(16), (self.size.height() / 4).max(16), spp.min(4))
         } else {
             (self.size.width(), self.size.height(), spp)
         }
     }
+}
+
+/// The most samples a pixel takes with `--noise` or `--time` when `--spp` is not given.
+pub(crate) const ADAPTIVE_SPP: u32 = 1024;
+
+/// Adaptive sampling: rounds of 16, 32, 64, ... samples, each pixel
+/// stopping when its noise is low enough ([`rtgi_render::adaptive`]).
+#[derive(Args, Debug, Clone, Default)]
+pub(crate) struct AdaptiveArgs {
+    /// Sample each pixel until the standard error of its mean is at most this fraction of it
+    /// (0.02 for 2%), checked after 16, 32, 64, ... samples; deterministic: the same seed and
+    /// options give the same image on any machine. Not with --samples, --tile, --resume,
+    /// --checkpoint, --time-limit or .accum output: a pixel's stop depends on all its samples
+    #[arg(long, value_name = "FRACTION", value_parser = parse_noise)]
+    pub(crate) noise: Option<f32>,
+
+    /// Render in rounds of doubling samples until the next round is predicted to end after
+    /// SECONDS (with --noise, whichever stops first); it then prints the --spp that renders the
+    /// same image without a time bound
+    #[arg(long, value_name = "SECONDS", value_parser = crate::render_job::parse_seconds)]
+    pub(crate) time: Option<f64>,
+}
+
+impl AdaptiveArgs {
+    /// The adaptive sampling asked for, if any.
+    pub(crate) fn sampling(&self) -> Option<rtgi_render::AdaptiveSampling> {
+        (self.noise.is_some() || self.time.is_some())
+            .then_some(rtgi_render::AdaptiveSampling { noise: self.noise, seconds: self.time })
+    }
+}
+
+fn parse_noise(text: &str) -> Result<f32, String> {
+    text.parse::<f32>()
+        .ok()
+        .filter(|n| n.is_finite() && *n > 0.0 && *n < 1.0)
+        .ok_or_else(|| format!("expected a fraction between 0 and 1, like 0.02 for 2% (got '{text}')"))
 }
 
 /// The arbitrary output variables: the integrators that compute a property

@@ -3,8 +3,10 @@ use std::time::Instant;
 
 use anyhow::{Result, bail};
 use rtgi_image::{HdrImage, Legibility, OutputFormat, ToneMap, check_writable, legibility};
+use rtgi_render::adaptive::AdaptiveOutcome;
 use rtgi_render::{
-    Accumulation, EffectPlan, EnvironmentSpec, Integrator, RenderIdentity, RenderSettings, recipe, render,
+    Accumulation, EffectPlan, EnvironmentSpec, Integrator, PixelSampler, RenderIdentity, RenderSettings, recipe,
+    render, render_adaptive,
 };
 
 use crate::cli::ToneArgs;
@@ -16,7 +18,7 @@ use crate::common::{
 use crate::interrupt;
 use crate::output::{out, outln};
 use crate::progress::Progress;
-use crate::render_job::{Ending, Renderer, ResumeOfAnotherRender, StoppedBySignal, run_passes};
+use crate::render_job::{Ending, Renderer, ResumeOfAnotherRender, StoppedBySignal, Totals, run_passes};
 
 /// Extension of accumulation files: checkpoints and the parts of split renders.
 pub(crate) const ACCUMULATION_EXTENSION: &str = "accum";
@@ -77,6 +79,10 @@ pub(crate) fn render_given(args: &RenderArgs, given: Option<Given<'_>>) -> Resul
     let (width, height, spp) = args.resolution();
     // Refuse unusable outputs and options before spending time on loading and rendering.
     check_output(&output)?;
+    let adaptive = args.adaptive.sampling();
+    if adaptive.is_some() {
+        refuse_split_adaptive(args, &output)?;
+    }
     if job.is_part() && !is_accumulation(&output) {
         bail!(
             "--samples and --tile render a part of an image: write it to an .{ACCUMULATION_EXTENSION} file \
@@ -125,11 +131,20 @@ pub(crate) fn render_given(args: &RenderArgs, given: Option<Given<'_>>) -> Resul
         width,
         height,
         samples_per_pixel: spp,
-        sampler: args.sampler.unwrap_or(recipe::default_sampler(spp)),
+        // Rounds of adaptive sampling take the first samples of each pixel's sequence.
+        sampler: args.sampler.unwrap_or(if adaptive.is_some() {
+            PixelSampler::Sobol
+        } else {
+            recipe::default_sampler(spp)
+        }),
         seed: args.seed.value,
         background: args.background,
+        adaptive,
         ..RenderSettings::default()
     };
+    if let Some(adaptive) = &adaptive {
+        adaptive.check(&settings)?;
+    }
     let pool = args.threads.pool()?;
     let (accel, prepared) = match committed {
         None => {
@@ -170,7 +185,191 @@ pub(crate) fn render_given(args: &RenderArgs, given: Option<Given<'_>>) -> Resul
             p.z
         );
     }
-    let identity = RenderIdentity::new(&scene, &camera, &settings);
+    let renderer = Renderer { scene: &scene, accel: accel.as_ref(), camera: &camera, settings: &settings };
+    let rendered = match adaptive {
+        Some(adaptive) => {
+            let mut rounds_printed = Ok(());
+            let (image, outcome) = pool.install(|| {
+                render_adaptive(&scene, accel.as_ref(), &camera, &settings, &adaptive, &mut |round| {
+                    rounds_printed = std::mem::replace(&mut rounds_printed, Ok(())).and_then(|()| {
+                        outln!(
+                            "round       {} samples per pixel: {} pixels rendered, {} of {} within the noise target, \
+                             {:.0} ms",
+                            round.samples_per_pixel,
+                            round.pixels,
+                            round.converged,
+                            settings.width as u64 * settings.height as u64,
+                            round.seconds * 1e3
+                        )
+                    })
+                })
+            })?;
+            printed = printed.and(rounds_printed);
+            Done::Adapted(image, outcome)
+        }
+        None => {
+            let accumulation = render_progressively(args, &renderer, started, from_script, resumed, &mut printed)?;
+            Done::Progressive(accumulation)
+        }
+    };
+    let (ending, totals) = rendered.ending_and_totals();
+    let done = rendered.samples_done();
+    if let Done::Progressive((accumulation, ..)) = &rendered
+        && let Some(path) = job.checkpoint_path()
+        && (ending != Ending::Complete || job.checkpoint.is_some())
+    {
+        accumulation.write(path)?;
+        say!("checkpoint  {} ({} of {} samples per pixel)", path.display(), accumulation.samples().end, samples.end);
+    }
+    let simulates_light = settings.integrator.simulates_light();
+    let image = match &rendered {
+        Done::Progressive((accumulation, ..)) => (done > 0).then(|| accumulation.image()),
+        Done::Adapted(image, _) => Some(image.clone()),
+    };
+    let tone_map = match &image {
+        Some(image) => tone_map(&args.tone, simulates_light, image),
+        None => ToneMap::default(),
+    };
+    let wrote_output = if let Done::Progressive((accumulation, ..)) = &rendered
+        && is_accumulation(&output)
+    {
+        accumulation.write(&output)?;
+        true
+    } else if let Some(image) = &image {
+        image.write(&output, &tone_map)?;
+        true
+    } else {
+        false
+    };
+    if ending == Ending::Complete {
+        for (kind, path) in &aov_outputs {
+            let aov_settings = RenderSettings { integrator: *kind, ..settings.clone() };
+            let (aov, _) = pool.install(|| render(&scene, accel.as_ref(), &camera, &aov_settings, &|_| {}));
+            aov.write(path, &tone_map)?;
+        }
+    }
+
+    let build = accel.as_ref().build_stats();
+    say!("scene       {scene_name}");
+    say!("triangles   {}", scene.triangles.len());
+    say!("load        {load_ms:.1} ms");
+    say!("build       {:.1} ms ({})", build.build_ms, build.variant);
+    match &rendered {
+        Done::Progressive(_) => say!(
+            "render      {:.1} ms, {}x{} at {} spp, {} threads, {} pass(es)",
+            totals.render_seconds * 1e3,
+            settings.width,
+            settings.height,
+            spp,
+            pool.current_num_threads(),
+            totals.passes
+        ),
+        Done::Adapted(_, outcome) => {
+            let fewest = outcome.samples.iter().copied().min().unwrap_or(0);
+            let mean = outcome.total_samples() as f64 / outcome.samples.len().max(1) as f64;
+            say!(
+                "render      {:.1} ms, {}x{} at {fewest} to {} spp (mean {mean:.1}), {} threads, {} round(s)",
+                totals.render_seconds * 1e3,
+                settings.width,
+                settings.height,
+                outcome.samples_reached,
+                pool.current_num_threads(),
+                totals.passes
+            );
+            say!("{}", adaptive_summary(args, outcome, spp, settings.sampler));
+        }
+    }
+    if job.is_part() {
+        say!("part        rows {rows:?}, samples {samples:?} of every pixel");
+    }
+    let rays_per_second = totals.rays as f64 / totals.render_seconds.max(1e-9);
+    say!("rays        {} ({:.3} Mrays/s)", totals.rays, rays_per_second * 1e-6);
+    let stopped_by = match ending {
+        Ending::Complete => None,
+        Ending::TimeLimit => Some(format!("the time limit ({} s)", job.time_limit.unwrap_or_default())),
+        Ending::Signal(signal) => Some(interrupt::name(signal).to_owned()),
+    };
+    if let Some(reason) = &stopped_by {
+        say!("stopped     by {reason} with {done} of {} samples per pixel", samples.end);
+    }
+    if wrote_output {
+        let partial = if matches!(rendered, Done::Progressive(_)) && done < samples.len() as u32 {
+            format!(" ({done} samples per pixel)")
+        } else {
+            String::new()
+        };
+        say!("wrote       {}{partial}", output.display());
+        if OutputFormat::from_path(&output).is_ok_and(|f| f == OutputFormat::Png) {
+            let how = if args.tone.exposure.is_some() { "--exposure" } else { "automatic; --exposure sets it" };
+            say!("exposure    {:+.1} stops ({how}), {} tone map", tone_map.exposure, tone_map.operator);
+        }
+        if let Some(image) = &image {
+            let phrasing = if from_script { Phrasing::Script } else { Phrasing::Options };
+            warn_if_illegible(image, &tone_map, args.tone.exposure.is_some(), phrasing);
+        }
+    } else {
+        say!("wrote       nothing: no sample finished");
+    }
+    if ending == Ending::Complete {
+        for (_, path) in &aov_outputs {
+            say!("wrote       {}", path.display());
+        }
+    } else if !aov_outputs.is_empty() {
+        say!("skipped     the AOVs (they are written when the render completes)");
+    }
+    match ending {
+        Ending::Signal(signal) => Err(StoppedBySignal(signal).into()),
+        Ending::TimeLimit if !wrote_output => bail!("no sample finished within the time limit"),
+        _ => printed.map(|()| Rendered {
+            image: image.map(|image| (image, tone_map)),
+            seconds: totals.render_seconds,
+            rays: totals.rays,
+        }),
+    }
+}
+
+/// How the samples were taken: passes over every pixel into an
+/// accumulation (which can be checkpointed, split and merged), or rounds of
+/// adaptive sampling.
+enum Done {
+    Progressive((Accumulation, Ending, Totals)),
+    Adapted(HdrImage, AdaptiveOutcome),
+}
+
+impl Done {
+    fn ending_and_totals(&self) -> (Ending, Totals) {
+        match self {
+            Done::Progressive((_, ending, totals)) => (*ending, *totals),
+            Done::Adapted(_, outcome) => (
+                Ending::Complete,
+                Totals { passes: outcome.rounds.len() as u32, rays: outcome.rays(), render_seconds: outcome.seconds() },
+            ),
+        }
+    }
+
+    /// Samples per pixel done: of every pixel, or of the pixels that took most.
+    fn samples_done(&self) -> u32 {
+        match self {
+            Done::Progressive((accumulation, ..)) => accumulation.samples_done(),
+            Done::Adapted(_, outcome) => outcome.samples_reached,
+        }
+    }
+}
+
+/// The passes of a render that is not adaptive, from `resumed` if given:
+/// the accumulation, why the passes ended, and what they took.
+fn render_progressively(
+    args: &RenderArgs,
+    renderer: &Renderer<'_>,
+    started: Instant,
+    from_script: bool,
+    resumed: Option<Accumulation>,
+    printed: &mut Result<()>,
+) -> Result<(Accumulation, Ending, Totals)> {
+    let job = &args.job;
+    let settings = renderer.settings;
+    let (rows, samples) = job.share(settings.height, settings.samples_per_pixel)?;
+    let identity = RenderIdentity::new(renderer.scene, renderer.camera, settings);
     let mut accumulation = match resumed {
         None => Accumulation::new(identity, rows.clone(), samples.start),
         Some(resumed) => {
@@ -200,108 +399,74 @@ pub(crate) fn render_given(args: &RenderArgs, given: Option<Given<'_>>) -> Resul
                 ))
                 .into());
             }
-            say!("resuming   {} at {} of {} samples per pixel", resume.display(), resumed.samples().end, samples.end);
+            let said = outln!(
+                "resuming   {} at {} of {} samples per pixel",
+                resume.display(),
+                resumed.samples().end,
+                samples.end
+            );
+            *printed = std::mem::replace(printed, Ok(())).and(said);
             resumed
         }
     };
-
     let before = accumulation.samples().end;
     let pixels = rows.len() as u64 * settings.width as u64;
     let progress = Progress::new(pixels, before, samples.end);
     let progress = if from_script { progress.with_forecast() } else { progress };
-    let renderer = Renderer { scene: &scene, accel: accel.as_ref(), camera: &camera, settings: &settings };
-    let (ending, totals) =
-        pool.install(|| run_passes(&renderer, job, started, &mut accumulation, samples.end, &progress))?;
+    let (ending, totals) = run_passes(renderer, job, started, &mut accumulation, samples.end, &progress)?;
     progress.finish();
+    Ok((accumulation, ending, totals))
+}
 
-    // Write what there is, whatever stopped the render.
-    let done = accumulation.samples_done();
-    if let Some(path) = job.checkpoint_path()
-        && (ending != Ending::Complete || job.checkpoint.is_some())
-    {
-        accumulation.write(path)?;
-        say!("checkpoint  {} ({} of {} samples per pixel)", path.display(), accumulation.samples().end, samples.end);
-    }
-    let simulates_light = settings.integrator.simulates_light();
-    let image = (done > 0).then(|| accumulation.image());
-    let tone_map = match &image {
-        Some(image) => tone_map(&args.tone, simulates_light, image),
-        None => ToneMap::default(),
-    };
-    let wrote_output = if is_accumulation(&output) {
-        accumulation.write(&output)?;
-        true
-    } else if let Some(image) = &image {
-        image.write(&output, &tone_map)?;
-        true
+/// Refuses what cannot go with adaptive sampling: whether a pixel goes on
+/// depends on all its samples so far, so the render cannot be split,
+/// checkpointed or resumed.
+fn refuse_split_adaptive(args: &RenderArgs, output: &Path) -> Result<()> {
+    let job = &args.job;
+    let what = if job.samples.is_some() {
+        Some("--samples")
+    } else if job.tile.is_some() {
+        Some("--tile")
+    } else if job.resume.is_some() {
+        Some("--resume")
+    } else if job.checkpoint.is_some() {
+        Some("--checkpoint")
+    } else if job.time_limit.is_some() {
+        Some("--time-limit (which stops to checkpoint; --time bounds an adaptive render)")
+    } else if is_accumulation(output) {
+        Some("an .accum output")
     } else {
-        false
+        None
     };
-    if ending == Ending::Complete {
-        for (kind, path) in &aov_outputs {
-            let aov_settings = RenderSettings { integrator: *kind, ..settings.clone() };
-            let (aov, _) = pool.install(|| render(&scene, accel.as_ref(), &camera, &aov_settings, &|_| {}));
-            aov.write(path, &tone_map)?;
-        }
+    match what {
+        Some(what) => bail!(
+            "--noise and --time sample each pixel until its own samples say it is done, so the render cannot be \
+             split, checkpointed or resumed: {what} cannot go with them; render in one go, or use --spp"
+        ),
+        None => Ok(()),
     }
+}
 
-    let build = accel.as_ref().build_stats();
-    say!("scene       {scene_name}");
-    say!("triangles   {}", scene.triangles.len());
-    say!("load        {load_ms:.1} ms");
-    say!("build       {:.1} ms ({})", build.build_ms, build.variant);
-    say!(
-        "render      {:.1} ms, {}x{} at {} spp, {} threads, {} pass(es)",
-        totals.render_seconds * 1e3,
-        settings.width,
-        settings.height,
-        spp,
-        pool.current_num_threads(),
-        totals.passes
-    );
-    if job.is_part() {
-        say!("part        rows {rows:?}, samples {samples:?} of every pixel");
-    }
-    let rays_per_second = totals.rays as f64 / totals.render_seconds.max(1e-9);
-    say!("rays        {} ({:.3} Mrays/s)", totals.rays, rays_per_second * 1e-6);
-    let stopped_by = match ending {
-        Ending::Complete => None,
-        Ending::TimeLimit => Some(format!("the time limit ({} s)", job.time_limit.unwrap_or_default())),
-        Ending::Signal(signal) => Some(interrupt::name(signal).to_owned()),
-    };
-    if let Some(reason) = &stopped_by {
-        say!("stopped     by {reason} with {} of {} samples per pixel", accumulation.samples().end, samples.end);
-    }
-    if wrote_output {
-        let partial = if done < samples.len() as u32 { format!(" ({done} samples per pixel)") } else { String::new() };
-        say!("wrote       {}{partial}", output.display());
-        if OutputFormat::from_path(&output).is_ok_and(|f| f == OutputFormat::Png) {
-            let how = if args.tone.exposure.is_some() { "--exposure" } else { "automatic; --exposure sets it" };
-            say!("exposure    {:+.1} stops ({how}), {} tone map", tone_map.exposure, tone_map.operator);
-        }
-        if let Some(image) = &image {
-            let phrasing = if from_script { Phrasing::Script } else { Phrasing::Options };
-            warn_if_illegible(image, &tone_map, args.tone.exposure.is_some(), phrasing);
-        }
+/// What adaptive sampling did, and how to render the same image again.
+fn adaptive_summary(args: &RenderArgs, outcome: &AdaptiveOutcome, spp: u32, sampler: PixelSampler) -> String {
+    let why = if outcome.stopped_by_time {
+        // The rounds of a fixed count are its passes: without a noise target they sum to a plain render.
+        let sampler = if args.adaptive.noise.is_none() { format!(" --sampler {sampler}") } else { String::new() };
+        format!(
+            "--time {} ended it after {} samples per pixel; --spp {}{sampler} with the same options and no --time \
+             renders the same image",
+            args.adaptive.time.unwrap_or_default(),
+            outcome.samples_reached,
+            outcome.samples_reached
+        )
+    } else if args.adaptive.noise.is_none() {
+        format!("every pixel took --spp {spp} within --time {}", args.adaptive.time.unwrap_or_default())
+    } else if outcome.samples_reached < spp {
+        "every pixel reached the noise target".to_owned()
     } else {
-        say!("wrote       nothing: no sample finished");
-    }
-    if ending == Ending::Complete {
-        for (_, path) in &aov_outputs {
-            say!("wrote       {}", path.display());
-        }
-    } else if !aov_outputs.is_empty() {
-        say!("skipped     the AOVs (they are written when the render completes)");
-    }
-    match ending {
-        Ending::Signal(signal) => Err(StoppedBySignal(signal).into()),
-        Ending::TimeLimit if !wrote_output => bail!("no sample finished within the time limit"),
-        _ => printed.map(|()| Rendered {
-            image: image.map(|image| (image, tone_map)),
-            seconds: totals.render_seconds,
-            rays: totals.rays,
-        }),
-    }
+        format!("pixels still above the noise target stopped at --spp {spp}")
+    };
+    format!("adaptive    {} pixel samples in {} rounds; {why}", outcome.total_samples(), outcome.rounds.len())
 }
 
 /// Says so when the image came out almost black or almost white, with the

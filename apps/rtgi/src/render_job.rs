@@ -92,7 +92,7 @@ fn band(index: u32, count: u32, height: u32) -> Range<u32> {
     edge(index)..edge(index + 1)
 }
 
-fn parse_seconds(text: &str) -> Result<f64, String> {
+pub(crate) fn parse_seconds(text: &str) -> Result<f64, String> {
     text.parse::<f64>()
         .ok()
         .filter(|s| s.is_finite() && *s > 0.0)

@@ -44,7 +44,7 @@ pub(crate) fn to_fixed(value: Vec3) -> PixelSum {
 
 /// The mean of `count` samples whose fixed-point sum is `sum`.
 #[inline]
-fn mean(sum: &PixelSum, count: u32) -> Vec3 {
+pub(crate) fn mean(sum: &PixelSum, count: u32) -> Vec3 {
     let scale = 1.0 / ((1u64 << FIXED_POINT_BITS) as f64 * count.max(1) as f64);
     Vec3::from_array(sum.map(|c| (c as f64 * scale) as f32))
 }

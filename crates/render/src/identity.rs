@@ -54,6 +54,8 @@ impl RenderIdentity {
             environment,
             effects,
             default_lighting,
+            // Adaptive renders are never accumulated ([`crate::render_pass`] refuses them).
+            adaptive: _,
         } = settings;
         let environment = match environment {
             None => "planned".to_owned(),

@@ -30,6 +30,7 @@ pub struct ReadmeDoctests;
 
 mod accumulation;
 mod accumulation_file;
+pub mod adaptive;
 mod bounce_sampling;
 pub mod bsdf;
 mod camera;
@@ -52,6 +53,7 @@ pub mod view_lighting;
 
 pub use accumulation::{Accumulation, FIXED_POINT_BITS, MergeError, PartSpan, PixelSum, SAMPLE_LIMIT};
 pub use accumulation_file::{AccumulationFileError, MergeFilesError};
+pub use adaptive::{AdaptiveSampling, render_adaptive};
 pub use bounce_sampling::BounceSampling;
 pub use camera::CameraRays;
 pub use default_lighting::{ENCLOSED, default_sky, default_sun, room_light, sky_visibility};
@@ -132,6 +134,10 @@ pub struct RenderSettings {
     /// an enclosed camera), and whether a probe of the view found the
     /// scene's own lights too weak for it.
     pub default_lighting: DefaultLighting,
+    /// Adaptive sampling: `samples_per_pixel` is then the most a pixel
+    /// takes, in rounds, each pixel stopping at the noise target or all at
+    /// the time bound ([`adaptive`]); `None` renders every pixel's samples.
+    pub adaptive: Option<AdaptiveSampling>,
 }
 
 /// Light the planner adds to scenes that bring too little of their own.
@@ -174,6 +180,7 @@ impl Default for RenderSettings {
             environment: None,
             effects: EffectOverrides::default(),
             default_lighting: DefaultLighting::Auto,
+            adaptive: None,
         }
     }
 }
@@ -219,7 +226,14 @@ fn tiles(width: u32, rows: Range<u32>) -> Vec<(u32, u32, u32, u32)> {
 /// finished since its last call; it must be cheap.
 ///
 /// The image has the same bits as any progressive or split render of the
-/// same settings ([`render_pass`], [`Accumulation::merge`]).
+/// same settings ([`render_pass`], [`Accumulation::merge`]). With
+/// [`RenderSettings::adaptive`], pixels take samples in rounds until their
+/// noise is low enough ([`render_adaptive`], which also says how each
+/// round went); such renders are not split.
+///
+/// # Panics
+/// If `settings.adaptive` cannot run ([`AdaptiveSampling::check`]: a
+/// sampler laid out for a fixed count, or no target).
 pub fn render<A: Accel + ?Sized>(
     scene: &Scene,
     accel: &A,
@@ -227,6 +241,20 @@ pub fn render<A: Accel + ?Sized>(
     settings: &RenderSettings,
     progress: &(dyn Fn(u64) + Sync),
 ) -> (HdrImage, RenderStats) {
+    if let Some(sampling) = &settings.adaptive {
+        let start = Instant::now();
+        let (image, outcome) = render_adaptive(scene, accel, camera, settings, sampling, &mut |_| {})
+            .unwrap_or_else(|e| panic!("adaptive sampling as the settings ask cannot run: {e}"));
+        progress(settings.width as u64 * settings.height as u64);
+        let stats = RenderStats {
+            width: settings.width,
+            height: settings.height,
+            samples_per_pixel: outcome.samples_reached,
+            rays: outcome.rays(),
+            render_ms: start.elapsed().as_secs_f64() * 1e3,
+        };
+        return (image, stats);
+    }
     let spp = settings.samples_per_pixel.max(1);
     let per_pixel = |done: u64| progress(done / spp as u64);
     let control = PassControl { progress: &per_pixel, cancelled: &|| false };
@@ -267,7 +295,8 @@ pub struct Cancelled;
 ///
 /// # Panics
 /// If `accumulation` is of another size, seed or sample count than
-/// `settings`, or `count` goes past the render's samples.
+/// `settings`, `count` goes past the render's samples, or the settings are
+/// adaptive.
 pub fn render_pass<A: Accel + ?Sized>(
     scene: &Scene,
     accel: &A,
@@ -277,6 +306,7 @@ pub fn render_pass<A: Accel + ?Sized>(
     count: u32,
     control: &PassControl<'_>,
 ) -> Result<RenderStats, Cancelled> {
+    assert!(settings.adaptive.is_none(), "adaptive renders are rendered in one go, not in passes");
     let identity = accumulation.identity();
     assert!(
         (identity.width, identity.height, identity.samples_per_pixel, identity.seed)
@@ -307,6 +337,22 @@ fn render_sums<A: Accel + ?Sized>(
     samples: Range<u32>,
     control: &PassControl<'_>,
 ) -> Result<(Vec<PixelSum>, RenderStats), Cancelled> {
+    render_sums_of(scene, accel, camera, settings, rows, samples, None, control)
+}
+
+/// [`render_sums`] of the pixels `active` marks (all without it; indexed
+/// by `y · width + x`); the other pixels' sums are zero.
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn render_sums_of<A: Accel + ?Sized>(
+    scene: &Scene,
+    accel: &A,
+    camera: &Camera,
+    settings: &RenderSettings,
+    rows: Range<u32>,
+    samples: Range<u32>,
+    active: Option<&[bool]>,
+    control: &PassControl<'_>,
+) -> Result<(Vec<PixelSum>, RenderStats), Cancelled> {
     let start = Instant::now();
     // The views of the closest hit follow the plan for alpha and textures too.
     let plan = EffectPlan::new(scene, settings);
@@ -315,7 +361,7 @@ fn render_sums<A: Accel + ?Sized>(
     // unless alpha masks need the filtered query.
     let batch = |rays: &[Ray], hits: &mut [Option<Hit>]| accel.intersect_batch(rays, hits);
     let first_hits: Option<&FirstHits> = if alpha { None } else { Some(&batch) };
-    let pass = Pass { camera, settings, rows: rows.clone(), samples: samples.clone(), control, first_hits };
+    let pass = Pass { camera, settings, rows: rows.clone(), samples: samples.clone(), active, control, first_hits };
     let (sums, rays) = match settings.integrator {
         Integrator::Primary => render_samples(&pass, |start, rng, rays| {
             *rays += 1;
@@ -353,6 +399,8 @@ struct Pass<'a> {
     settings: &'a RenderSettings,
     rows: Range<u32>,
     samples: Range<u32>,
+    /// With `Some`, only the pixels it marks are rendered (by `y · width + x`).
+    active: Option<&'a [bool]>,
     control: &'a PassControl<'a>,
     /// With `Some`, camera rays are traced in blocks through it.
     first_hits: Option<&'a FirstHits<'a>>,
@@ -433,8 +481,17 @@ fn render_samples(
     let camera_rays = CameraRays::new(pass.camera, width, settings.height);
     let spp = settings.samples_per_pixel.max(1);
     let first_hits = pass.first_hits;
-    render_blocks(width, pass.rows.clone(), pass.control, |pixels, values| {
+    render_blocks(width, pass.rows.clone(), pass.control, |pixels, values: &mut [PixelSum]| {
         let pixel_index = |(x, y): (u32, u32)| y as u64 * width as u64 + x as u64;
+        // The block's pixels to render, and where their sums go.
+        let chosen: Vec<usize> = match pass.active {
+            None => (0..pixels.len()).collect(),
+            Some(active) => (0..pixels.len()).filter(|&i| active[pixel_index(pixels[i]) as usize]).collect(),
+        };
+        let pixels: Vec<(u32, u32)> = chosen.iter().map(|&i| pixels[i]).collect();
+        if pixels.is_empty() {
+            return Some(0);
+        }
         // One more generator per pixel, past every sample's: its shift of the pixel's pattern.
         let shifts: Vec<Vec2> = pixels
             .iter()
@@ -467,7 +524,7 @@ fn render_samples(
                 let start =
                     PathStart { ray: *ray, first_hit: first_hits.map(|_| hits[i]), pixel, sampler: settings.sampler };
                 let value = sample(&start, rng, &mut traced);
-                accumulation::add(&mut values[i], &to_fixed(value));
+                accumulation::add(&mut values[chosen[i]], &to_fixed(value));
             }
         }
         (pass.control.progress)(pixels.len() as u64 * pass.samples.len() as u64);
