@@ -40,6 +40,7 @@ fn every_knob_writes_its_table_json_and_plots() {
         "packets",
         "direct",
         "clamp",
+        "adaptive",
         "analytic",
         "effects",
         "intersector",
@@ -120,11 +121,12 @@ fn every_knob_writes_its_table_json_and_plots() {
             assert_eq!(point["values"]["differing"], 0.0, "{knob}, {series}: {point}");
         }
     }
-    // The four equal-time panels: PNGs listed in the JSON, their captions among the findings.
+    // The equal-time panels: PNGs listed in the JSON, their captions among the findings.
     for (knob, panel) in [
         ("spp", "spp-equal-time.png"),
         ("depth", "depth-equal-time.png"),
         ("clamp", "clamp-equal-time.png"),
+        ("adaptive", "adaptive-equal-time.png"),
         ("direct", "direct-small-light-equal-time.png"),
     ] {
         let json: serde_json::Value =

@@ -43,6 +43,7 @@ fn report_scenes(knob: Knob) -> &'static [&'static str] {
         Knob::Spp => &[CORNELL, BUNNY, ROOM, GLOSSY],
         Knob::Depth => &[CORNELL, SPONZA],
         Knob::Clamp => &[CORNELL, ROOM, CONFERENCE],
+        Knob::Adaptive => &[CORNELL, ROOM],
         Knob::Accel => &[CORNELL, BUNNY, SPONZA, CONFERENCE],
         Knob::Effects => &[CORNELL, HELMET],
         Knob::Traversal | Knob::Packets => &[BUNNY],

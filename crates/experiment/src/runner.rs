@@ -59,6 +59,24 @@ pub(crate) fn equal_time(
     configurations
         .iter()
         .map(|(label, settings, ms_per_sample)| {
+            if let Some(sampling) = settings.adaptive {
+                // Adaptive sampling bounded by the budget itself: its rounds
+                // stop when the next would overrun, so it takes at most the budget.
+                let bounded = RenderSettings {
+                    samples_per_pixel: MAX_PANEL_SPP as u32,
+                    seed: 0,
+                    adaptive: Some(rtgi_render::AdaptiveSampling { seconds: Some(budget_ms * 1e-3), ..sampling }),
+                    ..settings.clone()
+                };
+                let (image, time_ms) = render(subject, &bounded);
+                let rmse = rtgi_image::compare(&image, &reference.image).expect("same size").rmse;
+                return crate::panel::Entry {
+                    label: format!("{label}, --time {:.3} s", budget_ms * 1e-3),
+                    image,
+                    time_ms,
+                    rmse,
+                };
+            }
             let render_at =
                 |spp: u32| render(subject, &RenderSettings { samples_per_pixel: spp, seed: 0, ..settings.clone() });
             let mut spp = (budget_ms / ms_per_sample.max(1e-9)).round().clamp(1.0, MAX_PANEL_SPP) as u32;

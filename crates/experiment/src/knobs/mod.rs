@@ -6,6 +6,7 @@ use crate::report::Report;
 use crate::{ExperimentError, Machine, Options, Subject};
 
 mod accel;
+mod adaptive;
 mod analytic;
 mod clamp;
 mod depth;
@@ -38,6 +39,8 @@ pub enum Knob {
     Direct,
     /// The indirect-light clamp: bias traded for variance.
     Clamp,
+    /// Adaptive sampling (noise targets) against fixed samples per pixel.
+    Adaptive,
     /// Each estimator's bias against answers known in closed form (white furnaces).
     Analytic,
     /// Each decision of the effects planner reversed.
@@ -62,6 +65,7 @@ impl Knob {
         Knob::Packets,
         Knob::Direct,
         Knob::Clamp,
+        Knob::Adaptive,
         Knob::Analytic,
         Knob::Effects,
         Knob::Intersector,
@@ -79,6 +83,7 @@ impl Knob {
             Knob::Packets => "packets",
             Knob::Direct => "direct",
             Knob::Clamp => "clamp",
+            Knob::Adaptive => "adaptive",
             Knob::Analytic => "analytic",
             Knob::Effects => "effects",
             Knob::Intersector => "intersector",
@@ -109,6 +114,9 @@ impl Knob {
                 "which sampling of direct light (light, BSDF or MIS) gives the least error in equal time, and where?"
             }
             Knob::Clamp => "how much bias does clamping indirect light add for the variance it removes?",
+            Knob::Adaptive => {
+                "does sampling until each pixel meets a noise target beat the same samples everywhere, at equal time?"
+            }
             Knob::Analytic => {
                 "is any estimator (sampler, direct-light strategy, roulette) biased against an answer known exactly?"
             }
@@ -187,6 +195,7 @@ pub(crate) fn run(
         Knob::Packets => packets::run(subject, options, report, progress),
         Knob::Direct => direct::run(subject, options, report, progress),
         Knob::Clamp => clamp::run(subject, options, report, progress),
+        Knob::Adaptive => adaptive::run(subject, options, report, progress),
         Knob::Analytic => analytic::run(options, report, progress),
         Knob::Effects => effects::run(subject, options, report, progress),
         Knob::Intersector => intersector::run(subject, options, report, progress),
