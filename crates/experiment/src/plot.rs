@@ -155,8 +155,10 @@ fn format_tick(v: f64) -> String {
 }
 
 /// Labelled ticks for a log axis from `lo` to `hi`: powers of ten, then 1,
-/// 2 and 5 times them, then every integer mantissa, whichever first gives
-/// at least three ticks inside the range.
+/// 2 and 5 times them, then every integer mantissa, then every half, fifth
+/// and tenth of one, whichever first gives at least three ticks inside the
+/// range (so a narrow range, 305 to 575, gets 350, 400, … 550, not 27
+/// labels that run into each other).
 fn log_ticks(lo: f64, hi: f64) -> Vec<f64> {
     // Within the doubles' range, whatever the axis was given (a range of a
     // thousand decades would otherwise ask for billions of ticks).
@@ -166,8 +168,11 @@ fn log_ticks(lo: f64, hi: f64) -> Vec<f64> {
         let step = ((last - first) / 6).max(1) as usize;
         return (first..=last).step_by(step).map(|e| 10f64.powi(e)).filter(|v| *v >= lo && *v <= hi).collect();
     }
-    let tenths: Vec<f64> = (10..100).map(|m| m as f64 / 10.0).collect();
-    for mantissas in [&[1.0][..], &[1.0, 2.0, 5.0], &[1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 8.0, 9.0], &tenths] {
+    let steps = |step: usize| -> Vec<f64> { (10..100).step_by(step).map(|m| m as f64 / 10.0).collect() };
+    let (halves, fifths, tenths) = (steps(5), steps(2), steps(1));
+    for mantissas in
+        [&[1.0][..], &[1.0, 2.0, 5.0], &[1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 8.0, 9.0], &halves, &fifths, &tenths]
+    {
         let ticks: Vec<f64> = (first..=last)
             .flat_map(|e| mantissas.iter().map(move |m| m * 10f64.powi(e)))
             // Rounded as printed, so that 0.3 is 0.3 and not 0.30000000000000004.
@@ -486,9 +491,10 @@ mod tests {
     #[test]
     fn log_axes_have_at_least_three_labelled_ticks() {
         assert_eq!(log_ticks(0.05, 200.0), vec![0.1, 1.0, 10.0, 100.0]);
-        // Less than a decade (the depth knob's RMSE): 1-2-5 mantissas, then every integer, then tenths.
+        // Less than a decade (the depth knob's RMSE): 1-2-5 mantissas, then every integer, then halves, fifths, tenths.
         assert_eq!(log_ticks(0.011, 0.06), vec![0.02, 0.03, 0.04, 0.05, 0.06]);
-        assert_eq!(log_ticks(0.109, 0.1616), vec![0.11, 0.12, 0.13, 0.14, 0.15, 0.16]);
+        assert_eq!(log_ticks(0.109, 0.1616), vec![0.12, 0.14, 0.16]);
+        assert_eq!(log_ticks(305.0, 575.0), vec![350.0, 400.0, 450.0, 500.0, 550.0]);
         assert_eq!(log_ticks(0.01211, 0.01219).len(), 3);
         // Hundreds of decades (a degenerate value on the axis): a handful of powers of ten.
         assert!(log_ticks(1e-300, 1e300).len() <= 8);
