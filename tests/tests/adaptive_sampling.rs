@@ -45,7 +45,8 @@ fn render_with(
     settings: &RenderSettings,
     sampling: &AdaptiveSampling,
 ) -> (HdrImage, AdaptiveOutcome) {
-    render_adaptive(scene, accel.as_ref(), camera, settings, sampling, &mut |_| {}).unwrap()
+    let settings = RenderSettings { adaptive: Some(*sampling), ..settings.clone() };
+    render_adaptive(scene, accel.as_ref(), camera, &settings, &mut |_| {}).unwrap()
 }
 
 fn bits(image: &HdrImage) -> Vec<u32> {
@@ -170,8 +171,8 @@ fn samplers_laid_out_for_a_fixed_count_and_meaningless_targets_are_refused() {
     let Some(box_) = cornell() else { return };
     let (scene, accel, camera) = &box_;
     let run = |sampler: PixelSampler, sampling: AdaptiveSampling| {
-        let settings = RenderSettings { sampler, ..settings(8, 16, 1) };
-        render_adaptive(scene, accel.as_ref(), camera, &settings, &sampling, &mut |_| {}).err()
+        let settings = RenderSettings { sampler, adaptive: Some(sampling), ..settings(8, 16, 1) };
+        render_adaptive(scene, accel.as_ref(), camera, &settings, &mut |_| {}).err()
     };
     for sampler in [PixelSampler::Stratified, PixelSampler::LowDiscrepancy] {
         assert_eq!(run(sampler, adaptive(Some(0.1), None)), Some(AdaptiveError::Sampler(sampler)));

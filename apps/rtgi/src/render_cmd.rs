@@ -187,12 +187,12 @@ pub(crate) fn render_given(args: &RenderArgs, given: Option<Given<'_>>) -> Resul
     }
     let renderer = Renderer { scene: &scene, accel: accel.as_ref(), camera: &camera, settings: &settings };
     let rendered = match adaptive {
-        Some(adaptive) => {
+        Some(_) => {
             let mut rounds_printed = Ok(());
             let (image, outcome) = pool.install(|| {
-                render_adaptive(&scene, accel.as_ref(), &camera, &settings, &adaptive, &mut |round| {
-                    rounds_printed = std::mem::replace(&mut rounds_printed, Ok(())).and_then(|()| {
-                        outln!(
+                render_adaptive(&scene, accel.as_ref(), &camera, &settings, &mut |round| {
+                    if rounds_printed.is_ok() {
+                        rounds_printed = outln!(
                             "round       {} samples per pixel: {} pixels rendered, {} of {} within the noise target, \
                              {:.0} ms",
                             round.samples_per_pixel,
@@ -200,8 +200,8 @@ pub(crate) fn render_given(args: &RenderArgs, given: Option<Given<'_>>) -> Resul
                             round.converged,
                             settings.width as u64 * settings.height as u64,
                             round.seconds * 1e3
-                        )
-                    })
+                        );
+                    }
                 })
             })?;
             printed = printed.and(rounds_printed);
@@ -399,13 +399,14 @@ fn render_progressively(
                 ))
                 .into());
             }
-            let said = outln!(
-                "resuming   {} at {} of {} samples per pixel",
-                resume.display(),
-                resumed.samples().end,
-                samples.end
-            );
-            *printed = std::mem::replace(printed, Ok(())).and(said);
+            if printed.is_ok() {
+                *printed = outln!(
+                    "resuming   {} at {} of {} samples per pixel",
+                    resume.display(),
+                    resumed.samples().end,
+                    samples.end
+                );
+            }
             resumed
         }
     };

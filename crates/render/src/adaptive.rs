@@ -154,16 +154,17 @@ impl AdaptiveSampling {
 }
 
 /// Renders `scene` with up to `settings.samples_per_pixel` samples a
-/// pixel, in rounds, each pixel stopping as `adaptive` says (see the
-/// module's documentation). `on_round` hears of each round as it ends.
+/// pixel, in rounds, each pixel stopping as `settings.adaptive` says (see
+/// the module's documentation; without it, [`AdaptiveError::NoTarget`]).
+/// `on_round` hears of each round as it ends.
 pub fn render_adaptive<A: Accel + ?Sized>(
     scene: &Scene,
     accel: &A,
     camera: &Camera,
     settings: &RenderSettings,
-    adaptive: &AdaptiveSampling,
     on_round: &mut dyn FnMut(&Round),
 ) -> Result<(HdrImage, AdaptiveOutcome), AdaptiveError> {
+    let adaptive = settings.adaptive.ok_or(AdaptiveError::NoTarget)?;
     adaptive.check(settings)?;
     let (width, height) = (settings.width, settings.height);
     let pixels = width as usize * height as usize;

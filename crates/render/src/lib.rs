@@ -241,9 +241,9 @@ pub fn render<A: Accel + ?Sized>(
     settings: &RenderSettings,
     progress: &(dyn Fn(u64) + Sync),
 ) -> (HdrImage, RenderStats) {
-    if let Some(sampling) = &settings.adaptive {
+    if settings.adaptive.is_some() {
         let start = Instant::now();
-        let (image, outcome) = render_adaptive(scene, accel, camera, settings, sampling, &mut |_| {})
+        let (image, outcome) = render_adaptive(scene, accel, camera, settings, &mut |_| {})
             .unwrap_or_else(|e| panic!("adaptive sampling as the settings ask cannot run: {e}"));
         progress(settings.width as u64 * settings.height as u64);
         let stats = RenderStats {
@@ -483,12 +483,18 @@ fn render_samples(
     let first_hits = pass.first_hits;
     render_blocks(width, pass.rows.clone(), pass.control, |pixels, values: &mut [PixelSum]| {
         let pixel_index = |(x, y): (u32, u32)| y as u64 * width as u64 + x as u64;
-        // The block's pixels to render, and where their sums go.
-        let chosen: Vec<usize> = match pass.active {
-            None => (0..pixels.len()).collect(),
-            Some(active) => (0..pixels.len()).filter(|&i| active[pixel_index(pixels[i]) as usize]).collect(),
+        // Under a mask, the block's pixels still going, and where their
+        // sums go; without one (every other render), the block as it is.
+        let chosen: Option<Vec<usize>> =
+            pass.active.map(|active| (0..pixels.len()).filter(|&i| active[pixel_index(pixels[i]) as usize]).collect());
+        let masked: Vec<(u32, u32)>;
+        let pixels = match &chosen {
+            None => pixels,
+            Some(chosen) => {
+                masked = chosen.iter().map(|&i| pixels[i]).collect();
+                &masked[..]
+            }
         };
-        let pixels: Vec<(u32, u32)> = chosen.iter().map(|&i| pixels[i]).collect();
         if pixels.is_empty() {
             return Some(0);
         }
@@ -524,7 +530,8 @@ fn render_samples(
                 let start =
                     PathStart { ray: *ray, first_hit: first_hits.map(|_| hits[i]), pixel, sampler: settings.sampler };
                 let value = sample(&start, rng, &mut traced);
-                accumulation::add(&mut values[chosen[i]], &to_fixed(value));
+                let slot = chosen.as_ref().map_or(i, |chosen| chosen[i]);
+                accumulation::add(&mut values[slot], &to_fixed(value));
             }
         }
         (pass.control.progress)(pixels.len() as u64 * pass.samples.len() as u64);

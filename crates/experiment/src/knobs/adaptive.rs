@@ -24,12 +24,7 @@ pub(super) fn run(
     mut report: Report,
     progress: &dyn Fn(&str),
 ) -> Result<Report, ExperimentError> {
-    if !subject.settings.integrator.simulates_light() {
-        return Err(ExperimentError::Unsuitable(format!(
-            "the adaptive experiment needs an integrator that simulates light (the subject uses '{}')",
-            subject.settings.integrator
-        )));
-    }
+    super::require_light_transport(subject, "adaptive")?;
     let (counts, targets, most): (&[u32], &[f32], u32) =
         if options.quick { (&[4, 16], &[0.3], 64) } else { (&[16, 64, 256], &[0.2, 0.1, 0.05, 0.03], MOST) };
     let samplers = [PixelSampler::Stratified, PixelSampler::Sobol];

@@ -24,12 +24,7 @@ pub(super) fn run(
     mut report: Report,
     progress: &dyn Fn(&str),
 ) -> Result<Report, ExperimentError> {
-    if !subject.settings.integrator.simulates_light() {
-        return Err(ExperimentError::Unsuitable(format!(
-            "the clamp experiment needs an integrator that simulates light (the subject uses '{}')",
-            subject.settings.integrator
-        )));
-    }
+    super::require_light_transport(subject, "clamp")?;
     let limits: &[f64] = if options.quick { &[0.25, 1.0, 4.0] } else { &LIMITS };
     let spp = if options.quick { 4 } else { 16 };
     let base = RenderSettings { samples_per_pixel: spp, indirect_clamp: None, ..subject.settings.clone() };

@@ -204,3 +204,15 @@ pub(crate) fn run(
     report.date = crate::provenance::utc_now();
     Ok(report)
 }
+
+/// Refuses a subject whose integrator simulates no light, for the knobs
+/// that change how light transport is sampled (`knob` names the experiment).
+fn require_light_transport(subject: &Subject, knob: &str) -> Result<(), ExperimentError> {
+    if subject.settings.integrator.simulates_light() {
+        return Ok(());
+    }
+    Err(ExperimentError::Unsuitable(format!(
+        "the {knob} experiment needs an integrator that simulates light (the subject uses '{}')",
+        subject.settings.integrator
+    )))
+}
