@@ -70,6 +70,59 @@ proptest! {
     }
 }
 
+/// Runs of sixteen rays from nearby origins in nearby directions, as a
+/// tile of camera rays is, so that the wide BVHs' batch queries trace them
+/// as packets; the last run is scattered, for the single-ray fallback.
+fn coherent_runs() -> impl Strategy<Value = Vec<Ray>> {
+    let run = (vec3(-14.0..14.0), vec3(-1.0..1.0), prop::collection::vec((vec3(-0.3..0.3), vec3(-0.05..0.05)), 16));
+    (prop::collection::vec(run, 3), rays()).prop_map(|(runs, scattered)| {
+        let mut rays: Vec<Ray> = runs
+            .into_iter()
+            .flat_map(|(origin, direction, jitters)| {
+                jitters.into_iter().map(move |(dp, dd)| Ray::new(origin + dp, direction + dd))
+            })
+            .collect();
+        rays.extend(scattered.into_iter().take(16));
+        rays
+    })
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 24, ..ProptestConfig::default() })]
+
+    /// The batch queries with a filter (cut-outs in `rtgi trace`) answer
+    /// as the linear scan's single filtered queries, bit for bit, packets
+    /// included.
+    #[test]
+    fn filtered_batches_match_the_linear_scan(triangles in soup(), rays in coherent_runs()) {
+        let holes = |t: u32, beta: f32, _: f32| !t.is_multiple_of(3) || beta > 0.5;
+        let references: Vec<(Intersector, Vec<_>)> = Intersector::ALL
+            .iter()
+            .map(|&i| {
+                let reference = LinearScan::new(&triangles, i);
+                (i, rays.iter().map(|r| (reference.intersect_filtered(r, &holes), reference.occluded_filtered(r, &holes))).collect())
+            })
+            .collect();
+        let mut failures = Vec::new();
+        for_every_variant(&triangles, |label, accel, params| {
+            let expected = &references.iter().find(|(i, _)| *i == params.intersector).expect("every intersector").1;
+            let mut closest = vec![None; rays.len()];
+            let mut any = vec![false; rays.len()];
+            accel.intersect_batch_filtered(&rays, &mut closest, &holes);
+            accel.occluded_batch_filtered(&rays, &mut any, &holes);
+            for (i, (ray, (want_closest, want_any))) in rays.iter().zip(expected).enumerate() {
+                if !same_hit(closest[i], *want_closest) {
+                    failures.push(format!("{label}: batch filtered closest {:?} != {want_closest:?} for ray {i} {ray:?}", closest[i]));
+                }
+                if any[i] != *want_any {
+                    failures.push(format!("{label}: batch filtered any-hit differs for ray {i} {ray:?}"));
+                }
+            }
+        });
+        prop_assert!(failures.is_empty(), "{}", failures.join("\n"));
+    }
+}
+
 #[test]
 fn helper_covers_every_variant() {
     let mut labels = Vec::new();

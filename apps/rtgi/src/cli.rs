@@ -537,6 +537,12 @@ pub(crate) struct TraceArgs {
     #[arg(long)]
     pub(crate) any_hit: bool,
 
+    /// Trace cut-outs (alpha-masked and blended materials) as solid surfaces; by default
+    /// rays pass through their holes as in renders, and blended surfaces count where their
+    /// alpha exceeds one half
+    #[arg(long)]
+    pub(crate) no_alpha: bool,
+
     #[command(flatten)]
     pub(crate) accel: AccelArgs,
 

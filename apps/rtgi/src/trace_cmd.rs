@@ -7,6 +7,7 @@ use anyhow::{Context, Result, bail};
 use rayon::prelude::*;
 use rtgi_accel::Accel;
 use rtgi_math::{Ray, Vec3};
+use rtgi_render::{alpha_accepts, has_alpha};
 
 use crate::cli::TraceArgs;
 use crate::common::{LoadedScene, check_output_folder, load_scene, refuse_inputs_as_outputs};
@@ -17,6 +18,10 @@ pub(crate) const RAY_BYTES: usize = 32;
 pub(crate) const HIT_BYTES: usize = 16;
 /// The triangle index of a miss.
 pub(crate) const MISS: u32 = u32::MAX;
+/// The uniform number a blended surface's alpha is compared with: a ray
+/// file has no samples to average stochastic transparency over, so a
+/// blended surface counts where its alpha exceeds one half.
+const BLEND_THRESHOLD: f32 = 0.5;
 /// Rays given to the batch queries at once: the wide BVHs trace coherent
 /// runs of the file (camera rays in tiles) as packets.
 const BATCH_RAYS: usize = 1024;
@@ -42,12 +47,16 @@ pub(crate) fn run(args: &TraceArgs) -> Result<()> {
     let accel = pool.install(|| args.accel.build(&scene))?;
     let build_ms = build_start.elapsed().as_secs_f64() * 1e3;
 
+    let cut_outs = has_alpha(&scene) && !args.no_alpha;
+    let accept = |triangle, beta, gamma| alpha_accepts(&scene, triangle, beta, gamma, BLEND_THRESHOLD);
+    let filter: Option<&(dyn Fn(u32, f32, f32) -> bool + Sync)> = cut_outs.then_some(&accept);
+
     let mut output = PartialFile::create(&out)?;
     let mut hits = Vec::with_capacity(CHUNK_RAYS);
     let (mut ray_count, mut hit_count, mut trace_s) = (0usize, 0usize, 0.0);
     while more {
         let trace_start = Instant::now();
-        pool.install(|| trace_chunk(accel.as_ref(), &rays, args.any_hit, &mut hits));
+        pool.install(|| trace_chunk(accel.as_ref(), &rays, args.any_hit, filter, &mut hits));
         trace_s += trace_start.elapsed().as_secs_f64();
         ray_count += rays.len();
         hit_count += hits.iter().filter(|h| h[4..8] != MISS.to_le_bytes()).count();
@@ -58,6 +67,18 @@ pub(crate) fn run(args: &TraceArgs) -> Result<()> {
 
     eprintln!("load   {load_ms:.1} ms ({} triangles)", scene.triangles.len());
     eprintln!("build  {build_ms:.1} ms ({})", accel.build_stats().variant);
+    if has_alpha(&scene) {
+        let materials = scene.materials.iter().filter(|m| m.alpha_mode != rtgi_scene::AlphaMode::Opaque).count();
+        eprintln!(
+            "alpha  {materials} of {} materials have cut-outs: {}",
+            scene.materials.len(),
+            if cut_outs {
+                "rays pass through their holes (blended ones where alpha is at most 0.5); --no-alpha traces them solid"
+            } else {
+                "traced solid (--no-alpha)"
+            }
+        );
+    }
     eprintln!(
         "trace  {:.1} ms: {} rays, {} {}, {:.2} Mrays/s on {} threads (file I/O excluded)",
         trace_s * 1e3,
@@ -71,20 +92,33 @@ pub(crate) fn run(args: &TraceArgs) -> Result<()> {
 }
 
 /// Traces `rays` through the batch queries, `BATCH_RAYS` at a time in
-/// parallel, and puts their encoded hits in `hits`, in the same order.
-fn trace_chunk(accel: &dyn Accel, rays: &[Ray], any_hit: bool, hits: &mut Vec<[u8; HIT_BYTES]>) {
+/// parallel, with the hit filter if there is one (cut-outs), and puts
+/// their encoded hits in `hits`, in the same order.
+fn trace_chunk(
+    accel: &dyn Accel,
+    rays: &[Ray],
+    any_hit: bool,
+    filter: Option<&(dyn Fn(u32, f32, f32) -> bool + Sync)>,
+    hits: &mut Vec<[u8; HIT_BYTES]>,
+) {
     hits.clear();
     hits.resize(rays.len(), [0; HIT_BYTES]);
     rays.par_chunks(BATCH_RAYS).zip(hits.par_chunks_mut(BATCH_RAYS)).for_each(|(batch, encoded)| {
         if any_hit {
             let mut occluded = vec![false; batch.len()];
-            accel.occluded_batch(batch, &mut occluded);
+            match filter {
+                Some(accept) => accel.occluded_batch_filtered(batch, &mut occluded, accept),
+                None => accel.occluded_batch(batch, &mut occluded),
+            }
             for (out, &o) in encoded.iter_mut().zip(&occluded) {
                 *out = encode_hit(0.0, if o { 0 } else { MISS }, 0.0, 0.0);
             }
         } else {
             let mut closest = vec![None; batch.len()];
-            accel.intersect_batch(batch, &mut closest);
+            match filter {
+                Some(accept) => accel.intersect_batch_filtered(batch, &mut closest, accept),
+                None => accel.intersect_batch(batch, &mut closest),
+            }
             for (out, hit) in encoded.iter_mut().zip(&closest) {
                 *out = match hit {
                     Some(h) => encode_hit(h.t, h.triangle, h.beta, h.gamma),

@@ -33,8 +33,8 @@
 use rtgi_math::{Ray, Vec3, Vec3A};
 
 use crate::slab::{BoxRay, RobustSlabs, SlabTest};
-use crate::triangle::{TriangleHit, TriangleTest};
-use crate::{Accel, BuildStats, Counter, Hit, NoCounter, TraversalCounters};
+use crate::triangle::{TriangleHit, TriangleTest, with_triangle_test};
+use crate::{Accel, BuildStats, Counter, Hit, Intersector, NoCounter, TraversalCounters};
 
 /// Whether a triangle can ever be hit: all corners finite and a non-zero
 /// area. The area is measured in double precision, where the cross product
@@ -47,6 +47,30 @@ pub fn is_hittable(triangle: &[Vec3; 3]) -> bool {
     }
     let [a, b, c] = triangle.map(|v| v.as_dvec3());
     (b - a).cross(c - a) != rtgi_math::glam::DVec3::ZERO
+}
+
+impl Intersector {
+    /// Intersects one ray with one triangle under the structures' hit rule
+    /// (see the crate's exactness contract): the hit if the triangle can be
+    /// hit at all ([`crate::is_hittable`]), its `t` lies in `[t_min, t_max]`
+    /// and the point is inside the triangle, edges included, with exactly
+    /// the bits every structure reports for it. Both sides are hit;
+    /// triangles of zero area and rays in a triangle's plane never are.
+    pub fn intersect(
+        self,
+        origin: Vec3,
+        direction: Vec3,
+        t_min: f32,
+        t_max: f32,
+        v: &[Vec3; 3],
+    ) -> Option<TriangleHit> {
+        let ray = Ray::with_range(origin, direction, t_min, t_max);
+        if !ray.is_valid() || !is_hittable(v) {
+            return None;
+        }
+        let v = v.map(Vec3A::from);
+        with_triangle_test!(self, |T| hit_triangle(&PreparedRay::<T>::new(&ray), &v, t_max))
+    }
 }
 
 /// A ray prepared once for the triangle test `T` and for box tests.
@@ -199,9 +223,14 @@ pub(crate) trait Structure: Send + Sync + std::fmt::Debug {
     /// [`Structure::query`] for every ray of `rays`, handing each answer
     /// to `answer(index, hit)`. Structures that trace coherent rays
     /// together override it.
-    fn query_batch<Q: QueryKind>(&self, rays: &[Ray], answer: &mut dyn FnMut(usize, Option<Hit>)) {
+    fn query_batch<Q: QueryKind, F: HitFilter>(
+        &self,
+        rays: &[Ray],
+        answer: &mut dyn FnMut(usize, Option<Hit>),
+        filter: &F,
+    ) {
         for (index, ray) in rays.iter().enumerate() {
-            answer(index, self.query::<Q, _, _>(ray, &mut NoCounter, &AcceptAll));
+            answer(index, self.query::<Q, _, _>(ray, &mut NoCounter, filter));
         }
     }
 
@@ -241,12 +270,22 @@ impl<S: Structure> Accel for S {
 
     fn intersect_batch(&self, rays: &[Ray], hits: &mut [Option<Hit>]) {
         assert_eq!(rays.len(), hits.len(), "one hit slot per ray");
-        self.query_batch::<Closest>(rays, &mut |index, hit| hits[index] = hit);
+        self.query_batch::<Closest, _>(rays, &mut |index, hit| hits[index] = hit, &AcceptAll);
     }
 
     fn occluded_batch(&self, rays: &[Ray], occluded: &mut [bool]) {
         assert_eq!(rays.len(), occluded.len(), "one answer slot per ray");
-        self.query_batch::<AnyHit>(rays, &mut |index, hit| occluded[index] = hit.is_some());
+        self.query_batch::<AnyHit, _>(rays, &mut |index, hit| occluded[index] = hit.is_some(), &AcceptAll);
+    }
+
+    fn intersect_batch_filtered(&self, rays: &[Ray], hits: &mut [Option<Hit>], accept: &dyn Fn(u32, f32, f32) -> bool) {
+        assert_eq!(rays.len(), hits.len(), "one hit slot per ray");
+        self.query_batch::<Closest, _>(rays, &mut |index, hit| hits[index] = hit, &accept);
+    }
+
+    fn occluded_batch_filtered(&self, rays: &[Ray], occluded: &mut [bool], accept: &dyn Fn(u32, f32, f32) -> bool) {
+        assert_eq!(rays.len(), occluded.len(), "one answer slot per ray");
+        self.query_batch::<AnyHit, _>(rays, &mut |index, hit| occluded[index] = hit.is_some(), &accept);
     }
 }
 

@@ -335,6 +335,71 @@ impl EmbreeBackend {
         context.rethrow();
         embree_ray.tfar == f32::NEG_INFINITY
     }
+
+    /// Closest hits of `rays` in packets of 16, with `filter` (or none) in the context.
+    fn closest_batch(&self, rays: &[Ray], hits: &mut [Option<Hit>], filter: Option<&dyn Fn(u32, f32, f32) -> bool>) {
+        assert_eq!(rays.len(), hits.len(), "one hit slot per ray");
+        let mut context = FilterContext::new(sys::RTCIntersectContextFlags::COHERENT, filter, &self.ids);
+        for (rays, hits) in rays.chunks(PACKET).zip(hits.chunks_mut(PACKET)) {
+            let valid = ValidMask::of(rays);
+            hits.fill(None);
+            if !valid.any() {
+                continue;
+            }
+            let mut packet = sys::RTCRayHit16 {
+                ray: packet_rays(rays),
+                hit: sys::RTCHit16 {
+                    Ng_x: [0.0; PACKET],
+                    Ng_y: [0.0; PACKET],
+                    Ng_z: [0.0; PACKET],
+                    u: [0.0; PACKET],
+                    v: [0.0; PACKET],
+                    primID: [INVALID_ID; PACKET],
+                    geomID: [INVALID_ID; PACKET],
+                    instID: [[INVALID_ID; PACKET]],
+                },
+            };
+            let context_pointer: *mut FilterContext = &mut context;
+            // SAFETY: the scene is committed and only read; `valid` and
+            // `packet` are 64-byte aligned as `rtcIntersect16` requires
+            // (`repr(align(64))`) and live across the call; the context is
+            // live and `repr(C)` with Embree's context first, as in `closest`.
+            unsafe { sys::rtcIntersect16(valid.0.as_ptr(), self.scene, context_pointer.cast(), &mut packet) };
+            context.rethrow();
+            for (lane, hit) in hits.iter_mut().enumerate() {
+                if valid.0[lane] != 0 && packet.hit.geomID[lane] != INVALID_ID {
+                    *hit = Some(self.hit(
+                        packet.ray.tfar[lane],
+                        packet.hit.primID[lane],
+                        packet.hit.u[lane],
+                        packet.hit.v[lane],
+                    ));
+                }
+            }
+        }
+    }
+
+    /// Any-hit answers of `rays` in packets of 16, with `filter` (or none) in the context.
+    fn any_batch(&self, rays: &[Ray], occluded: &mut [bool], filter: Option<&dyn Fn(u32, f32, f32) -> bool>) {
+        assert_eq!(rays.len(), occluded.len(), "one answer slot per ray");
+        let mut context = FilterContext::new(sys::RTCIntersectContextFlags::COHERENT, filter, &self.ids);
+        for (rays, answers) in rays.chunks(PACKET).zip(occluded.chunks_mut(PACKET)) {
+            let valid = ValidMask::of(rays);
+            answers.fill(false);
+            if !valid.any() {
+                continue;
+            }
+            let mut packet = packet_rays(rays);
+            let context_pointer: *mut FilterContext = &mut context;
+            // SAFETY: as in `closest_batch`; Embree sets `tfar` to -∞ in
+            // the lanes whose ray is occluded.
+            unsafe { sys::rtcOccluded16(valid.0.as_ptr(), self.scene, context_pointer.cast(), &mut packet) };
+            context.rethrow();
+            for (lane, answer) in answers.iter_mut().enumerate() {
+                *answer = valid.0[lane] != 0 && packet.tfar[lane] == f32::NEG_INFINITY;
+            }
+        }
+    }
 }
 
 /// Embree's ray for ours: the same origin, direction (not normalised: `t`
@@ -410,7 +475,8 @@ impl<'a> FilterContext<'a> {
 unsafe extern "C" fn filter_hits(args: *const sys::RTCFilterFunctionNArguments) {
     // SAFETY: Embree calls this with valid arguments for the duration of
     // the call: `context` is the pointer the query was given, which points
-    // to the first field of a live `FilterContext` (`closest`, `any`), so
+    // to the first field of a live `FilterContext` (`closest`, `any` and
+    // their batches), so
     // it may be cast back; nothing else accesses that context while the
     // query runs. `valid` holds `N` ints and `hit` is a structure of
     // arrays of `N` lanes per field, laid out as `RTCHitN` documents:
@@ -532,64 +598,22 @@ impl Accel for EmbreeBackend {
     /// hint; agrees with [`Accel::intersect`] to rounding (see the type's
     /// documentation).
     fn intersect_batch(&self, rays: &[Ray], hits: &mut [Option<Hit>]) {
-        assert_eq!(rays.len(), hits.len(), "one hit slot per ray");
-        let mut context = FilterContext::new(sys::RTCIntersectContextFlags::COHERENT, None, &self.ids);
-        for (rays, hits) in rays.chunks(PACKET).zip(hits.chunks_mut(PACKET)) {
-            let valid = ValidMask::of(rays);
-            hits.fill(None);
-            if !valid.any() {
-                continue;
-            }
-            let mut packet = sys::RTCRayHit16 {
-                ray: packet_rays(rays),
-                hit: sys::RTCHit16 {
-                    Ng_x: [0.0; PACKET],
-                    Ng_y: [0.0; PACKET],
-                    Ng_z: [0.0; PACKET],
-                    u: [0.0; PACKET],
-                    v: [0.0; PACKET],
-                    primID: [INVALID_ID; PACKET],
-                    geomID: [INVALID_ID; PACKET],
-                    instID: [[INVALID_ID; PACKET]],
-                },
-            };
-            let context_pointer: *mut FilterContext = &mut context;
-            // SAFETY: the scene is committed and only read; `valid` and
-            // `packet` are 64-byte aligned as `rtcIntersect16` requires
-            // (`repr(align(64))`) and live across the call; the context has
-            // no filter, so Embree does not call back into Rust.
-            unsafe { sys::rtcIntersect16(valid.0.as_ptr(), self.scene, context_pointer.cast(), &mut packet) };
-            for (lane, hit) in hits.iter_mut().enumerate() {
-                if valid.0[lane] != 0 && packet.hit.geomID[lane] != INVALID_ID {
-                    *hit = Some(self.hit(
-                        packet.ray.tfar[lane],
-                        packet.hit.primID[lane],
-                        packet.hit.u[lane],
-                        packet.hit.v[lane],
-                    ));
-                }
-            }
-        }
+        self.closest_batch(rays, hits, None);
     }
 
     /// Packets of 16 rays through `rtcOccluded16`, with the coherent-ray hint.
     fn occluded_batch(&self, rays: &[Ray], occluded: &mut [bool]) {
-        assert_eq!(rays.len(), occluded.len(), "one answer slot per ray");
-        let mut context = FilterContext::new(sys::RTCIntersectContextFlags::COHERENT, None, &self.ids);
-        for (rays, answers) in rays.chunks(PACKET).zip(occluded.chunks_mut(PACKET)) {
-            let valid = ValidMask::of(rays);
-            answers.fill(false);
-            if !valid.any() {
-                continue;
-            }
-            let mut packet = packet_rays(rays);
-            let context_pointer: *mut FilterContext = &mut context;
-            // SAFETY: as in `intersect_batch`; Embree sets `tfar` to -∞ in
-            // the lanes whose ray is occluded.
-            unsafe { sys::rtcOccluded16(valid.0.as_ptr(), self.scene, context_pointer.cast(), &mut packet) };
-            for (lane, answer) in answers.iter_mut().enumerate() {
-                *answer = valid.0[lane] != 0 && packet.tfar[lane] == f32::NEG_INFINITY;
-            }
-        }
+        self.any_batch(rays, occluded, None);
+    }
+
+    /// [`EmbreeBackend::intersect_batch`] with the filter in the context,
+    /// called by Embree for the candidate hits of all sixteen lanes.
+    fn intersect_batch_filtered(&self, rays: &[Ray], hits: &mut [Option<Hit>], accept: &dyn Fn(u32, f32, f32) -> bool) {
+        self.closest_batch(rays, hits, Some(accept));
+    }
+
+    /// [`EmbreeBackend::occluded_batch`] with the filter in the context.
+    fn occluded_batch_filtered(&self, rays: &[Ray], occluded: &mut [bool], accept: &dyn Fn(u32, f32, f32) -> bool) {
+        self.any_batch(rays, occluded, Some(accept));
     }
 }

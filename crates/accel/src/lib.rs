@@ -234,4 +234,32 @@ pub trait Accel: Send + Sync + std::fmt::Debug {
             *answer = self.occluded(ray);
         }
     }
+
+    /// [`Accel::intersect_batch`] with the filter of
+    /// [`Accel::intersect_filtered`]: `hits[i]` becomes
+    /// `self.intersect_filtered(&rays[i], accept)`, bit for bit. The wide
+    /// BVHs trace coherent runs as packets here too, so cut-outs (alpha
+    /// masks) cost a filter call per candidate hit, not a slower path.
+    ///
+    /// # Panics
+    /// If the two slices differ in length.
+    fn intersect_batch_filtered(&self, rays: &[Ray], hits: &mut [Option<Hit>], accept: &dyn Fn(u32, f32, f32) -> bool) {
+        assert_eq!(rays.len(), hits.len(), "one hit slot per ray");
+        for (ray, hit) in rays.iter().zip(hits) {
+            *hit = self.intersect_filtered(ray, accept);
+        }
+    }
+
+    /// [`Accel::occluded_batch`] with the filter of
+    /// [`Accel::intersect_filtered`]: `occluded[i]` becomes
+    /// `self.occluded_filtered(&rays[i], accept)`.
+    ///
+    /// # Panics
+    /// If the two slices differ in length.
+    fn occluded_batch_filtered(&self, rays: &[Ray], occluded: &mut [bool], accept: &dyn Fn(u32, f32, f32) -> bool) {
+        assert_eq!(rays.len(), occluded.len(), "one answer slot per ray");
+        for (ray, answer) in rays.iter().zip(occluded) {
+            *answer = self.occluded_filtered(ray, accept);
+        }
+    }
 }

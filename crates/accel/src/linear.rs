@@ -3,7 +3,7 @@ use std::time::Instant;
 use rtgi_math::{Ray, Vec3A};
 
 use crate::contract::{Best, HitFilter, PreparedRay, QueryKind, Structure, is_hittable, test_triangles};
-use crate::triangle::{MollerTrumbore, TriangleTest, Watertight, WatertightF64};
+use crate::triangle::{TriangleTest, with_triangle_test};
 use crate::{BuildStats, Counter, Hit, Intersector, TriangleSource};
 
 /// The reference structure: every ray is tested against every hittable
@@ -58,11 +58,7 @@ impl LinearScan {
 
 impl Structure for LinearScan {
     fn query<Q: QueryKind, C: Counter, F: HitFilter>(&self, ray: &Ray, counter: &mut C, filter: &F) -> Option<Hit> {
-        match self.intersector {
-            Intersector::Watertight => self.scan::<Q, C, Watertight, F>(ray, counter, filter),
-            Intersector::MollerTrumbore => self.scan::<Q, C, MollerTrumbore, F>(ray, counter, filter),
-            Intersector::WatertightF64 => self.scan::<Q, C, WatertightF64, F>(ray, counter, filter),
-        }
+        with_triangle_test!(self.intersector, |T| self.scan::<Q, C, T, F>(ray, counter, filter))
     }
 
     fn stats(&self) -> &BuildStats {

@@ -1,8 +1,7 @@
 //! Ray/triangle intersection tests.
 
-use rtgi_math::{Vec3, Vec3A};
+use rtgi_math::Vec3A;
 
-use crate::contract::{PreparedRay, hit_triangle};
 use crate::exact;
 use crate::simd::arith;
 use crate::simd::triangles::{self, BlockHits, TriangleBlock};
@@ -66,32 +65,6 @@ impl Intersector {
             Intersector::MollerTrumbore => false,
         }
     }
-
-    /// Intersects one ray with one triangle under the structures' hit rule
-    /// (see the crate's exactness contract): the hit if the triangle can be
-    /// hit at all ([`crate::is_hittable`]), its `t` lies in `[t_min, t_max]`
-    /// and the point is inside the triangle, edges included, with exactly
-    /// the bits every structure reports for it. Both sides are hit;
-    /// triangles of zero area and rays in a triangle's plane never are.
-    pub fn intersect(
-        self,
-        origin: Vec3,
-        direction: Vec3,
-        t_min: f32,
-        t_max: f32,
-        v: &[Vec3; 3],
-    ) -> Option<TriangleHit> {
-        let ray = rtgi_math::Ray::with_range(origin, direction, t_min, t_max);
-        if !ray.is_valid() || !crate::is_hittable(v) {
-            return None;
-        }
-        let v = v.map(Vec3A::from);
-        match self {
-            Intersector::Watertight => hit_triangle(&PreparedRay::<Watertight>::new(&ray), &v, t_max),
-            Intersector::MollerTrumbore => hit_triangle(&PreparedRay::<MollerTrumbore>::new(&ray), &v, t_max),
-            Intersector::WatertightF64 => hit_triangle(&PreparedRay::<WatertightF64>::new(&ray), &v, t_max),
-        }
-    }
 }
 
 impl rtgi_math::NamedChoice for Intersector {
@@ -125,6 +98,34 @@ pub(crate) trait TriangleTest {
     /// `intersect` itself (the watertight test's double-precision cases).
     fn intersect_block(ray: &Self::Ray, t_min: f32, t_max: f32, block: &TriangleBlock) -> BlockHits;
 }
+
+/// Evaluates `$body` with `$test` naming the [`TriangleTest`] that the
+/// run-time choice `$intersector` ([`Intersector`]) stands for: the one
+/// place where that choice becomes a type, so that the structures' loops
+/// are monomorphised for it and a new test is added in one match.
+///
+/// ```ignore
+/// with_triangle_test!(self.intersector, |T| self.scan::<Q, C, T, F>(ray, counter, filter))
+/// ```
+macro_rules! with_triangle_test {
+    ($intersector:expr, |$test:ident| $body:expr) => {
+        match $intersector {
+            $crate::Intersector::Watertight => {
+                type $test = $crate::triangle::Watertight;
+                $body
+            }
+            $crate::Intersector::MollerTrumbore => {
+                type $test = $crate::triangle::MollerTrumbore;
+                $body
+            }
+            $crate::Intersector::WatertightF64 => {
+                type $test = $crate::triangle::WatertightF64;
+                $body
+            }
+        }
+    };
+}
+pub(crate) use with_triangle_test;
 
 pub(crate) struct MollerTrumbore;
 
@@ -383,6 +384,7 @@ fn exact_hit(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use rtgi_math::Vec3;
 
     const TRI: [Vec3; 3] = [Vec3::new(0.0, 0.0, 0.0), Vec3::new(1.0, 0.0, 0.0), Vec3::new(0.0, 1.0, 0.0)];
 

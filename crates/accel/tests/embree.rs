@@ -230,6 +230,35 @@ fn batches_agree_with_single_rays() {
 }
 
 #[test]
+fn filtered_batches_agree_with_filtered_single_rays() {
+    let triangles = soup(3000, 1.0, 13);
+    let embree = EmbreeBackend::new(&triangles).expect("Embree builds");
+    let rays: Vec<Ray> = (0..1024)
+        .map(|i| {
+            let (x, y) = ((i % 32) as f32 / 32.0 - 0.5, (i / 32) as f32 / 32.0 - 0.5);
+            Ray::new(Vec3::new(0.0, 0.0, -15.0), Vec3::new(x, y, 1.0))
+        })
+        .collect();
+    // Every other triangle is a hole, as alpha-masked surfaces are.
+    let holes = |triangle: u32, _: f32, _: f32| triangle % 2 == 1;
+    let mut hits = vec![None; rays.len()];
+    embree.intersect_batch_filtered(&rays, &mut hits, &holes);
+    let mut occluded = vec![false; rays.len()];
+    embree.occluded_batch_filtered(&rays, &mut occluded, &holes);
+    let mut unfiltered = vec![None; rays.len()];
+    embree.intersect_batch(&rays, &mut unfiltered);
+    let mut same = 0;
+    for (i, ray) in rays.iter().enumerate() {
+        assert_eq!(occluded[i], embree.occluded_filtered(ray, &holes), "{ray:?}");
+        assert!(hits[i].is_none_or(|h| h.triangle % 2 == 1), "a hole was hit: {:?}", hits[i]);
+        same += usize::from(hits[i].map(|h| h.triangle) == embree.intersect_filtered(ray, &holes).map(|h| h.triangle));
+    }
+    assert!(same as f64 >= 0.999 * rays.len() as f64, "{same} of {}", rays.len());
+    let through = (0..rays.len()).filter(|&i| hits[i].map(|h| h.triangle) != unfiltered[i].map(|h| h.triangle)).count();
+    assert!(through > 50, "only {through} rays went through a hole");
+}
+
+#[test]
 fn invalid_rays_hit_nothing() {
     let triangles = [[Vec3::new(-1.0, -1.0, 1.0), Vec3::new(1.0, -1.0, 1.0), Vec3::new(0.0, 1.0, 1.0)]];
     let embree = EmbreeBackend::new(&triangles).expect("Embree builds");

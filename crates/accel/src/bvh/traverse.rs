@@ -7,8 +7,8 @@ use rtgi_math::Ray;
 use super::{Bvh, BvhNode};
 use crate::contract::{Best, HitFilter, PreparedRay, QueryKind, test_triangles};
 use crate::slab::{BoxRay, FastSlabs, RobustSlabs, SlabTest};
-use crate::triangle::{MollerTrumbore, TriangleTest, Watertight, WatertightF64};
-use crate::{Counter, Hit, Intersector};
+use crate::triangle::{TriangleTest, with_triangle_test};
+use crate::{Counter, Hit};
 
 /// Entries of the largest traversal stack. A stack holds at most one entry
 /// per level of the tree, and builds never exceed 64 + 32 levels (see
@@ -79,14 +79,10 @@ macro_rules! monomorphise {
                 }
             };
         }
-        match ($self.intersector, $self.traversal) {
-            (Intersector::Watertight, Traversal::Robust) => sized!(Watertight, RobustSlabs),
-            (Intersector::Watertight, Traversal::Fast) => sized!(Watertight, FastSlabs),
-            (Intersector::MollerTrumbore, Traversal::Robust) => sized!(MollerTrumbore, RobustSlabs),
-            (Intersector::MollerTrumbore, Traversal::Fast) => sized!(MollerTrumbore, FastSlabs),
-            (Intersector::WatertightF64, Traversal::Robust) => sized!(WatertightF64, RobustSlabs),
-            (Intersector::WatertightF64, Traversal::Fast) => sized!(WatertightF64, FastSlabs),
-        }
+        with_triangle_test!($self.intersector, |T| match $self.traversal {
+            Traversal::Robust => sized!(T, RobustSlabs),
+            Traversal::Fast => sized!(T, FastSlabs),
+        })
     }};
 }
 

@@ -19,8 +19,8 @@
 use std::sync::atomic::{AtomicU8, Ordering};
 
 use super::boxes::{FAR_OF_NEAR, PlaneRay, WideBoxes};
+use super::packet::{Lanes, PACKET, PacketRays};
 use crate::slab::ROBUST_FAR_SCALE;
-use crate::wide::packet::{Lanes, PACKET, PacketRays};
 
 /// The instruction sets the kernels are compiled for, narrowest first.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]

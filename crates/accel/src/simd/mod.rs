@@ -4,7 +4,8 @@
 //!
 //! Inside the crate: `boxes.rs` tests one ray against the `W` child boxes
 //! of a wide node, stored structure-of-arrays, with the robust slab test's
-//! arithmetic lane by lane; `triangles.rs` tests one ray against a block of
+//! arithmetic lane by lane, and `packet.rs` sixteen rays against one box;
+//! `triangles.rs` tests one ray against a block of
 //! four triangles, stored structure-of-arrays; `arith.rs` holds the
 //! ray/triangle arithmetic written once, generic over one lane (`f32`) or
 //! four (`Vec4`), so that the scalar tests and the block tests compute the
@@ -15,6 +16,7 @@
 pub(crate) mod arith;
 pub(crate) mod boxes;
 mod dispatch;
+pub(crate) mod packet;
 pub(crate) mod triangles;
 
 pub(crate) use dispatch::{Isa, Kernel, dispatch, prefetch};

@@ -133,8 +133,13 @@ impl<const W: usize> Structure for WideBvh<W> {
         self.query_dispatched::<Q, C, F>(ray, counter, filter)
     }
 
-    fn query_batch<Q: QueryKind>(&self, rays: &[rtgi_math::Ray], answer: &mut dyn FnMut(usize, Option<Hit>)) {
-        self.query_batch_dispatched::<Q>(rays, answer)
+    fn query_batch<Q: QueryKind, F: HitFilter>(
+        &self,
+        rays: &[rtgi_math::Ray],
+        answer: &mut dyn FnMut(usize, Option<Hit>),
+        filter: &F,
+    ) {
+        self.query_batch_dispatched::<Q, F>(rays, answer, filter)
     }
 
     fn stats(&self) -> &BuildStats {

@@ -14,8 +14,8 @@ use crate::simd::boxes::PlaneRay;
 use crate::simd::triangles::TriangleBlock;
 use crate::simd::{Isa, Kernel, dispatch, prefetch};
 use crate::slab::BoxRay;
-use crate::triangle::{MollerTrumbore, TriangleTest, Watertight, WatertightF64};
-use crate::{Counter, Hit, Intersector};
+use crate::triangle::{TriangleTest, with_triangle_test};
+use crate::{Counter, Hit};
 
 /// Children waiting to be visited, with the distance at which the ray
 /// enters each, packed into 64 bits (so that a new stack is cleared with
@@ -75,17 +75,13 @@ impl<const W: usize> WideBvh<W> {
         counter: &mut C,
         filter: &F,
     ) -> Option<Hit> {
-        match self.intersector {
-            Intersector::Watertight => {
-                dispatch(SingleRay::<W, Q, C, Watertight, F> { bvh: self, ray, counter, filter, test: PhantomData })
-            }
-            Intersector::MollerTrumbore => {
-                dispatch(SingleRay::<W, Q, C, MollerTrumbore, F> { bvh: self, ray, counter, filter, test: PhantomData })
-            }
-            Intersector::WatertightF64 => {
-                dispatch(SingleRay::<W, Q, C, WatertightF64, F> { bvh: self, ray, counter, filter, test: PhantomData })
-            }
-        }
+        with_triangle_test!(self.intersector, |T| dispatch(SingleRay::<W, Q, C, T, F> {
+            bvh: self,
+            ray,
+            counter,
+            filter,
+            test: PhantomData
+        }))
     }
 
     /// Closest hit, or with [`crate::contract::AnyHit`] the first hit found.
