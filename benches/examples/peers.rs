@@ -1,4 +1,4 @@
-//! Our binary SAH BVH and our wide BVHs (one ray at a time, and through
+//! Our binary SAH BVH and our wide BVHs, with and without spatial splits (one ray at a time, and through
 //! the batch API, which traces coherent rays as packets of 16) against
 //! peers on the same rays, in one run:
 //! `cargo run --release -p rtgi-benches --example peers [-- SCENE.obj]`.
@@ -73,7 +73,7 @@ fn main() {
     let incoherent = box_rays(&scene, 1_000_000, 1);
     println!("{}: {} triangles; medians of {RUNS} alternating runs", path.display(), triangles.len());
 
-    let ours: Vec<(AccelKind, Box<dyn Accel>)> = [AccelKind::Sah, AccelKind::Bvh4, AccelKind::Bvh8]
+    let ours: Vec<(AccelKind, Box<dyn Accel>)> = [AccelKind::Sah, AccelKind::Bvh4, AccelKind::Bvh8, AccelKind::Sbvh8]
         .map(|kind| (kind, kind.build(&triangles, &kind.default_params())))
         .into();
     let peer_triangles: Vec<obvhs::triangle::Triangle> = triangles
@@ -103,6 +103,7 @@ fn main() {
         let names: [&'static str; 2] = match kind {
             AccelKind::Bvh4 => ["rtgi bvh4", "rtgi bvh4 16"],
             AccelKind::Bvh8 => ["rtgi bvh8", "rtgi bvh8 16"],
+            AccelKind::Sbvh8 => ["rtgi sbvh8", "rtgi sbvh8 16"],
             _ => ["rtgi sah", ""],
         };
         contenders.push(Contender {

@@ -241,7 +241,8 @@ fn verify_checks_the_built_in_adversarial_scenes_and_writes_json() {
     {
         assert!(run.stdout.lines().any(|l| l.starts_with(kind)), "no row for {kind}:\n{}", run.stdout);
     }
-    for structure in ["linear", "object-median", "spatial-median", "sah", "sah-sweep", "bvh4", "bvh8"] {
+    for structure in ["linear", "object-median", "spatial-median", "sah", "sah-sweep", "bvh4", "bvh8", "sbvh", "sbvh8"]
+    {
         assert!(run.stdout.lines().any(|l| l.starts_with(structure)), "no row for {structure}:\n{}", run.stdout);
     }
     let report: serde_json::Value = serde_json::from_slice(&std::fs::read(&json).unwrap()).unwrap();
@@ -249,14 +250,16 @@ fn verify_checks_the_built_in_adversarial_scenes_and_writes_json() {
     // Ours (the wide BVHs twice: one ray at a time and in batches) and the
     // peers built in (Embree, with the embree feature), whose differences
     // are reported but are not failures.
-    assert_eq!(structures.len(), 9 + rtgi_accel::AccelKind::PEERS.len());
+    let all = rtgi_accel::AccelKind::ALL;
+    let ours_expected = all.len() + all.iter().filter(|k| k.node_width().is_some_and(|w| w > 2)).count();
+    assert_eq!(structures.len(), ours_expected + rtgi_accel::AccelKind::PEERS.len());
     assert!(
         structures
             .iter()
             .any(|s| s["structure"].as_str().is_some_and(|n| n.starts_with("bvh8") && n.ends_with("batch")))
     );
     let mut ours = structures.iter().filter(|s| s["peer"] == false);
-    assert_eq!(ours.clone().count(), 9);
+    assert_eq!(ours.clone().count(), ours_expected);
     assert!(ours.all(|s| s["tally"]["closest_disagreements"] == 0 && s["tally"]["leaks"] == 0));
 }
 

@@ -22,6 +22,12 @@ pub enum AccelKind {
     Bvh4,
     /// Binned SAH BVH collapsed to eight children a node, traversed with SIMD.
     Bvh8,
+    /// BVH split by the binned SAH with spatial splits (SBVH): triangles
+    /// that straddle a cut are referenced on both sides, so that nodes of
+    /// interiors with long walls overlap less.
+    Sbvh,
+    /// The spatial-split BVH collapsed to eight children a node, traversed with SIMD.
+    Sbvh8,
     /// Intel Embree 3, a peer to compare against, not held to the exactness contract.
     ///
     /// Built with the `embree` feature: [`crate::EmbreeBackend`].
@@ -93,6 +99,8 @@ impl AccelKind {
         AccelKind::SahSweep,
         AccelKind::Bvh4,
         AccelKind::Bvh8,
+        AccelKind::Sbvh,
+        AccelKind::Sbvh8,
     ];
 
     /// Backends written by others, measured beside ours but not held to
@@ -117,6 +125,7 @@ impl AccelKind {
             AccelKind::Linear => "linear",
             AccelKind::Bvh4 => "bvh4",
             AccelKind::Bvh8 => "bvh8",
+            AccelKind::Sbvh8 => "sbvh8",
             #[cfg(feature = "embree")]
             AccelKind::Embree => "embree",
             _ => self.split_method().map_or("linear", SplitMethod::name),
@@ -129,7 +138,7 @@ impl AccelKind {
         match self {
             AccelKind::Linear => None,
             AccelKind::Bvh4 => Some(4),
-            AccelKind::Bvh8 => Some(8),
+            AccelKind::Bvh8 | AccelKind::Sbvh8 => Some(8),
             #[cfg(feature = "embree")]
             AccelKind::Embree => None,
             _ => Some(2),
@@ -159,6 +168,7 @@ impl AccelKind {
             AccelKind::Sah => Some(SplitMethod::BinnedSah),
             AccelKind::SahSweep => Some(SplitMethod::SweepSah),
             AccelKind::Bvh4 | AccelKind::Bvh8 => Some(SplitMethod::BinnedSah),
+            AccelKind::Sbvh | AccelKind::Sbvh8 => Some(SplitMethod::SpatialSah),
             #[cfg(feature = "embree")]
             AccelKind::Embree => None,
         }
@@ -193,7 +203,7 @@ impl AccelKind {
         }
         Ok(match (self, self.split_method()) {
             (AccelKind::Bvh4, Some(method)) => Box::new(Bvh4::new(triangles, method, params)),
-            (AccelKind::Bvh8, Some(method)) => Box::new(Bvh8::new(triangles, method, params)),
+            (AccelKind::Bvh8 | AccelKind::Sbvh8, Some(method)) => Box::new(Bvh8::new(triangles, method, params)),
             (_, Some(method)) => Box::new(Bvh::new(triangles, method, params)),
             (_, None) => Box::new(LinearScan::new(triangles, params.intersector)),
         })
@@ -247,29 +257,35 @@ impl std::str::FromStr for AccelKind {
 }
 
 impl AccelKind {
-    /// Every variant with a spread of build parameters (leaf sizes 1, 2, 4,
-    /// 8 and 16; for the binned SAH also 2 and 32 bins), each with both
-    /// intersectors, all with the robust traversal: the configurations that
-    /// tests run each case over, so that a new variant is tested as soon as
-    /// it is added to [`AccelKind::ALL`]. The exactness contract (see the
-    /// crate's documentation) holds for every one of them.
+    /// Every variant with a spread of build parameters, all with the robust
+    /// traversal: with the default intersector, leaf sizes 1, 2, 4, 8 and
+    /// 16, the variant's tuned parameters, and for the binned SAH also 2
+    /// and 32 bins and the course's SAH; with the other intersectors, leaf
+    /// sizes 1, 4 and 16 and the tuned parameters (a sample, so that the
+    /// tests' time does not grow with every variant times every knob).
+    /// These are the configurations that tests run each case over, so that
+    /// a new variant is tested as soon as it is added to
+    /// [`AccelKind::ALL`]. The exactness contract (see the crate's
+    /// documentation) holds for every one of them.
     pub fn all_configurations() -> Vec<(AccelKind, BuildParams)> {
         let mut configurations = Vec::new();
         for &intersector in Intersector::ALL {
             let base = BuildParams { intersector, ..BuildParams::default() };
+            let every_knob = intersector == Intersector::default();
+            let leaf_sizes: &[usize] = if every_knob { &[1, 2, 4, 8, 16] } else { &[1, 4, 16] };
             for &kind in Self::ALL {
                 if kind.split_method().is_none() {
                     configurations.push((kind, base.clone()));
                     continue;
                 }
-                for max_leaf_size in [1, 2, 4, 8, 16] {
+                for &max_leaf_size in leaf_sizes {
                     configurations.push((kind, BuildParams { max_leaf_size, ..base.clone() }));
                 }
                 let tuned = BuildParams { intersector, ..kind.default_params() };
                 if !configurations.contains(&(kind, tuned.clone())) {
                     configurations.push((kind, tuned));
                 }
-                if kind == AccelKind::Sah {
+                if kind == AccelKind::Sah && every_knob {
                     for sah_bins in [2, 32] {
                         configurations.push((kind, BuildParams { sah_bins, ..base.clone() }));
                     }

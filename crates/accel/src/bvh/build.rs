@@ -15,7 +15,7 @@ use rtgi_math::{Vec3, Vec3A};
 use rayon::prelude::*;
 
 use super::split::{BuildRef, CentredPrimRef, Context, PrimRef, RangeBounds, Split, SplitMethod};
-use super::{BvhNode, median, sah};
+use super::{BvhNode, median, sah, spatial};
 use crate::BuildParams;
 use crate::boxa::BoxA;
 
@@ -40,6 +40,11 @@ pub(crate) struct Tree {
 }
 
 impl Tree {
+    /// The tree over no primitives.
+    pub(crate) fn empty() -> Tree {
+        Tree { nodes: Vec::new(), order: Vec::new(), leaves: 0, depth: 0, leaf_size_histogram: vec![], sah_cost: 0.0 }
+    }
+
     /// The statistics of a build that made this tree: `variant` names it,
     /// `inputs` primitives were given and `excluded` left out, it began at
     /// `start`, and its leaves keep `leaf_bytes` beside the nodes.
@@ -70,15 +75,15 @@ impl Tree {
 /// primitives start at `link`; an interior node's left child is in the next
 /// slot and its right child in slot `link`.
 #[derive(Clone, Copy, Debug, Default)]
-struct Slot {
+pub(crate) struct Slot {
     min: Vec3,
-    link: u32,
+    pub(crate) link: u32,
     max: Vec3,
-    count: u32,
+    pub(crate) count: u32,
 }
 
 impl Slot {
-    fn new(bounds: BoxA, link: u32, count: u32) -> Self {
+    pub(crate) fn new(bounds: BoxA, link: u32, count: u32) -> Self {
         Slot { min: bounds.min.into(), link, max: bounds.max.into(), count }
     }
 
@@ -88,8 +93,12 @@ impl Slot {
 }
 
 /// Builds a tree over primitives given by their boxes, each centred in its
-/// box (triangles).
+/// box (triangles). With spatial splits a primitive may be in several
+/// leaves ([`spatial`]).
 pub(crate) fn build(boxes: &[BoxA], method: SplitMethod, params: &BuildParams) -> Tree {
+    if method == SplitMethod::SpatialSah {
+        return spatial::build(boxes, &Context::of(method, params));
+    }
     let prims = boxes.par_iter().enumerate().map(|(i, b)| PrimRef::new(*b, i as u32)).collect();
     build_over(prims, method, params)
 }
@@ -107,22 +116,9 @@ pub(crate) fn build_with_centroids(primitives: &[(BoxA, Vec3A)], method: SplitMe
 fn build_over<R: BuildRef>(mut prims: Vec<R>, method: SplitMethod, params: &BuildParams) -> Tree {
     let n = prims.len();
     if n == 0 {
-        return Tree {
-            nodes: Vec::new(),
-            order: Vec::new(),
-            leaves: 0,
-            depth: 0,
-            leaf_size_histogram: vec![],
-            sah_cost: 0.0,
-        };
+        return Tree::empty();
     }
-    let ctx = Context {
-        method,
-        max_leaf_size: params.max_leaf_size.max(1),
-        sah_bins: params.sah_bins.clamp(2, 256),
-        sah_axes: params.sah_axes,
-        traversal_cost: params.traversal_cost.max(0.0),
-    };
+    let ctx = Context::of(method, params);
     let mut slots = vec![Slot::default(); 2 * n - 1];
     let root = RangeBounds::of(&prims);
     build_node(&ctx, &mut prims, 0, &mut slots, 0, 0, root);
@@ -150,7 +146,8 @@ fn build_node<R: BuildRef>(
         match ctx.method {
             SplitMethod::ObjectMedian => (n > ctx.max_leaf_size).then(|| median::object_median(prims, &range)),
             SplitMethod::SpatialMedian => (n > ctx.max_leaf_size).then(|| median::spatial_median(prims, &range)),
-            SplitMethod::BinnedSah => sah::binned(ctx, prims, &range),
+            // User primitives are not split: their references stay whole.
+            SplitMethod::BinnedSah | SplitMethod::SpatialSah => sah::binned(ctx, prims, &range),
             SplitMethod::SweepSah => sah::sweep(ctx, prims, &range),
         }
     };
@@ -186,7 +183,7 @@ fn build_node<R: BuildRef>(
 /// Lays the used slots out depth-first with siblings adjacent, and measures
 /// the tree: depth, leaves, leaf sizes and SAH cost (intersection cost 1,
 /// traversal cost as given, relative to the root's area).
-fn layout(slots: &[Slot], order: Vec<u32>, traversal_cost: f32) -> Tree {
+pub(crate) fn layout(slots: &[Slot], order: Vec<u32>, traversal_cost: f32) -> Tree {
     let root_area = slots[0].bounds().half_area();
     // At most every slot is used; reserving that much only claims address
     // space, and saves the copies of a growing vector.

@@ -11,6 +11,7 @@ mod build;
 mod median;
 mod primitives;
 mod sah;
+mod spatial;
 mod split;
 mod traverse;
 mod validate;
@@ -114,6 +115,9 @@ pub struct Bvh {
     stats: BuildStats,
     intersector: crate::Intersector,
     traversal: Traversal,
+    /// Built with spatial splits: a triangle may be in several leaves,
+    /// each holding the part of its box on the leaf's side of the cuts.
+    spatial_splits: bool,
 }
 
 impl Bvh {
@@ -152,6 +156,7 @@ impl Bvh {
             stats,
             intersector: params.intersector,
             traversal: params.traversal,
+            spatial_splits: method == SplitMethod::SpatialSah,
         }
     }
 

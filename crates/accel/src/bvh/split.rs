@@ -21,16 +21,22 @@ pub enum SplitMethod {
     BinnedSah,
     /// Surface area heuristic evaluated between every pair of neighbouring centroids on all three axes.
     SweepSah,
+    /// Binned SAH with spatial splits (SBVH): where children would overlap, a
+    /// node may be cut by a plane and the triangles across it referenced on
+    /// both sides, their boxes cut at the plane (at most 1.5 references a
+    /// triangle). A [`crate::PrimitiveBvh`] builds with the binned SAH instead.
+    SpatialSah,
 }
 
 impl SplitMethod {
-    /// The variant's name on command lines and in reports (`object-median`, `spatial-median`, `sah`, `sah-sweep`).
+    /// The variant's name on command lines and in reports (`object-median`, `spatial-median`, `sah`, `sah-sweep`, `sbvh`).
     pub fn name(self) -> &'static str {
         match self {
             SplitMethod::ObjectMedian => "object-median",
             SplitMethod::SpatialMedian => "spatial-median",
             SplitMethod::BinnedSah => "sah",
             SplitMethod::SweepSah => "sah-sweep",
+            SplitMethod::SpatialSah => "sbvh",
         }
     }
 }
@@ -122,6 +128,19 @@ pub(crate) struct Context {
     pub(crate) sah_bins: usize,
     pub(crate) sah_axes: crate::SahAxes,
     pub(crate) traversal_cost: f32,
+}
+
+impl Context {
+    /// The inputs of a build with `method` and `params`, clamped to what the builders handle.
+    pub(crate) fn of(method: SplitMethod, params: &crate::BuildParams) -> Context {
+        Context {
+            method,
+            max_leaf_size: params.max_leaf_size.max(1),
+            sah_bins: params.sah_bins.clamp(2, 256),
+            sah_axes: params.sah_axes,
+            traversal_cost: params.traversal_cost.max(0.0),
+        }
+    }
 }
 
 /// Bounds of a range of primitives and of their (doubled) centroids.

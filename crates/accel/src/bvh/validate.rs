@@ -1,12 +1,23 @@
 //! Structural checks of a built hierarchy.
 
+use std::collections::HashMap;
+
+use rtgi_math::{Aabb, Vec3A};
+
 use super::Bvh;
+
+fn triangle_box(triangle: &[Vec3A; 3]) -> Aabb {
+    let [a, b, c] = *triangle;
+    Aabb::new(a.min(b).min(c).into(), a.max(b).max(c).into())
+}
 
 impl Bvh {
     /// Checks the invariants of the tree and returns the first violation:
     /// every triangle that can be hit is in exactly one leaf, every child's
     /// box lies inside its parent's, every leaf's box holds its triangles,
-    /// and every node is reachable exactly once.
+    /// and every node is reachable exactly once. With spatial splits a
+    /// triangle may be in several leaves, whose boxes hold parts of its box
+    /// that together reach all of it.
     pub fn validate(&self) -> Result<(), String> {
         let hittable = self.triangle_ids.len();
         if self.nodes.is_empty() {
@@ -14,6 +25,8 @@ impl Bvh {
         }
         let mut seen_triangle = vec![false; hittable];
         let mut seen_node = vec![false; self.nodes.len()];
+        // With spatial splits: the hull of each triangle's parts, and its whole box.
+        let mut pieces: HashMap<u32, (Aabb, Aabb)> = HashMap::new();
         let mut stack = vec![(0usize, 0usize)];
         while let Some((index, depth)) = stack.pop() {
             if std::mem::replace(&mut seen_node[index], true) {
@@ -33,7 +46,12 @@ impl Bvh {
                     if std::mem::replace(&mut seen_triangle[i], true) {
                         return Err(format!("triangle slot {i} is in two leaves"));
                     }
-                    if !self.triangles[i].iter().all(|&v| bounds.contains_point(v.into())) {
+                    if self.spatial_splits {
+                        let whole = triangle_box(&self.triangles[i]);
+                        let part = Aabb::new(whole.min.max(bounds.min), whole.max.min(bounds.max));
+                        let (hull, _) = pieces.entry(self.triangle_ids[i]).or_insert((Aabb::EMPTY, whole));
+                        *hull = hull.union(&part);
+                    } else if !self.triangles[i].iter().all(|&v| bounds.contains_point(v.into())) {
                         return Err(format!("leaf {index} does not contain its triangle {}", self.triangle_ids[i]));
                     }
                 }
@@ -54,6 +72,18 @@ impl Bvh {
         }
         if let Some(unused) = seen_node.iter().position(|s| !s) {
             return Err(format!("node {unused} is unreachable"));
+        }
+        if self.spatial_splits {
+            let hittable_triangles = self.stats.triangles - self.stats.excluded_triangles;
+            if pieces.len() != hittable_triangles {
+                return Err(format!("{} of {hittable_triangles} triangles are in a leaf", pieces.len()));
+            }
+            for (id, (hull, whole)) in &pieces {
+                if hull != whole {
+                    return Err(format!("the leaves of triangle {id} hold only {hull:?} of its box {whole:?}"));
+                }
+            }
+            return Ok(());
         }
         let mut ids = self.triangle_ids.clone();
         ids.sort_unstable();

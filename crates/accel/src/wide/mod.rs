@@ -56,6 +56,7 @@ impl<const W: usize> WideBvh<W> {
         let stats = BuildStats {
             variant: match method {
                 SplitMethod::BinnedSah => format!("bvh{W}"),
+                SplitMethod::SpatialSah => format!("sbvh{W}"),
                 _ => format!("{}-bvh{W}", method.name()),
             },
             triangles: triangles.len(),
