@@ -46,6 +46,7 @@ pub fn adversarial_cases(special: usize, seed: u64) -> Vec<Case> {
     cases.push(touching_boxes());
     cases.push(walls_and_needles(25 * special, seed));
     cases.push(hollow_needles(special, seed));
+    cases.push(crossing_planks(special, seed));
     cases
 }
 
@@ -329,6 +330,79 @@ pub fn hollow_needles(count: usize, seed: u64) -> Case {
         }
     }
     Case { name: "hollow-needles".into(), triangles, special_rays: vec![("inside", rays)] }
+}
+
+/// A lattice of long thin planks in the cube [0, 32]³: along x, along z,
+/// upright, and tilted across the whole cube, each crossing many others,
+/// which spatial splits (`sbvh`) cut into references on both sides of
+/// planes. The cube's bounds make the root's candidate planes the integers,
+/// and the rays go where a cut could lose a hit: lying in the planes
+/// `x = k` or `z = k` (a zero direction component, the slab test's NaN
+/// case) and aimed at points of the planks on those planes, some nearly
+/// parallel to them; rays aimed at a plank must hit it.
+fn crossing_planks(count: usize, seed: u64) -> Case {
+    let quad = |a: Vec3, b: Vec3, c: Vec3, d: Vec3| [[a, b, c], [a, c, d]];
+    let mut planks: Vec<[Vec3; 4]> = Vec::new();
+    for k in 0..16 {
+        let (at, level) = (2.0 * k as f32, (k % 4) as f32 * 8.0);
+        let (x, z) = (Vec3::X * 32.0, Vec3::Z * 32.0);
+        let across = 0.25;
+        let along_x = Vec3::new(0.0, level + 1.0, at + 0.5);
+        planks.push([along_x, along_x + x, along_x + x + Vec3::Z * across, along_x + Vec3::Z * across]);
+        let along_z = Vec3::new(at + 1.5, level + 5.0, 0.0);
+        planks.push([along_z, along_z + Vec3::X * across, along_z + Vec3::X * across + z, along_z + z]);
+        if k % 4 == 0 {
+            let post = Vec3::new(at + 0.75, 0.0, 31.0 - at);
+            planks.push([post, post + Vec3::X * across, post + Vec3::new(across, 32.0, 0.0), post + Vec3::Y * 32.0]);
+        }
+        if k % 8 == 0 {
+            // Corner to corner, rising: most of its box holds none of it,
+            // so some of its pieces hold none of it either.
+            let from = Vec3::new(0.0, level, at);
+            let to = Vec3::new(32.0, 32.0 - level, 32.0 - at);
+            let side = (to - from).cross(Vec3::Y).normalize() * across;
+            planks.push([from, to, to + side, from + side]);
+        }
+    }
+    let triangles: Vec<[Vec3; 3]> = planks.iter().flat_map(|&[a, b, c, d]| quad(a, b, c, d)).collect();
+    let mut rng = Rng::new(seed, 9);
+    let mut rays = Vec::new();
+    while rays.len() < count {
+        // A point on a plank where its length crosses an integer plane.
+        let [a, b, _, d] = planks[rng.next_below(planks.len() as u32) as usize];
+        let (long, across) = if (b - a).length() > (d - a).length() { (b - a, d - a) } else { (d - a, b - a) };
+        let axis = long.abs().max_position();
+        // Strictly between the plank's ends: a ray through an end, an open
+        // edge, may rightly miss.
+        let (start, end) = (a[axis].min(a[axis] + long[axis]), a[axis].max(a[axis] + long[axis]));
+        let plane = start.floor() + 1.0 + rng.next_below((end.ceil() - start.floor() - 1.0) as u32) as f32;
+        let u = (plane - a[axis]) / long[axis];
+        let mut target = a + long * u + across * (0.05 + 0.9 * rng.next_f32());
+        if long.abs().cmpgt(Vec3::ZERO).bitmask().count_ones() == 1 {
+            // Along an axis: exactly on the plane, still on the plank.
+            target[axis] = plane;
+        }
+        let mut direction = uniform_sphere(rng.next_f32(), rng.next_f32());
+        match rng.next_below(3) {
+            // In the plane: the component across it is zero, of either sign.
+            0 => direction[axis] = if rng.next_f32() < 0.5 { 0.0 } else { -0.0 },
+            // Nearly in it.
+            1 => direction[axis] = direction[axis].signum() * 10f32.powf(-7.0 * rng.next_f32()),
+            _ => {}
+        }
+        let distance = 1.0 + 40.0 * rng.next_f32();
+        let origin = target - direction * distance;
+        let ray = Ray::new(origin, target - origin);
+        // The plank's plane must not hold the ray (a grazing ray may miss it rightly).
+        let normal = long.cross(across).normalize();
+        let expect = if ray.direction.normalize().dot(normal).abs() > 1e-3 {
+            Expect::HitBy(1.0 + 1e-3)
+        } else {
+            Expect::Nothing
+        };
+        rays.push(ProbeRay { ray, expect });
+    }
+    Case { name: "crossing-planks".into(), triangles, special_rays: vec![("on-planes", rays)] }
 }
 
 /// A 4 × 4 × 4 block of unit cubes that touch: neighbouring faces coincide,
