@@ -69,8 +69,8 @@ mod tests {
 
     #[test]
     fn a_failed_write_keeps_the_old_file_and_leaves_no_temporary() {
-        let dir = std::env::temp_dir().join(format!("rtgi-atomic-{}", std::process::id()));
-        fs::create_dir_all(&dir).unwrap();
+        let temporary = tempfile::tempdir().unwrap();
+        let dir = temporary.path();
         let path = dir.join("kept.txt");
         write_atomically(&path, b"old").unwrap();
         let failed = write_atomically_with(&path, |out| {
@@ -79,7 +79,7 @@ mod tests {
         });
         assert!(failed.is_err());
         assert_eq!(fs::read(&path).unwrap(), b"old");
-        let names: Vec<_> = fs::read_dir(&dir).unwrap().map(|entry| entry.unwrap().file_name()).collect();
+        let names: Vec<_> = fs::read_dir(dir).unwrap().map(|entry| entry.unwrap().file_name()).collect();
         assert!(names.iter().all(|name| !name.to_string_lossy().starts_with(".tmp")), "{names:?}");
         write_atomically(&path, b"new").unwrap();
         assert_eq!(fs::read(&path).unwrap(), b"new");
@@ -89,14 +89,13 @@ mod tests {
     #[test]
     fn outputs_get_the_permissions_of_a_plain_write() {
         use std::os::unix::fs::PermissionsExt;
-        let dir = std::env::temp_dir().join(format!("rtgi-atomic-mode-{}", std::process::id()));
-        fs::create_dir_all(&dir).unwrap();
+        let temporary = tempfile::tempdir().unwrap();
+        let dir = temporary.path();
         let (atomic, plain) = (dir.join("atomic"), dir.join("plain"));
         write_atomically(&atomic, b"x").unwrap();
         fs::write(&plain, b"x").unwrap();
         let mode = |path: &Path| fs::metadata(path).unwrap().permissions().mode();
         assert_eq!(mode(&atomic), mode(&plain));
-        fs::remove_dir_all(&dir).unwrap();
     }
 
     #[cfg(unix)]
@@ -109,8 +108,8 @@ mod tests {
 
     #[test]
     fn writers_racing_to_one_path_all_succeed_and_one_complete_file_is_left() {
-        let dir = std::env::temp_dir().join(format!("rtgi-atomic-race-{}", std::process::id()));
-        fs::create_dir_all(&dir).unwrap();
+        let temporary = tempfile::tempdir().unwrap();
+        let dir = temporary.path();
         let path = dir.join("raced.bin");
         let contents: Vec<Vec<u8>> = (0..2u8).map(|writer| vec![writer; 1 << 20]).collect();
         for _ in 0..10 {
@@ -124,7 +123,6 @@ mod tests {
             let written = fs::read(&path).unwrap();
             assert!(contents.contains(&written), "a mix of the writers' contents");
         }
-        assert_eq!(fs::read_dir(&dir).unwrap().count(), 1, "temporary files left behind");
-        fs::remove_dir_all(&dir).unwrap();
+        assert_eq!(fs::read_dir(dir).unwrap().count(), 1, "temporary files left behind");
     }
 }

@@ -164,10 +164,9 @@ mod tests {
     use super::*;
     use rtgi_math::Vec3;
 
-    fn scratch(name: &str) -> PathBuf {
-        let dir = std::env::temp_dir().join(format!("rtgi-image-test-{}", std::process::id()));
-        fs::create_dir_all(&dir).unwrap();
-        dir.join(name)
+    /// A path in `dir`, a temporary folder that is removed when the test ends.
+    fn scratch(dir: &tempfile::TempDir, name: &str) -> PathBuf {
+        dir.path().join(name)
     }
 
     fn gradient() -> HdrImage {
@@ -182,7 +181,8 @@ mod tests {
 
     #[test]
     fn exr_round_trips_exactly() {
-        let path = scratch("round.exr");
+        let dir = tempfile::tempdir().unwrap();
+        let path = scratch(&dir, "round.exr");
         let image = gradient();
         image.write(&path, &ToneMap::default()).unwrap();
         assert_eq!(HdrImage::read_exr(&path).unwrap(), image);
@@ -190,7 +190,8 @@ mod tests {
 
     #[test]
     fn png_is_written_with_srgb_values() {
-        let path = scratch("gradient.png");
+        let dir = tempfile::tempdir().unwrap();
+        let path = scratch(&dir, "gradient.png");
         gradient().write(&path, &ToneMap::default()).unwrap();
         let decoded = image::open(&path).unwrap().to_rgb8();
         assert_eq!(decoded.dimensions(), (7, 3));
@@ -201,23 +202,25 @@ mod tests {
 
     #[test]
     fn unknown_extension_and_missing_folder_are_errors() {
+        let dir = tempfile::tempdir().unwrap();
         let image = gradient();
-        let err = image.write(&scratch("x.bmp"), &ToneMap::default()).unwrap_err();
+        let err = image.write(&scratch(&dir, "x.bmp"), &ToneMap::default()).unwrap_err();
         assert!(err.to_string().contains("x.bmp"), "{err}");
-        let missing = scratch("no-such-folder").join("x.png");
+        let missing = scratch(&dir, "no-such-folder").join("x.png");
         let err = check_writable(&missing).unwrap_err().to_string();
         assert!(err.ends_with("no-such-folder does not exist"), "{err}");
         assert!(image.write(&missing, &ToneMap::default()).is_err());
         // A file where the folder should be.
-        std::fs::write(scratch("a-file"), b"").unwrap();
-        let err = check_writable(&scratch("a-file").join("x.png")).unwrap_err().to_string();
+        std::fs::write(scratch(&dir, "a-file"), b"").unwrap();
+        let err = check_writable(&scratch(&dir, "a-file").join("x.png")).unwrap_err().to_string();
         assert!(err.ends_with("a-file is not a folder"), "{err}");
         assert!(!missing.exists());
     }
 
     #[test]
     fn failed_write_keeps_the_old_file() {
-        let path = scratch("keep.png");
+        let dir = tempfile::tempdir().unwrap();
+        let path = scratch(&dir, "keep.png");
         gradient().write(&path, &ToneMap::default()).unwrap();
         let before = fs::read(&path).unwrap();
         // A zero-sized image cannot be encoded as PNG; the earlier file must survive.

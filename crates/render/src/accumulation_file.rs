@@ -254,10 +254,9 @@ fn decode(input: &mut impl Read, checksum: &mut Fnv) -> Result<i128, String> {
 mod tests {
     use super::*;
 
-    fn scratch(name: &str) -> PathBuf {
-        let dir = std::env::temp_dir().join(format!("rtgi-accumulation-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
-        dir.join(name)
+    /// A path in `dir`, a temporary folder that is removed when the test ends.
+    fn scratch(dir: &tempfile::TempDir, name: &str) -> PathBuf {
+        dir.path().join(name)
     }
 
     #[test]
@@ -275,15 +274,16 @@ mod tests {
 
     #[test]
     fn files_round_trip_and_damage_is_found() {
+        let dir = tempfile::tempdir().unwrap();
         let identity = RenderIdentity::for_tests(3, 5, 8);
         let sums: Vec<PixelSum> = (0..6).map(|i| [i * 1_000_000_007, -i, (i << 90) + 3]).collect();
         let accumulation = Accumulation::from_parts(identity, 2..4, 0..5, sums).unwrap();
-        let path = scratch("round-trip.accum");
+        let path = scratch(&dir, "round-trip.accum");
         accumulation.write(&path).unwrap();
         assert_eq!(Accumulation::read(&path).unwrap(), accumulation);
 
         let bytes = std::fs::read(&path).unwrap();
-        let damaged = scratch("damaged.accum");
+        let damaged = scratch(&dir, "damaged.accum");
         let mut flipped = bytes.clone();
         let last = flipped.len() - 9;
         flipped[last] ^= 1;
@@ -300,6 +300,7 @@ mod tests {
 
     #[test]
     fn merging_files_streams_to_the_bits_of_merging_in_memory() {
+        let dir = tempfile::tempdir().unwrap();
         let identity = RenderIdentity::for_tests(3, 6, 12);
         let part = |rows: Range<u32>, samples: Range<u32>, seed: i128| {
             let pixels = (rows.end - rows.start) as i128 * 3;
@@ -307,7 +308,7 @@ mod tests {
             Accumulation::from_parts(identity.clone(), rows, samples, sums).unwrap()
         };
         let parts = vec![part(3..6, 4..12, 5), part(0..3, 0..7, 1), part(3..6, 0..4, 2), part(0..3, 7..12, 3)];
-        let paths: Vec<PathBuf> = (0..parts.len()).map(|i| scratch(&format!("stream-{i}.accum"))).collect();
+        let paths: Vec<PathBuf> = (0..parts.len()).map(|i| scratch(&dir, &format!("stream-{i}.accum"))).collect();
         for (part, path) in parts.iter().zip(&paths) {
             part.write(path).unwrap();
         }

@@ -48,7 +48,8 @@ mod tests {
 
     #[test]
     fn finds_files_whose_names_differ_in_case() {
-        let dir = std::env::temp_dir().join(format!("rtgi-resolve-{}", std::process::id()));
+        let temporary = tempfile::tempdir().unwrap();
+        let dir = temporary.path().to_path_buf();
         std::fs::create_dir_all(dir.join("Sub")).unwrap();
         std::fs::write(dir.join("Sub").join("tex.JPG"), b"x").unwrap();
         assert_eq!(resolve_case_insensitive(&dir, "sub/TEX.jpg"), Some(dir.join("Sub").join("tex.JPG")));
