@@ -67,7 +67,8 @@ pub fn render_cornell_box(
 
 /// A fresh empty folder for one test's files, removed when the test
 /// passes and kept (its path printed) when it fails, for a look at what the
-/// failing run wrote.
+/// failing run wrote, or when `RTGI_KEEP_SCRATCH` is set (to measure or
+/// profile on the scenes a test builds).
 pub fn scratch_dir(test: &str) -> ScratchDir {
     let dir = std::env::temp_dir().join(format!("rtgi-tests-{}-{test}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
@@ -96,6 +97,8 @@ impl Drop for ScratchDir {
     fn drop(&mut self) {
         if std::thread::panicking() {
             eprintln!("the failing test's files are kept in {}", self.0.display());
+        } else if std::env::var_os("RTGI_KEEP_SCRATCH").is_some() {
+            eprintln!("the test's files are kept in {} (RTGI_KEEP_SCRATCH)", self.0.display());
         } else {
             let _ = std::fs::remove_dir_all(&self.0);
         }
