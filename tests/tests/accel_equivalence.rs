@@ -18,8 +18,10 @@ fn soup() -> impl Strategy<Value = Vec<[Vec3; 3]>> {
         .prop_map(|ts| ts.into_iter().map(|(a, e1, e2)| [a, a + e1, a + e2]).collect())
 }
 
+/// Rays from anywhere, some with ranges that start behind their origin (a
+/// negative `t_min`), half of them bounded.
 fn rays() -> impl Strategy<Value = Vec<Ray>> {
-    prop::collection::vec((vec3(-14.0..14.0), vec3(-1.0..1.0), 0.0f32..2.0, prop::bool::ANY), 64).prop_map(|rs| {
+    prop::collection::vec((vec3(-14.0..14.0), vec3(-1.0..1.0), -3.0f32..2.0, prop::bool::ANY), 64).prop_map(|rs| {
         rs.into_iter()
             .map(|(o, d, t_min, bounded)| {
                 let t_max = if bounded { t_min + 8.0 } else { f32::INFINITY };

@@ -293,6 +293,21 @@ impl<S: Structure> Accel for S {
 mod tests {
     use super::*;
 
+    /// A ray whose range starts behind its origin finds hits there too,
+    /// on axis-aligned triangles as well: their boxes are flat, entered and
+    /// left at the same distance, and the robust test's enlarged exit must
+    /// not fall below that distance when it is negative.
+    #[test]
+    fn flat_triangles_behind_the_origin_are_hit_within_a_negative_range() {
+        let wall = [Vec3::new(-1.0, -1.0, -1.0), Vec3::new(-1.0, 1.0, -1.0), Vec3::new(-1.0, 0.0, 1.0)];
+        for intersector in Intersector::ALL {
+            let hit = intersector.intersect(Vec3::ZERO, Vec3::X, -10.0, 10.0, &wall);
+            assert_eq!(hit.map(|h| h.t), Some(-1.0), "{intersector}");
+            let ahead = wall.map(|v| v * Vec3::new(-1.0, 1.0, 1.0));
+            assert_eq!(intersector.intersect(Vec3::ZERO, Vec3::X, -10.0, 10.0, &ahead).map(|h| h.t), Some(1.0));
+        }
+    }
+
     #[test]
     fn hittable_means_finite_with_area() {
         let good = [Vec3::ZERO, Vec3::X, Vec3::Y];

@@ -76,9 +76,7 @@
 //! to one triangle). The [`verify`] module checks the contract on any
 //! scene, and `rtgi verify` runs it from the command line; the fast
 //! traversal ([`Traversal::Fast`]) drops boxes that rays graze and is
-//! outside the contract. The spatial-split trees (`sbvh`, `sbvh8`) hold it
-//! for every ray whose `t_min` is not negative; for a negative `t_min`
-//! see the limit in [`SplitMethod::SpatialSah`].
+//! outside the contract.
 //!
 //! # Peers
 //!

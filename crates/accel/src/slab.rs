@@ -9,10 +9,27 @@
 
 use rtgi_math::{BVec3A, Ray, Vec3A, gamma};
 
-/// `1 + 2γ(3)`: slab exit distances are enlarged by this factor so that
+/// `1 + 2γ(3)`: slab exit distances are moved later by this factor so that
 /// rounding never drops a box the ray touches (Ize, "Robust BVH Ray
-/// Traversal", JCGT 2013; pbrt-v4 `Bounds3::IntersectP`).
+/// Traversal", JCGT 2013; pbrt-v4 `Bounds3::IntersectP`). Positive exits
+/// are multiplied by it and negative ones divided by it ([`later_exit`]).
 pub(crate) const ROBUST_FAR_SCALE: f32 = 1.0 + 2.0 * gamma(3);
+
+/// `1 / (1 + 2γ(3))`, the factor of negative exits ([`later_exit`]).
+pub(crate) const ROBUST_FAR_SHRINK: f32 = 1.0 / ROBUST_FAR_SCALE;
+
+/// An exit distance moved later by the robust factor whatever its sign:
+/// `max(t·(1 + 2γ), t / (1 + 2γ))`. For `t ≥ 0` that is `t·(1 + 2γ)`, bit
+/// for bit; for `t < 0` multiplying would move it earlier, and a ray whose
+/// range starts behind its origin (a negative `t_min`) would miss boxes it
+/// touches there: a flat box (an axis-aligned triangle's) is entered and
+/// left at one distance. Both products are monotone in `t`, and so is
+/// their maximum, which traversal's exact culling needs. A NaN stays NaN,
+/// which the slab tests ignore. Every slab kernel computes exits this way.
+#[inline(always)]
+pub(crate) fn later_exit<T: Copy + std::ops::Mul<f32, Output = T>>(t: T, max: impl Fn(T, T) -> T) -> T {
+    max(t * ROBUST_FAR_SCALE, t * ROBUST_FAR_SHRINK)
+}
 
 /// A ray prepared for box tests.
 #[derive(Clone, Copy, Debug)]
@@ -48,7 +65,8 @@ pub(crate) trait SlabTest {
     fn enter(ray: &BoxRay, min: Vec3A, max: Vec3A, t_max: f32) -> f32;
 }
 
-/// Conservative: exit distances enlarged by `1 + 2γ(3)`, near and far
+/// Conservative: exit distances moved later by the factor `1 + 2γ(3)`
+/// whatever their sign ([`later_exit`]), near and far
 /// planes chosen by the direction's sign bit, and the NaN of `0 · ∞` (an
 /// origin on a slab plane along a zero direction component) ignored.
 ///
@@ -63,7 +81,7 @@ impl SlabTest for RobustSlabs {
         let t_min_planes = (min - ray.origin) * ray.inv_direction;
         let t_max_planes = (max - ray.origin) * ray.inv_direction;
         let near = Vec3A::select(ray.negative, t_max_planes, t_min_planes);
-        let far = Vec3A::select(ray.negative, t_min_planes, t_max_planes) * ROBUST_FAR_SCALE;
+        let far = later_exit(Vec3A::select(ray.negative, t_min_planes, t_max_planes), Vec3A::max);
         let (enter, exit) = clip_nan_ignoring(near, far, Vec3A::splat(ray.t_min), Vec3A::splat(t_max));
         if enter <= exit && enter < f32::INFINITY { enter } else { f32::INFINITY }
     }

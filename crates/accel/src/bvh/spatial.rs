@@ -27,14 +27,10 @@
 //! lose a hit that lies next to the plane.
 //!
 //! One step of this needs the piece on the entry side not to be left
-//! before it is entered: its exit at the plane, enlarged by the robust
-//! test's factor `1 + 2γ`, must not fall below the entry. That holds for
-//! distances of at least zero, so for every ray whose `t_min` is not
-//! negative (every ray a renderer, `rtgi rays` or `rtgi verify` makes). For
-//! a negative `t_min` the factor shrinks a negative exit, and a hit within
-//! a rounding error of a cut plane, behind the origin, could be culled
-//! when another hit lies within that same rounding error behind it: the
-//! one case where `sbvh` and `sbvh8` may differ from the linear scan.
+//! before it is entered: its exit at the plane must not fall below the
+//! entry, which lies before the plane. The robust test moves every exit
+//! later, negative ones too (`slab::later_exit`), so this holds for rays
+//! whose range starts behind their origin as well.
 //!
 //! The builder, like the others, sees only boxes.
 

@@ -25,12 +25,6 @@ pub enum SplitMethod {
     /// node may be cut by a plane and the triangles across it referenced on
     /// both sides, their boxes cut at the plane (at most 1.5 references a
     /// triangle). A [`crate::PrimitiveBvh`] builds with the binned SAH instead.
-    ///
-    /// The exactness contract holds for rays whose `t_min` is not negative.
-    /// With a negative `t_min`, a hit behind the origin within a rounding
-    /// error of a cut plane can be lost when another hit lies within that
-    /// same error behind it (the robust slab test enlarges exits by a
-    /// factor, which shrinks a negative one).
     SpatialSah,
 }
 

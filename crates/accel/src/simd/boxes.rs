@@ -11,7 +11,7 @@
 
 use rtgi_math::Vec4;
 
-use crate::slab::{BoxRay, ROBUST_FAR_SCALE};
+use crate::slab::{BoxRay, later_exit};
 
 /// The boxes of `W` children: `planes[k]` holds, for each child, the box's
 /// minimum (k = 0, 1, 2) or maximum (k = 3, 4, 5) along axis `k % 3`.
@@ -63,7 +63,7 @@ impl<const W: usize> WideBoxes<W> {
                 let far = Vec4::from_slice(&self.planes[ray.near[axis] ^ flip][lanes.clone()]);
                 let (origin, inv) = (Vec4::splat(ray.origin[axis]), Vec4::splat(ray.inv_direction[axis]));
                 let t_near = (near - origin) * inv;
-                let t_far = (far - origin) * inv * Vec4::splat(ROBUST_FAR_SCALE);
+                let t_far = later_exit((far - origin) * inv, Vec4::max);
                 // A NaN compares false and leaves the bound as it was.
                 enter = Vec4::select(t_near.cmpgt(enter), t_near, enter);
                 exit = Vec4::select(t_far.cmplt(exit), t_far, exit);

@@ -20,7 +20,7 @@ use std::sync::atomic::{AtomicU8, Ordering};
 
 use super::boxes::{FAR_OF_NEAR, PlaneRay, WideBoxes};
 use super::packet::{Lanes, PACKET, PacketRays};
-use crate::slab::ROBUST_FAR_SCALE;
+use crate::slab::{ROBUST_FAR_SCALE, ROBUST_FAR_SHRINK};
 
 /// The instruction sets the kernels are compiled for, narrowest first.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
@@ -279,6 +279,20 @@ impl Isa for Avx512 {
     }
 }
 
+/// [`crate::slab::later_exit`] on eight lanes: `max(t·(1 + 2γ), t / (1 + 2γ))`.
+/// Both products are NaN together, so `max_ps` keeps the NaN the slab
+/// tests ignore.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+#[inline]
+fn later_exit_avx2(t: std::arch::x86_64::__m256) -> std::arch::x86_64::__m256 {
+    use std::arch::x86_64::*;
+    _mm256_max_ps(
+        _mm256_mul_ps(t, _mm256_set1_ps(ROBUST_FAR_SCALE)),
+        _mm256_mul_ps(t, _mm256_set1_ps(ROBUST_FAR_SHRINK)),
+    )
+}
+
 /// [`WideBoxes::enter`] eight lanes at a time, in 256-bit registers; the
 /// same operations in the same order, lane by lane.
 #[cfg(target_arch = "x86_64")]
@@ -306,7 +320,7 @@ fn enter_boxes_avx2<const W: usize>(boxes: &WideBoxes<W>, ray: &PlaneRay, t_max:
             let origin = _mm256_set1_ps(ray.origin[axis]);
             let inv = _mm256_set1_ps(ray.inv_direction[axis]);
             let t_near = _mm256_mul_ps(_mm256_sub_ps(near, origin), inv);
-            let t_far = _mm256_mul_ps(_mm256_mul_ps(_mm256_sub_ps(far, origin), inv), _mm256_set1_ps(ROBUST_FAR_SCALE));
+            let t_far = later_exit_avx2(_mm256_mul_ps(_mm256_sub_ps(far, origin), inv));
             // `max(a, b)` is `a > b ? a : b`: a NaN in `a` leaves the bound.
             enter = _mm256_max_ps(t_near, enter);
             exit = _mm256_min_ps(t_far, exit);
@@ -346,10 +360,7 @@ fn enter_box_packet_avx2(near: [f32; 3], far: [f32; 3], rays: &PacketRays, t_max
             let origin = load(&rays.origin[axis], chunk);
             let inv = load(&rays.inv_direction[axis], chunk);
             let t_near = _mm256_mul_ps(_mm256_sub_ps(_mm256_set1_ps(near[axis]), origin), inv);
-            let t_far = _mm256_mul_ps(
-                _mm256_mul_ps(_mm256_sub_ps(_mm256_set1_ps(far[axis]), origin), inv),
-                _mm256_set1_ps(ROBUST_FAR_SCALE),
-            );
+            let t_far = later_exit_avx2(_mm256_mul_ps(_mm256_sub_ps(_mm256_set1_ps(far[axis]), origin), inv));
             enter = _mm256_max_ps(t_near, enter);
             exit = _mm256_min_ps(t_far, exit);
         }
@@ -379,9 +390,11 @@ fn enter_box_packet_avx512(near: [f32; 3], far: [f32; 3], rays: &PacketRays, t_m
         let origin = load(&rays.origin[axis]);
         let inv = load(&rays.inv_direction[axis]);
         let t_near = _mm512_mul_ps(_mm512_sub_ps(_mm512_set1_ps(near[axis]), origin), inv);
-        let t_far = _mm512_mul_ps(
-            _mm512_mul_ps(_mm512_sub_ps(_mm512_set1_ps(far[axis]), origin), inv),
-            _mm512_set1_ps(ROBUST_FAR_SCALE),
+        let distance = _mm512_mul_ps(_mm512_sub_ps(_mm512_set1_ps(far[axis]), origin), inv);
+        // `crate::slab::later_exit`, as in `later_exit_avx2`.
+        let t_far = _mm512_max_ps(
+            _mm512_mul_ps(distance, _mm512_set1_ps(ROBUST_FAR_SCALE)),
+            _mm512_mul_ps(distance, _mm512_set1_ps(ROBUST_FAR_SHRINK)),
         );
         enter = _mm512_max_ps(t_near, enter);
         exit = _mm512_min_ps(t_far, exit);

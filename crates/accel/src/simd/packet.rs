@@ -5,7 +5,7 @@
 
 use rtgi_math::{Ray, Vec4};
 
-use crate::slab::ROBUST_FAR_SCALE;
+use crate::slab::later_exit;
 
 /// Rays in a packet.
 pub(crate) const PACKET: usize = 16;
@@ -91,7 +91,7 @@ impl PacketRays {
                 let origin = Vec4::from_slice(&self.origin[axis].0[lanes.clone()]);
                 let inv = Vec4::from_slice(&self.inv_direction[axis].0[lanes.clone()]);
                 let t_near = (Vec4::splat(near[axis]) - origin) * inv;
-                let t_far = (Vec4::splat(far[axis]) - origin) * inv * Vec4::splat(ROBUST_FAR_SCALE);
+                let t_far = later_exit((Vec4::splat(far[axis]) - origin) * inv, Vec4::max);
                 // A NaN compares false and leaves the bound as it was.
                 enter = Vec4::select(t_near.cmpgt(enter), t_near, enter);
                 exit = Vec4::select(t_far.cmplt(exit), t_far, exit);
