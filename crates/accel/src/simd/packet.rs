@@ -3,8 +3,9 @@
 //! (`wide/packet.rs`) walks a wide BVH with them; the box test has an
 //! intrinsic twin in `dispatch.rs`.
 
-use rtgi_math::{Ray, Vec4};
+use rtgi_math::{Mat4, Ray, Vec4};
 
+use super::boxes::{FAR_OF_NEAR, WideBoxes};
 use crate::slab::later_exit;
 
 /// Rays in a packet.
@@ -27,6 +28,27 @@ pub(crate) struct PacketRays {
 #[repr(C, align(64))]
 pub(crate) struct Lanes(pub(crate) [f32; PACKET]);
 
+impl Lanes {
+    /// The lanes four at a time.
+    #[inline(always)]
+    fn chunks(&self) -> impl Iterator<Item = Vec4> + '_ {
+        self.0.chunks_exact(4).map(Vec4::from_slice)
+    }
+
+    /// The greatest of the lanes in `mask`, or -∞ for an empty mask.
+    #[inline(always)]
+    pub(crate) fn latest(&self, mask: u32) -> f32 {
+        let mut latest = f32::NEG_INFINITY;
+        let mut lanes = mask;
+        while lanes != 0 {
+            let lane = lanes.trailing_zeros() as usize;
+            lanes &= lanes - 1;
+            latest = latest.max(self.0[lane]);
+        }
+        latest
+    }
+}
+
 /// Smallest cosine between the first ray's direction and any other's for
 /// a batch of rays to be traced as a packet: about 8°. Beyond that the
 /// rays part ways soon and single rays are faster.
@@ -36,41 +58,69 @@ impl PacketRays {
     /// The packet of `rays` (at most [`PACKET`]), or `None` if they are
     /// not coherent: an invalid ray, direction signs that differ, or
     /// directions too far apart.
+    ///
+    /// Four rays at a time are transposed to structure-of-arrays and
+    /// checked together, with vector instructions.
+    #[inline(always)]
     pub(crate) fn new(rays: &[Ray]) -> Option<Self> {
         debug_assert!(rays.len() <= PACKET);
         let first = rays.first()?;
-        let sign_bits = |ray: &Ray| ray.direction.is_negative_bitmask();
-        let (axis, first_signs) = (first.direction, sign_bits(first));
-        let axis_length2 = axis.length_squared();
-        // cos(d, axis) ≥ c, squared: (d · axis)² ≥ c² |d|² |axis|², with d · axis ≥ 0.
-        let coherent = rays.iter().all(|ray| {
-            let along = ray.direction.dot(axis);
-            ray.is_valid()
-                && sign_bits(ray) == first_signs
-                && along >= 0.0
-                && along * along >= COHERENT_COSINE * COHERENT_COSINE * ray.direction.length_squared() * axis_length2
-        });
-        if !coherent {
-            return None;
-        }
-        // Lanes past the end repeat the first ray; their answers are dropped.
+        let axis = Vec4::from((first.direction, 0.0));
+        let min_cosine2 = Vec4::splat(COHERENT_COSINE * COHERENT_COSINE * axis.length_squared());
+        let signs = first.direction.is_negative_bitmask();
         let mut packet = PacketRays {
             origin: [Lanes([0.0; PACKET]); 3],
             inv_direction: [Lanes([0.0; PACKET]); 3],
-            t_min: Lanes([first.t_min; PACKET]),
-            near: [0, 1, 2].map(|axis| if first_signs >> axis & 1 == 1 { axis + 3 } else { axis }),
+            t_min: Lanes([0.0; PACKET]),
+            near: [0, 1, 2].map(|axis| if signs >> axis & 1 == 1 { axis + 3 } else { axis }),
         };
-        for lane in 0..PACKET {
-            let ray = rays.get(lane).unwrap_or(first);
-            // As `BoxRay` computes it, so that the box tests agree with the scalar one.
-            let (origin, inv) = (ray.origin.to_array(), (1.0 / rtgi_math::Vec3A::from(ray.direction)).to_array());
-            for axis in 0..3 {
-                packet.origin[axis].0[lane] = origin[axis];
-                packet.inv_direction[axis].0[lane] = inv[axis];
+        let mut coherent = true;
+        for chunk in 0..PACKET / 4 {
+            // Lanes past the end repeat the first ray; their answers are dropped.
+            let ray = |lane: usize| rays.get(chunk * 4 + lane).unwrap_or(first);
+            let [ox, oy, oz, dx] = Mat4::from_cols_array_2d(&[0, 1, 2, 3].map(|lane| {
+                let ray = ray(lane);
+                [ray.origin.x, ray.origin.y, ray.origin.z, ray.direction.x]
+            }))
+            .transpose()
+            .to_cols_array_2d()
+            .map(Vec4::from);
+            let [dy, dz, t_min, t_max] = Mat4::from_cols_array_2d(&[0, 1, 2, 3].map(|lane| {
+                let ray = ray(lane);
+                [ray.direction.y, ray.direction.z, ray.t_min, ray.t_max]
+            }))
+            .transpose()
+            .to_cols_array_2d()
+            .map(Vec4::from);
+            let finite = |v: Vec4| v.abs().cmplt(Vec4::INFINITY);
+            let along = dx * axis.x + dy * axis.y + dz * axis.z;
+            let length2 = dx * dx + dy * dy + dz * dz;
+            // As `Ray::is_valid`: finite origin and direction, a non-zero
+            // direction and a non-empty range (NaN compares false).
+            let valid = finite(ox)
+                & finite(oy)
+                & finite(oz)
+                & finite(dx)
+                & finite(dy)
+                & finite(dz)
+                & (dx.cmpne(Vec4::ZERO) | dy.cmpne(Vec4::ZERO) | dz.cmpne(Vec4::ZERO))
+                & t_min.cmple(t_max);
+            let same_signs = [dx, dy, dz]
+                .iter()
+                .enumerate()
+                .all(|(axis, d)| d.is_negative_bitmask() == if signs >> axis & 1 == 1 { 0b1111 } else { 0 });
+            // cos(d, axis) ≥ c, squared: (d · axis)² ≥ c² |d|² |axis|², with d · axis ≥ 0.
+            let close = along.cmpge(Vec4::ZERO) & (along * along).cmpge(min_cosine2 * length2);
+            coherent &= (valid & close).all() & same_signs;
+            let lanes = chunk * 4..chunk * 4 + 4;
+            for (axis, (o, d)) in [(ox, dx), (oy, dy), (oz, dz)].into_iter().enumerate() {
+                o.write_to_slice(&mut packet.origin[axis].0[lanes.clone()]);
+                // As `BoxRay` computes it, so that the box tests agree with the scalar one.
+                (Vec4::ONE / d).write_to_slice(&mut packet.inv_direction[axis].0[lanes.clone()]);
             }
-            packet.t_min.0[lane] = ray.t_min;
+            t_min.write_to_slice(&mut packet.t_min.0[lanes]);
         }
-        Some(packet)
+        coherent.then_some(packet)
     }
 }
 
@@ -101,5 +151,199 @@ impl PacketRays {
             mask |= entered.bitmask() << (chunk * 4);
         }
         (mask & active, earliest.min_element())
+    }
+}
+
+/// The rays of a packet as one ray with interval coordinates: for each
+/// axis, the range of the origins and of the inverse directions. Its box
+/// test bounds every ray's: the distance at which it enters a box is no
+/// later than any ray's entry, and the exit no earlier than any ray's
+/// exit, so a box it misses is missed by every ray of the packet.
+///
+/// Why the bounds hold, bit for bit. A ray computes the distance to a
+/// plane `p` as `fl(fl(p - o) * i)`. Rounding is monotone, so
+/// `fl(p - o)` lies between its values at the extreme origins, and the
+/// product's exact value over the rectangle of differences and inverses
+/// is least (or greatest) at a corner, which the rounded corner product
+/// then bounds too. The inverses of a packet share one sign, so the
+/// corner is picked by the sign of the difference alone (below). A ray
+/// with a zero direction component (an infinite inverse) on a plane
+/// through its origin gets NaN, which drops the axis from its test; the
+/// corner product is then NaN or infinite too, and drops it from the
+/// bound (see [`IntervalRay::enter_boxes`]).
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct IntervalRay {
+    /// Per axis, the origin coordinate furthest along the direction: the
+    /// one whose near plane distance is least.
+    origin_ahead: [f32; 3],
+    /// Per axis, the origin coordinate least far along the direction.
+    origin_behind: [f32; 3],
+    /// Per axis, the inverse direction of least magnitude.
+    inv_small: [f32; 3],
+    /// Per axis, the inverse direction of greatest magnitude.
+    inv_big: [f32; 3],
+    /// Per axis, 1 for a positive direction and -1 for a negative one.
+    sign: [f32; 3],
+    near: [usize; 3],
+    /// The least `t_min` of the rays.
+    t_min: f32,
+}
+
+impl IntervalRay {
+    #[inline(always)]
+    pub(crate) fn new(packet: &PacketRays) -> Self {
+        let lanes_min = |lanes: &Lanes| lanes.chunks().fold(Vec4::INFINITY, Vec4::min).min_element();
+        let lanes_max = |lanes: &Lanes| lanes.chunks().fold(Vec4::NEG_INFINITY, Vec4::max).max_element();
+        let mut ray = IntervalRay {
+            origin_ahead: [0.0; 3],
+            origin_behind: [0.0; 3],
+            inv_small: [0.0; 3],
+            inv_big: [0.0; 3],
+            sign: [1.0; 3],
+            near: packet.near,
+            t_min: lanes_min(&packet.t_min),
+        };
+        for axis in 0..3 {
+            let (origin_min, origin_max) = (lanes_min(&packet.origin[axis]), lanes_max(&packet.origin[axis]));
+            let (inv_min, inv_max) = (lanes_min(&packet.inv_direction[axis]), lanes_max(&packet.inv_direction[axis]));
+            if packet.near[axis] == axis {
+                ray.origin_ahead[axis] = origin_max;
+                ray.origin_behind[axis] = origin_min;
+                (ray.inv_small[axis], ray.inv_big[axis]) = (inv_min, inv_max);
+            } else {
+                ray.origin_ahead[axis] = origin_min;
+                ray.origin_behind[axis] = origin_max;
+                (ray.inv_small[axis], ray.inv_big[axis]) = (inv_max, inv_min);
+                ray.sign[axis] = -1.0;
+            }
+        }
+        ray
+    }
+
+    /// For each of the `W` boxes, a distance no later than the one at
+    /// which any ray of the packet enters it within `[t_min, t_max]`
+    /// (`t_max` being the latest of the rays'), or +∞ where no ray can
+    /// enter it; and a mask of the boxes that some ray may enter.
+    ///
+    /// The near plane's least distance takes the origin ahead, and then
+    /// the smallest inverse where the difference points along the
+    /// direction (all distances are positive) and the biggest otherwise.
+    /// The far plane's greatest distance takes the origin behind, the
+    /// biggest inverse where the difference points along the direction or
+    /// is zero, and the smallest otherwise. At a zero difference the
+    /// biggest inverse gives NaN when it is infinite, which drops the axis,
+    /// as it does for the ray that has it.
+    #[inline(always)]
+    pub(crate) fn enter_boxes<const W: usize>(&self, boxes: &WideBoxes<W>, t_max: f32) -> (u32, [f32; W]) {
+        const { assert!(W.is_multiple_of(4), "wide nodes have a multiple of four lanes") };
+        let mut distances = [f32::INFINITY; W];
+        let mut mask = 0;
+        for chunk in 0..W / 4 {
+            let lanes = chunk * 4..chunk * 4 + 4;
+            let mut enter = Vec4::splat(self.t_min);
+            let mut exit = Vec4::splat(t_max);
+            for (axis, flip) in FAR_OF_NEAR.into_iter().enumerate() {
+                let near = Vec4::from_slice(&boxes.planes[self.near[axis]][lanes.clone()]);
+                let far = Vec4::from_slice(&boxes.planes[self.near[axis] ^ flip][lanes.clone()]);
+                let (small, big, sign) =
+                    (Vec4::splat(self.inv_small[axis]), Vec4::splat(self.inv_big[axis]), Vec4::splat(self.sign[axis]));
+                let to_near = near - Vec4::splat(self.origin_ahead[axis]);
+                let to_far = far - Vec4::splat(self.origin_behind[axis]);
+                let t_near = to_near * Vec4::select((to_near * sign).cmpgt(Vec4::ZERO), small, big);
+                let t_far = to_far * Vec4::select((to_far * sign).cmplt(Vec4::ZERO), small, big);
+                let t_far = later_exit(t_far, Vec4::max);
+                // A NaN compares false and leaves the bound as it was.
+                enter = Vec4::select(t_near.cmpgt(enter), t_near, enter);
+                exit = Vec4::select(t_far.cmplt(exit), t_far, exit);
+            }
+            let entered = enter.cmple(exit) & enter.cmplt(Vec4::INFINITY);
+            Vec4::select(entered, enter, Vec4::INFINITY).write_to_slice(&mut distances[lanes]);
+            mask |= entered.bitmask() << (chunk * 4);
+        }
+        (mask, distances)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use rtgi_math::{Rng, Vec3};
+
+    /// A coordinate that often lies on a box plane or is zero.
+    fn coordinate(rng: &mut Rng) -> f32 {
+        match rng.next_u32() % 8 {
+            0 => 0.0,
+            1 => 1.0,
+            2 => -1.0,
+            3 => -0.0,
+            _ => rng.next_f32() * 8.0 - 4.0,
+        }
+    }
+
+    /// Sixteen rays with one set of direction signs: directions near a
+    /// common one, each component sometimes zero (of the common sign),
+    /// origins near a common one and sometimes on a box plane.
+    fn packet(rng: &mut Rng) -> Vec<Ray> {
+        let base_origin = Vec3::from([0; 3].map(|_| coordinate(rng)));
+        let signs = [0; 3].map(|_| rng.next_u32().is_multiple_of(2));
+        // An axis the rays nearly lie across: components zero or tiny.
+        let across = [0; 3].map(|_| rng.next_u32().is_multiple_of(3));
+        let base = [0; 3].map(|_| 0.3 + rng.next_f32());
+        let spread = [0.0, 0.01, 0.5][rng.next_u32() as usize % 3];
+        let t_min = [0.0, -2.0, 0.5][rng.next_u32() as usize % 3];
+        (0..PACKET)
+            .map(|_| {
+                let direction = Vec3::from([0, 1, 2].map(|axis| {
+                    let magnitude = match (across[axis], rng.next_u32() % 2) {
+                        (true, 0) => 0.0,
+                        (true, _) => rng.next_f32() * 1e-3,
+                        (false, _) => base[axis] * (1.0 + 0.02 * rng.next_f32()),
+                    };
+                    if signs[axis] { -magnitude } else { magnitude }
+                }));
+                let direction = if direction.abs() == Vec3::ZERO { Vec3::new(0.0, 0.0, 1.0) } else { direction };
+                let jitter = Vec3::from([0; 3].map(|_| (rng.next_f32() - 0.5) * spread));
+                let origin = if rng.next_u32().is_multiple_of(3) { base_origin } else { base_origin + jitter };
+                Ray { t_min, ..Ray::new(origin, direction) }
+            })
+            .collect()
+    }
+
+    #[test]
+    fn the_interval_ray_enters_every_box_a_ray_of_its_packet_enters_no_later() {
+        let mut rng = Rng::new(31, 4);
+        let (mut packets, mut entries) = (0, 0);
+        for _ in 0..20_000 {
+            let rays = packet(&mut rng);
+            let Some(packet) = PacketRays::new(&rays) else { continue };
+            packets += 1;
+            let interval = IntervalRay::new(&packet);
+            let mut boxes = WideBoxes::<8>::EMPTY;
+            for lane in 0..8 {
+                let a = Vec3::from([0; 3].map(|_| coordinate(&mut rng)));
+                let b = Vec3::from([0; 3].map(|_| coordinate(&mut rng)));
+                boxes.set(lane, a.min(b).to_array(), a.max(b).to_array());
+            }
+            let t_max = Lanes(std::array::from_fn(|_| {
+                if rng.next_u32().is_multiple_of(2) { f32::INFINITY } else { rng.next_f32() * 6.0 - 1.0 }
+            }));
+            let (maybe, bounds) = interval.enter_boxes(&boxes, t_max.latest(u32::MAX >> 16));
+            for (lane, bound) in bounds.iter().enumerate() {
+                let near = [0, 1, 2].map(|axis| boxes.planes[packet.near[axis]][lane]);
+                let far = [0, 1, 2].map(|axis| boxes.planes[packet.near[axis] ^ FAR_OF_NEAR[axis]][lane]);
+                for (lane_of_ray, ray) in rays.iter().enumerate() {
+                    let (entered, enter) = packet.enter_box(near, far, &t_max, 1 << lane_of_ray);
+                    if entered != 0 {
+                        entries += 1;
+                        assert!(maybe >> lane & 1 == 1, "box {lane} entered by {ray:?} but culled");
+                        assert!(*bound <= enter, "box {lane}: bound {bound} after the entry {enter} of {ray:?}");
+                    }
+                }
+            }
+        }
+        assert!(
+            packets > 5_000 && entries > 50_000,
+            "{packets} packets, {entries} entries: the generator lost its cases"
+        );
     }
 }
