@@ -16,6 +16,7 @@ use serde::{Deserialize, Serialize};
 use crate::pareto;
 use crate::plot::Plot;
 use crate::provenance::Build;
+use crate::report::{Point, format_number};
 use crate::{ExperimentError, Knob, Machine, Report};
 
 /// What one `rtgi experiment all` run was: its command and how long it took.
@@ -290,7 +291,56 @@ pub fn summary_markdown(folder: &Path) -> Result<String, ExperimentError> {
             let _ = writeln!(md, "- **`{}`**, {}: {finding}", entry.report.knob, entry.report.scene);
         }
     }
+    md.push_str(&peers_markdown(&reports));
     Ok(md)
+}
+
+/// Our wide BVHs beside Embree, from the `accel` reports that measured
+/// Embree: throughput and build time, and each as a multiple of Embree's
+/// (greater is better for rays, less for builds). Empty when no report
+/// measured Embree.
+fn peers_markdown(reports: &[IndexedReport]) -> String {
+    const OURS: [&str; 3] = ["bvh4", "bvh8", "sbvh8"];
+    let mut rows = Vec::new();
+    let mut threads = 0;
+    for entry in reports.iter().filter(|e| e.report.knob == "accel") {
+        let point = |name: &str| entry.report.series.iter().find(|s| s.name == name).and_then(|s| s.points.first());
+        let Some(embree) = point("embree") else { continue };
+        let figures = |point: &Point| {
+            let value = |key: &str| point.values.get(key).copied().unwrap_or(f64::NAN);
+            let build = point.time.as_ref().map_or(f64::NAN, |t| t.median_ms);
+            [value("camera_mrays"), value("camera_batch_mrays"), value("incoherent_mrays"), build]
+        };
+        let theirs = figures(embree);
+        threads = entry.report.machine.threads;
+        let scene = scene_slug(&entry.report.scene);
+        for name in OURS {
+            let Some(point) = point(name) else { continue };
+            let cells: Vec<String> = figures(point)
+                .iter()
+                .zip(theirs)
+                .map(|(ours, theirs)| format!("{} ({:.2}×)", format_number(*ours), ours / theirs))
+                .collect();
+            rows.push(format!("| {scene} | {name} | {} |", cells.join(" | ")));
+        }
+        let cells: Vec<String> = theirs.iter().map(|v| format_number(*v)).collect();
+        rows.push(format!("| {scene} | Embree | {} |", cells.join(" | ")));
+    }
+    if rows.is_empty() {
+        return String::new();
+    }
+    let mut md = format!(
+        "\nAgainst Embree (from the `accel` reports: the same rays for all, {threads} threads; in brackets, the \
+         multiple of Embree's figure: `rtcIntersect1` for camera and incoherent rays, `rtcIntersect16` for \
+         the batch of camera rays, and its build):\n\n\
+         | scene | structure | camera Mrays/s | camera batch Mrays/s | incoherent Mrays/s | build ms |\n\
+         |---|---|---:|---:|---:|---:|\n",
+    );
+    for row in rows {
+        md.push_str(&row);
+        md.push('\n');
+    }
+    md
 }
 
 /// Writes `index.md` and the Pareto plots into `folder` from the reports'
