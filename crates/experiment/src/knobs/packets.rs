@@ -38,8 +38,10 @@ pub(super) fn run(
             (subset, expected)
         })
         .collect();
-    let kinds: Vec<AccelKind> =
-        [AccelKind::Bvh4, AccelKind::Bvh8].into_iter().chain(AccelKind::PEERS.iter().copied()).collect();
+    let kinds: Vec<AccelKind> = [AccelKind::Bvh4, AccelKind::Bvh8, AccelKind::Sbvh8]
+        .into_iter()
+        .chain(AccelKind::PEERS.iter().copied())
+        .collect();
     let mut steps = Steps::new(kinds.len(), progress);
     let mut table = Table {
         title: format!(
