@@ -51,28 +51,46 @@ impl<const W: usize> WideBoxes<W> {
     /// EVEX-encoded when compiled for a wider level.
     #[inline(always)]
     pub(crate) fn enter(&self, ray: &PlaneRay, t_max: f32) -> (u32, [f32; W]) {
+        self.enter_with(ray.near, ray.t_min, t_max, |axis, near, far| {
+            let (origin, inv) = (Vec4::splat(ray.origin[axis]), Vec4::splat(ray.inv_direction[axis]));
+            ((near - origin) * inv, later_exit((far - origin) * inv, Vec4::max))
+        })
+    }
+
+    /// The slab test's combination of distances, four boxes at a time:
+    /// `distances(axis, near, far)` gives the distances along `axis` to
+    /// four boxes' near and far planes (the far ones enlarged), where
+    /// `near_planes[axis]` indexes the near planes in [`WideBoxes::planes`].
+    /// Returns each box's entry distance within `[t_min, t_max]`, or +∞,
+    /// and the mask of the boxes entered.
+    #[inline(always)]
+    pub(crate) fn enter_with(
+        &self,
+        near_planes: [usize; 3],
+        t_min: f32,
+        t_max: f32,
+        distances: impl Fn(usize, Vec4, Vec4) -> (Vec4, Vec4),
+    ) -> (u32, [f32; W]) {
         const { assert!(W.is_multiple_of(4), "wide nodes have a multiple of four lanes") };
-        let mut distances = [f32::INFINITY; W];
+        let mut entries = [f32::INFINITY; W];
         let mut mask = 0;
         for chunk in 0..W / 4 {
             let lanes = chunk * 4..chunk * 4 + 4;
-            let mut enter = Vec4::splat(ray.t_min);
+            let mut enter = Vec4::splat(t_min);
             let mut exit = Vec4::splat(t_max);
             for (axis, flip) in FAR_OF_NEAR.into_iter().enumerate() {
-                let near = Vec4::from_slice(&self.planes[ray.near[axis]][lanes.clone()]);
-                let far = Vec4::from_slice(&self.planes[ray.near[axis] ^ flip][lanes.clone()]);
-                let (origin, inv) = (Vec4::splat(ray.origin[axis]), Vec4::splat(ray.inv_direction[axis]));
-                let t_near = (near - origin) * inv;
-                let t_far = later_exit((far - origin) * inv, Vec4::max);
+                let near = Vec4::from_slice(&self.planes[near_planes[axis]][lanes.clone()]);
+                let far = Vec4::from_slice(&self.planes[near_planes[axis] ^ flip][lanes.clone()]);
+                let (t_near, t_far) = distances(axis, near, far);
                 // A NaN compares false and leaves the bound as it was.
                 enter = Vec4::select(t_near.cmpgt(enter), t_near, enter);
                 exit = Vec4::select(t_far.cmplt(exit), t_far, exit);
             }
             let entered = enter.cmple(exit) & enter.cmplt(Vec4::INFINITY);
-            Vec4::select(entered, enter, Vec4::INFINITY).write_to_slice(&mut distances[lanes]);
+            Vec4::select(entered, enter, Vec4::INFINITY).write_to_slice(&mut entries[lanes]);
             mask |= entered.bitmask() << (chunk * 4);
         }
-        (mask, distances)
+        (mask, entries)
     }
 }
 

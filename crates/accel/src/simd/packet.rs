@@ -5,7 +5,7 @@
 
 use rtgi_math::{Mat4, Ray, Vec4};
 
-use super::boxes::{FAR_OF_NEAR, WideBoxes};
+use super::boxes::WideBoxes;
 use crate::slab::later_exit;
 
 /// Rays in a packet.
@@ -235,38 +235,22 @@ impl IntervalRay {
     /// as it does for the ray that has it.
     #[inline(always)]
     pub(crate) fn enter_boxes<const W: usize>(&self, boxes: &WideBoxes<W>, t_max: f32) -> (u32, [f32; W]) {
-        const { assert!(W.is_multiple_of(4), "wide nodes have a multiple of four lanes") };
-        let mut distances = [f32::INFINITY; W];
-        let mut mask = 0;
-        for chunk in 0..W / 4 {
-            let lanes = chunk * 4..chunk * 4 + 4;
-            let mut enter = Vec4::splat(self.t_min);
-            let mut exit = Vec4::splat(t_max);
-            for (axis, flip) in FAR_OF_NEAR.into_iter().enumerate() {
-                let near = Vec4::from_slice(&boxes.planes[self.near[axis]][lanes.clone()]);
-                let far = Vec4::from_slice(&boxes.planes[self.near[axis] ^ flip][lanes.clone()]);
-                let (small, big, sign) =
-                    (Vec4::splat(self.inv_small[axis]), Vec4::splat(self.inv_big[axis]), Vec4::splat(self.sign[axis]));
-                let to_near = near - Vec4::splat(self.origin_ahead[axis]);
-                let to_far = far - Vec4::splat(self.origin_behind[axis]);
-                let t_near = to_near * Vec4::select((to_near * sign).cmpgt(Vec4::ZERO), small, big);
-                let t_far = to_far * Vec4::select((to_far * sign).cmplt(Vec4::ZERO), small, big);
-                let t_far = later_exit(t_far, Vec4::max);
-                // A NaN compares false and leaves the bound as it was.
-                enter = Vec4::select(t_near.cmpgt(enter), t_near, enter);
-                exit = Vec4::select(t_far.cmplt(exit), t_far, exit);
-            }
-            let entered = enter.cmple(exit) & enter.cmplt(Vec4::INFINITY);
-            Vec4::select(entered, enter, Vec4::INFINITY).write_to_slice(&mut distances[lanes]);
-            mask |= entered.bitmask() << (chunk * 4);
-        }
-        (mask, distances)
+        boxes.enter_with(self.near, self.t_min, t_max, |axis, near, far| {
+            let (small, big, sign) =
+                (Vec4::splat(self.inv_small[axis]), Vec4::splat(self.inv_big[axis]), Vec4::splat(self.sign[axis]));
+            let to_near = near - Vec4::splat(self.origin_ahead[axis]);
+            let to_far = far - Vec4::splat(self.origin_behind[axis]);
+            let t_near = to_near * Vec4::select((to_near * sign).cmpgt(Vec4::ZERO), small, big);
+            let t_far = to_far * Vec4::select((to_far * sign).cmplt(Vec4::ZERO), small, big);
+            (t_near, later_exit(t_far, Vec4::max))
+        })
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::simd::boxes::FAR_OF_NEAR;
     use rtgi_math::{Rng, Vec3};
 
     /// A coordinate that often lies on a box plane or is zero.
