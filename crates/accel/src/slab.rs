@@ -7,29 +7,11 @@
 //! contains another is never entered later nor left earlier than it, bit
 //! for bit; that is what lets traversal cull boxes exactly.
 
-use rtgi_math::{BVec3A, Ray, Vec3A, gamma};
+use rtgi_math::{BVec3A, Ray, Vec3A};
 
-/// `1 + 2γ(3)`: slab exit distances are moved later by this factor so that
-/// rounding never drops a box the ray touches (Ize, "Robust BVH Ray
-/// Traversal", JCGT 2013; pbrt-v4 `Bounds3::IntersectP`). Positive exits
-/// are multiplied by it and negative ones divided by it ([`later_exit`]).
-pub(crate) const ROBUST_FAR_SCALE: f32 = 1.0 + 2.0 * gamma(3);
-
-/// `1 / (1 + 2γ(3))`, the factor of negative exits ([`later_exit`]).
-pub(crate) const ROBUST_FAR_SHRINK: f32 = 1.0 / ROBUST_FAR_SCALE;
-
-/// An exit distance moved later by the robust factor whatever its sign:
-/// `max(t·(1 + 2γ), t / (1 + 2γ))`. For `t ≥ 0` that is `t·(1 + 2γ)`, bit
-/// for bit; for `t < 0` multiplying would move it earlier, and a ray whose
-/// range starts behind its origin (a negative `t_min`) would miss boxes it
-/// touches there: a flat box (an axis-aligned triangle's) is entered and
-/// left at one distance. Both products are monotone in `t`, and so is
-/// their maximum, which traversal's exact culling needs. A NaN stays NaN,
-/// which the slab tests ignore. Every slab kernel computes exits this way.
-#[inline(always)]
-pub(crate) fn later_exit<T: Copy + std::ops::Mul<f32, Output = T>>(t: T, max: impl Fn(T, T) -> T) -> T {
-    max(t * ROBUST_FAR_SCALE, t * ROBUST_FAR_SHRINK)
-}
+// The robust slab test's exit factor and its use on either sign, shared
+// with `rtgi_math::Aabb::intersect`: one definition of the rounding rule.
+pub(crate) use rtgi_math::{ROBUST_FAR_SCALE, ROBUST_FAR_SHRINK, later_exit};
 
 /// A ray prepared for box tests.
 #[derive(Clone, Copy, Debug)]

@@ -1,6 +1,6 @@
 use glam::Vec3;
 
-use crate::float::gamma;
+use crate::float::later_exit;
 use crate::ray::RayWithInverse;
 
 /// An axis-aligned bounding box, closed on all sides.
@@ -124,9 +124,11 @@ impl Aabb {
     ///
     /// The near and far planes are chosen from the sign bit of `1 / d_c`, so
     /// -0 behaves as a negative direction, consistent with its reciprocal -∞.
-    /// The exit distance is enlarged by `1 + 2γ(3)`, which makes the test
+    /// The exit distance is moved later by the factor `1 + 2γ(3)` (divided by
+    /// it where it is negative, [`later_exit`]), which makes the test
     /// conservative: rounding can never drop a box the ray touches (Ize,
-    /// "Robust BVH Ray Traversal", JCGT 2013; pbrt-v4 `Bounds3::IntersectP`).
+    /// "Robust BVH Ray Traversal", JCGT 2013; pbrt-v4 `Bounds3::IntersectP`),
+    /// behind the origin too.
     #[inline]
     pub fn intersect(&self, ray: &RayWithInverse) -> Option<(f32, f32)> {
         let bounds = [self.min, self.max];
@@ -137,7 +139,7 @@ impl Aabb {
             let near_plane = bounds[octant[axis]][axis];
             let far_plane = bounds[1 - octant[axis]][axis];
             let t_near = (near_plane - ray.origin[axis]) * ray.inv_direction[axis];
-            let t_far = (far_plane - ray.origin[axis]) * ray.inv_direction[axis] * ROBUST_FAR_SCALE;
+            let t_far = later_exit((far_plane - ray.origin[axis]) * ray.inv_direction[axis], f32::max);
             // Written as comparisons so that a NaN distance leaves the interval alone.
             if t_near > t_enter {
                 t_enter = t_near;
@@ -150,10 +152,6 @@ impl Aabb {
         (t_enter <= t_exit && t_enter < f32::INFINITY).then_some((t_enter, t_exit))
     }
 }
-
-/// `1 + 2γ(3)`: the relative enlargement of the slab exit distance that covers
-/// the rounding of `(plane - origin) * inv_direction` (pbrt-v4, section 6.8.2).
-const ROBUST_FAR_SCALE: f32 = 1.0 + 2.0 * gamma(3);
 
 #[cfg(test)]
 mod tests {
@@ -202,6 +200,18 @@ mod tests {
                 assert!(hits(&b, Vec3::new(1.0, 1.0, start_z), Vec3::new(zero, zero, sign)));
             }
         }
+    }
+
+    #[test]
+    fn a_flat_box_behind_the_origin_is_hit_by_a_range_that_starts_behind_it() {
+        // The box of an axis-aligned triangle at x = -1: entered and left at
+        // t = -1. Multiplying that exit by 1 + 2γ moved it before the entry.
+        let wall = Aabb::new(Vec3::new(-1.0, -1.0, -1.0), Vec3::new(-1.0, 1.0, 1.0));
+        let ray = Ray::with_range(Vec3::ZERO, Vec3::X, -10.0, 10.0).with_inverse();
+        let (enter, exit) = wall.intersect(&ray).expect("the wall behind the origin is in the ray's range");
+        assert!(enter <= -1.0 && exit >= -1.0, "[{enter}, {exit}]");
+        let ahead = Ray::with_range(Vec3::ZERO, -Vec3::X, 0.0, 10.0).with_inverse();
+        assert!(wall.intersect(&ahead).is_some());
     }
 
     #[test]

@@ -12,6 +12,29 @@ pub const fn gamma(n: i32) -> f32 {
     n_eps / (1.0 - n_eps)
 }
 
+/// `1 + 2γ(3)`: slab exit distances are moved later by this factor so that
+/// rounding never drops a box the ray touches (Ize, "Robust BVH Ray
+/// Traversal", JCGT 2013; pbrt-v4 `Bounds3::IntersectP`). Positive exits
+/// are multiplied by it and negative ones divided by it ([`later_exit`]).
+pub const ROBUST_FAR_SCALE: f32 = 1.0 + 2.0 * gamma(3);
+
+/// `1 / (1 + 2γ(3))`, the factor of negative exits ([`later_exit`]).
+pub const ROBUST_FAR_SHRINK: f32 = 1.0 / ROBUST_FAR_SCALE;
+
+/// A slab test's exit distance moved later by the robust factor whatever
+/// its sign: `max(t·(1 + 2γ), t / (1 + 2γ))`, for one number (`f32::max`)
+/// or several lanes (`Vec4::max`). For `t ≥ 0` that is `t·(1 + 2γ)`, bit
+/// for bit; for `t < 0` multiplying would move it earlier, and a ray whose
+/// range starts behind its origin (a negative `t_min`) would miss boxes it
+/// touches there: a flat box (an axis-aligned triangle's) is entered and
+/// left at one distance. Both products are monotone in `t`, and so is
+/// their maximum, which exact culling needs. A NaN stays NaN, which the
+/// slab tests ignore.
+#[inline(always)]
+pub fn later_exit<T: Copy + std::ops::Mul<f32, Output = T>>(t: T, max: impl Fn(T, T) -> T) -> T {
+    max(t * ROBUST_FAR_SCALE, t * ROBUST_FAR_SHRINK)
+}
+
 /// The smallest f32 greater than `x` (infinity and NaN are returned unchanged).
 #[inline]
 pub fn next_float_up(x: f32) -> f32 {
