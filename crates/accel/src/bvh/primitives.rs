@@ -7,7 +7,7 @@ use std::time::Instant;
 use rayon::prelude::*;
 use rtgi_math::{Aabb, Ray, Vec3A};
 
-use super::traverse::STACK_SIZE;
+use super::traverse::{BinaryQuery, STACK_SIZE, traverse_binary};
 use super::{BvhNode, SplitMethod, build};
 use crate::boxa::BoxA;
 use crate::primitive::{buildable_bounds, hit_primitive};
@@ -141,76 +141,56 @@ impl<P: Primitive> PrimitiveBvh<P> {
         self.nodes.first().map_or(Aabb::EMPTY, BvhNode::bounds)
     }
 
-    /// One query, front to back with an explicit stack, as the triangle
-    /// BVH's robust traversal; `ANY_HIT` stops at the first hit accepted.
+    /// One query, by the triangle BVH's traversal ([`traverse_binary`])
+    /// with the robust slab test; `ANY_HIT` stops at the first hit accepted.
     fn query<const ANY_HIT: bool>(&self, ray: &Ray) -> Option<PrimitiveHit<P::Payload>> {
         if !ray.is_valid() || self.nodes.is_empty() {
             return None;
         }
-        let box_ray = BoxRay::new(ray);
-        let enter = |node: &BvhNode, t_max: f32| {
-            let (min, max) = node.corners();
-            RobustSlabs::enter(&box_ray, min, max, t_max)
-        };
-        let mut best: Option<PrimitiveHit<P::Payload>> = None;
-        let mut t_max = ray.t_max;
+        let mut query = PrimitiveQuery::<P, ANY_HIT> { bvh: self, ray, box_ray: BoxRay::new(ray), best: None };
         // Builds never exceed 64 + 32 levels, so the stack cannot overflow.
-        let mut stack = [0u32; STACK_SIZE];
-        let mut stack_len = 0;
-        if enter(&self.nodes[0], t_max) == f32::INFINITY {
-            return None;
-        }
-        let mut node = &self.nodes[0];
-        loop {
-            if node.is_leaf() {
-                let range = node.first() as usize..(node.first() + node.count()) as usize;
-                for (&id, &bounds) in self.leaf_ids[range.clone()].iter().zip(&self.leaf_bounds[range]) {
-                    let primitive = &self.primitives[id as usize];
-                    let Some((t, payload)) = hit_primitive(primitive, bounds, ray, &box_ray, t_max) else {
-                        continue;
-                    };
-                    let precedes = best.as_ref().is_none_or(|b| t < b.t || (t == b.t && id < b.primitive));
-                    if precedes {
-                        t_max = t;
-                        best = Some(PrimitiveHit { t, primitive: id, payload });
-                        if ANY_HIT {
-                            return best;
-                        }
-                    }
-                }
-            } else {
-                let first = node.first();
-                let (mut near, mut far) = (first, first + 1);
-                let (mut enter_near, mut enter_far) =
-                    (enter(&self.nodes[near as usize], t_max), enter(&self.nodes[far as usize], t_max));
-                if enter_far < enter_near {
-                    std::mem::swap(&mut near, &mut far);
-                    std::mem::swap(&mut enter_near, &mut enter_far);
-                }
-                // A missed box enters at +∞; a box entered at exactly the
-                // best distance is visited, as it may hold a tie with a
-                // lower index.
-                if enter_near < f32::INFINITY {
-                    if enter_far < f32::INFINITY {
-                        stack[stack_len] = far;
-                        stack_len += 1;
-                    }
-                    node = &self.nodes[near as usize];
-                    continue;
-                }
-            }
-            // The next pushed box still entered no later than the best hit.
-            loop {
-                if stack_len == 0 {
-                    return best;
-                }
-                stack_len -= 1;
-                let candidate = &self.nodes[stack[stack_len] as usize];
-                if enter(candidate, t_max) < f32::INFINITY {
-                    node = candidate;
-                    break;
+        traverse_binary::<_, STACK_SIZE>(&self.nodes, &mut query);
+        query.best
+    }
+}
+
+/// A query on a [`PrimitiveBvh`], for [`traverse_binary`].
+struct PrimitiveQuery<'a, P: Primitive, const ANY_HIT: bool> {
+    bvh: &'a PrimitiveBvh<P>,
+    ray: &'a Ray,
+    box_ray: BoxRay,
+    best: Option<PrimitiveHit<P::Payload>>,
+}
+
+impl<P: Primitive, const ANY_HIT: bool> BinaryQuery for PrimitiveQuery<'_, P, ANY_HIT> {
+    #[inline(always)]
+    fn enter(&self, node: &BvhNode, t_max: f32) -> f32 {
+        let (min, max) = node.corners();
+        RobustSlabs::enter(&self.box_ray, min, max, t_max)
+    }
+
+    #[inline(always)]
+    fn t_max(&self) -> f32 {
+        self.best.as_ref().map_or(self.ray.t_max, |best| best.t)
+    }
+
+    /// Offers each primitive's hit; the best is the least in the order
+    /// (distance, primitive index), as for triangles.
+    fn visit_leaf(&mut self, leaf: &BvhNode) -> bool {
+        let range = leaf.first() as usize..(leaf.first() + leaf.count()) as usize;
+        for (&id, &bounds) in self.bvh.leaf_ids[range.clone()].iter().zip(&self.bvh.leaf_bounds[range]) {
+            let primitive = &self.bvh.primitives[id as usize];
+            let Some((t, payload)) = hit_primitive(primitive, bounds, self.ray, &self.box_ray, self.t_max()) else {
+                continue;
+            };
+            let precedes = self.best.as_ref().is_none_or(|b| t < b.t || (t == b.t && id < b.primitive));
+            if precedes {
+                self.best = Some(PrimitiveHit { t, primitive: id, payload });
+                if ANY_HIT {
+                    return true;
                 }
             }
         }
+        false
     }
 }

@@ -2,6 +2,8 @@
 //! ray/triangle test and the slab test so that every combination runs as
 //! its own monomorphised loop.
 
+use std::marker::PhantomData;
+
 use rtgi_math::Ray;
 
 use super::{Bvh, BvhNode};
@@ -139,66 +141,132 @@ impl Bvh {
         if !ray.is_valid() || self.nodes.is_empty() {
             return None;
         }
-        let prepared = PreparedRay::<T>::new(ray);
-        let box_ray = &prepared.boxes;
-        let mut best = Best::new(ray);
-        let root = &self.nodes[0];
-        counter.node_visited();
-        if root.enter::<S>(box_ray, best.t_max) == f32::INFINITY {
-            return None;
+        let mut query = TriangleQuery::<Q, C, T, S, F> {
+            bvh: self,
+            prepared: PreparedRay::<T>::new(ray),
+            best: Best::new(ray),
+            counter,
+            filter,
+            kinds: PhantomData,
+        };
+        traverse_binary::<_, STACK>(&self.nodes, &mut query);
+        query.best.hit
+    }
+}
+
+/// A query during [`traverse_binary`]: how it tests boxes and leaves, and
+/// the distance beyond which nothing can improve its answer.
+pub(crate) trait BinaryQuery {
+    /// The distance at which the ray enters `node`'s box within
+    /// `[t_min, t_max]`, or +∞.
+    fn enter(&self, node: &BvhNode, t_max: f32) -> f32;
+    /// The best hit's distance so far (the ray's `t_max` before any).
+    fn t_max(&self) -> f32;
+    /// Tests the primitives of a leaf; returns whether the query is
+    /// answered (an any-hit query found a hit).
+    fn visit_leaf(&mut self, leaf: &BvhNode) -> bool;
+    /// Counts a box tested.
+    #[inline(always)]
+    fn node_visited(&mut self) {}
+}
+
+/// Front-to-back traversal of a binary BVH's `nodes` (the root first, the
+/// two children of a node side by side), shared by the triangle BVH and
+/// [`crate::PrimitiveBvh`]. Both children's boxes are tested together, the
+/// nearer visited first; a child that is a leaf is tested at once, and the
+/// farther child waits on a stack of `STACK` entries (one per level) when
+/// both are to be descended. A box entered at exactly the best distance is
+/// still visited, as it may hold a tie with a lower index; a missed box
+/// enters at +∞, which an unbounded `t_max` does not exclude.
+#[inline(always)]
+pub(crate) fn traverse_binary<B: BinaryQuery, const STACK: usize>(nodes: &[BvhNode], query: &mut B) {
+    let Some(root) = nodes.first() else { return };
+    query.node_visited();
+    if query.enter(root, query.t_max()) == f32::INFINITY {
+        return;
+    }
+    if root.is_leaf() {
+        query.visit_leaf(root);
+        return;
+    }
+    let mut stack = [0u32; STACK];
+    let mut stack_len = 0;
+    let mut children = root.first();
+    loop {
+        let pair = &nodes[children as usize..children as usize + 2];
+        query.node_visited();
+        query.node_visited();
+        let (mut near, mut far) = (&pair[0], &pair[1]);
+        let t_max = query.t_max();
+        let (mut enter_near, mut enter_far) = (query.enter(near, t_max), query.enter(far, t_max));
+        if enter_far < enter_near {
+            std::mem::swap(&mut near, &mut far);
+            std::mem::swap(&mut enter_near, &mut enter_far);
         }
-        if root.is_leaf() {
-            self.visit_leaf::<Q, C, T, F>(root, &prepared, &mut best, counter, filter);
-            return best.hit;
+        let mut descend_near = enter_near < f32::INFINITY;
+        if descend_near && near.is_leaf() {
+            if query.visit_leaf(near) {
+                return;
+            }
+            descend_near = false;
         }
-        let mut stack = [0u32; STACK];
-        let mut stack_len = 0;
-        let mut children = root.first();
-        loop {
-            let pair = &self.nodes[children as usize..children as usize + 2];
-            counter.node_visited();
-            counter.node_visited();
-            let (mut near, mut far) = (&pair[0], &pair[1]);
-            let (mut enter_near, mut enter_far) =
-                (near.enter::<S>(box_ray, best.t_max), far.enter::<S>(box_ray, best.t_max));
-            if enter_far < enter_near {
-                std::mem::swap(&mut near, &mut far);
-                std::mem::swap(&mut enter_near, &mut enter_far);
+        // The near leaf may have found a hit in front of the far box.
+        let mut descend_far = enter_far < f32::INFINITY && enter_far <= query.t_max();
+        if descend_far && far.is_leaf() {
+            if query.visit_leaf(far) {
+                return;
             }
-            let mut descend_near = enter_near < f32::INFINITY;
-            if descend_near && near.is_leaf() {
-                if self.visit_leaf::<Q, C, T, F>(near, &prepared, &mut best, counter, filter) {
-                    return best.hit;
-                }
-                descend_near = false;
-            }
-            // The near leaf may have found a hit in front of the far box; a
-            // box entered at exactly the best distance may still hold a tie
-            // with a lower index, so it is visited. (A missed box enters at
-            // +∞, which an unbounded t_max does not exclude.)
-            let mut descend_far = enter_far < f32::INFINITY && enter_far <= best.t_max;
-            if descend_far && far.is_leaf() {
-                if self.visit_leaf::<Q, C, T, F>(far, &prepared, &mut best, counter, filter) {
-                    return best.hit;
-                }
-                descend_far = false;
-            }
-            children = match (descend_near, descend_far) {
-                (true, true) => {
-                    stack[stack_len] = far.first();
-                    stack_len += 1;
-                    near.first()
-                }
-                (true, false) => near.first(),
-                (false, true) => far.first(),
-                (false, false) => {
-                    if stack_len == 0 {
-                        return best.hit;
-                    }
-                    stack_len -= 1;
-                    stack[stack_len]
-                }
-            };
+            descend_far = false;
         }
+        children = match (descend_near, descend_far) {
+            (true, true) => {
+                stack[stack_len] = far.first();
+                stack_len += 1;
+                near.first()
+            }
+            (true, false) => near.first(),
+            (false, true) => far.first(),
+            (false, false) => {
+                if stack_len == 0 {
+                    return;
+                }
+                stack_len -= 1;
+                stack[stack_len]
+            }
+        };
+    }
+}
+
+/// A triangle query on a [`Bvh`], for [`traverse_binary`].
+struct TriangleQuery<'a, Q, C, T: TriangleTest, S, F> {
+    bvh: &'a Bvh,
+    prepared: PreparedRay<T>,
+    best: Best,
+    counter: &'a mut C,
+    filter: &'a F,
+    kinds: PhantomData<(Q, S)>,
+}
+
+impl<Q: QueryKind, C: Counter, T: TriangleTest, S: SlabTest, F: HitFilter> BinaryQuery
+    for TriangleQuery<'_, Q, C, T, S, F>
+{
+    #[inline(always)]
+    fn enter(&self, node: &BvhNode, t_max: f32) -> f32 {
+        node.enter::<S>(&self.prepared.boxes, t_max)
+    }
+
+    #[inline(always)]
+    fn t_max(&self) -> f32 {
+        self.best.t_max
+    }
+
+    #[inline(always)]
+    fn visit_leaf(&mut self, leaf: &BvhNode) -> bool {
+        self.bvh.visit_leaf::<Q, C, T, F>(leaf, &self.prepared, &mut self.best, self.counter, self.filter)
+    }
+
+    #[inline(always)]
+    fn node_visited(&mut self) {
+        self.counter.node_visited();
     }
 }
