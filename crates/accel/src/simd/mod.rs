@@ -4,7 +4,8 @@
 //!
 //! Inside the crate: `boxes.rs` tests one ray against the `W` child boxes
 //! of a wide node, stored structure-of-arrays, with the robust slab test's
-//! arithmetic lane by lane, and `packet.rs` sixteen rays against one box;
+//! arithmetic lane by lane, and `packet.rs` sixteen rays against one box
+//! and, through the interval ray that bounds them, against a node's boxes;
 //! `triangles.rs` tests one ray against a block of
 //! four triangles, stored structure-of-arrays; `arith.rs` holds the
 //! ray/triangle arithmetic written once, generic over one lane (`f32`) or

@@ -1,7 +1,9 @@
-//! The rays of a packet, structure-of-arrays, and the one test they take
-//! together: which of them enter a box. The packet traversal
-//! (`wide/packet.rs`) walks a wide BVH with them; the box test has an
-//! intrinsic twin in `dispatch.rs`.
+//! The rays of a packet, structure-of-arrays, and the two box tests they
+//! take together: which of them enter a box ([`PacketRays::enter_box`],
+//! with an intrinsic twin in `dispatch.rs`), and which of a node's boxes
+//! any of them may enter, tested once for all by the interval ray that
+//! bounds them ([`IntervalRay`]). The packet traversal (`wide/packet.rs`)
+//! walks a wide BVH with them.
 
 use rtgi_math::{Mat4, Ray, Vec4};
 
