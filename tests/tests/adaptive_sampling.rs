@@ -1,13 +1,22 @@
+//! Clean images in bounded time.
+//!
 //! Adaptive sampling (`rtgi render --noise`, `--time`): deterministic, close
 //! to the converged reference at every noise target (its stopping rule
 //! could bias it; the tests measure how much), fewer samples where the image
 //! is smooth, and refused where it cannot work.
+//!
+//! The denoiser (`rtgi render --denoise`): against the converged Cornell
+//! box at several sample counts it must lower the error without moving the
+//! image's brightness, and the command applies it to PNG output only.
 
 use rtgi_accel::{Accel, AccelKind, BuildParams};
 use rtgi_image::HdrImage;
 use rtgi_math::luminance;
 use rtgi_render::adaptive::{AdaptiveError, AdaptiveOutcome, FIRST_ROUND};
-use rtgi_render::{AdaptiveSampling, PixelSampler, RenderSettings, frame_scene, render, render_adaptive};
+use rtgi_render::{
+    AdaptiveSampling, DenoiseSettings, Guides, PixelSampler, RenderSettings, frame_scene, render, render_adaptive,
+    render_denoised,
+};
 use rtgi_scene::{Camera, Scene};
 use rtgi_tests::{CORNELL_SIZE, Run, run_cli, scratch_dir, shared_scene, workspace_root};
 
@@ -251,4 +260,113 @@ fn the_command_says_how_it_adapted_and_its_time_bound_names_the_render_that_repe
     assert!(!run.success && run.stderr.contains("stratified sampler"), "{}", run.stderr);
     let run = rtgi(&["render", "--quick", "--noise", "2", "-o", dir.join("x.png").to_str().unwrap()]);
     assert!(!run.success && run.stderr.contains("a fraction between 0 and 1"), "{}", run.stderr);
+}
+
+fn mean_luminance(image: &HdrImage) -> f64 {
+    image.pixels().iter().map(|&p| luminance(p) as f64).sum::<f64>() / image.pixels().len() as f64
+}
+
+#[test]
+fn the_denoised_cornell_box_is_closer_to_the_converged_one_at_every_sample_count_and_as_bright() {
+    // The filter is biased by design (blur, fireflies taken out): against
+    // the 16,384-sample reference, its error must still fall with the
+    // samples, stay below the samples' mean, and leave the brightness.
+    let Some(box_) = cornell() else { return };
+    let (scene, accel, camera) = &box_;
+    let reference = HdrImage::read_exr(&workspace_root().join("tests/references/cornell-box-path.exr")).unwrap();
+    let mut previous = f64::INFINITY;
+    for spp in [4u32, 16, 64] {
+        let settings = settings(CORNELL_SIZE, spp, 3);
+        let (clean, raw) = render_denoised(scene, accel.as_ref(), camera, &settings, &DenoiseSettings::default());
+        let guides = Guides::render(scene, accel.as_ref(), camera, &settings);
+        let inside = interior(&guides);
+        let (raw_inside, clean_inside) =
+            (relative_rms_where(&raw, &reference, &inside), relative_rms_where(&clean, &reference, &inside));
+        let (raw_all, clean_all) = (errors(&raw, &reference).0, errors(&clean, &reference).0);
+        let brightness = mean_luminance(&clean) / mean_luminance(&reference) - 1.0;
+        println!(
+            "{spp} spp: relative RMS error {raw_inside:.4} raw, {clean_inside:.4} denoised away from edges \
+             ({} pixels); {raw_all:.4} and {clean_all:.4} over the lit image; denoised brightness {brightness:+.4}",
+            inside.iter().filter(|&&b| b).count()
+        );
+        // Away from edges the noise is what the filter takes out.
+        assert!(clean_inside < 0.6 * raw_inside, "{spp} spp: {clean_inside} denoised against {raw_inside} raw");
+        // Edges (anti-aliasing noise the guides keep apart) it cannot
+        // smooth, but it must not make the whole image worse.
+        assert!(clean_all <= raw_all, "{spp} spp: {clean_all} denoised against {raw_all} raw over the image");
+        assert!(clean_inside < previous, "{spp} spp: more samples did not lower the denoised error");
+        previous = clean_inside;
+        // The filter moves light between pixels and takes out fireflies: the
+        // image as a whole must keep its brightness within 3%.
+        assert!(brightness.abs() < 0.03, "{spp} spp: the denoised image is off by {brightness:+.4}");
+    }
+}
+
+#[test]
+fn png_previews_are_denoised_and_exr_and_split_renders_keep_the_samples_mean() {
+    let dir = scratch_dir("denoise-cli");
+    let render = |extra: &[&str]| -> Run {
+        let mut args = vec!["render", "--width", "32", "--height", "32", "--spp", "4"];
+        args.extend_from_slice(extra);
+        rtgi(&args)
+    };
+    let out = |name: &str| dir.join(name).to_str().unwrap().to_owned();
+
+    let png = render(&["-o", &out("a.png")]);
+    assert!(png.success && png.stdout.contains("denoised "), "{}", png.stdout);
+    let exr = render(&["-o", &out("a.exr")]);
+    assert!(exr.success && !exr.stdout.contains("denoised "), "{}", exr.stdout);
+    let off = render(&["-o", &out("b.png"), "--denoise", "off"]);
+    assert!(off.success && !off.stdout.contains("denoised "), "{}", off.stdout);
+    let exr_on = render(&["-o", &out("b.exr"), "--denoise", "on"]);
+    assert!(exr_on.success && exr_on.stdout.contains("denoised "), "{}", exr_on.stdout);
+    // The AOV integrators are not noisy light: auto leaves them, on is refused.
+    let albedo = render(&["-o", &out("c.png"), "--integrator", "albedo"]);
+    assert!(albedo.success && !albedo.stdout.contains("denoised "), "{}", albedo.stdout);
+    let refused = render(&["-o", &out("d.png"), "--integrator", "albedo", "--denoise", "on"]);
+    assert!(!refused.success && refused.stderr.contains("--denoise on is for the direct and path integrators"));
+    let accumulation = render(&["-o", &out("e.accum"), "--denoise", "on"]);
+    assert!(
+        !accumulation.success && accumulation.stderr.contains("keeps the samples' sums"),
+        "{}",
+        accumulation.stderr
+    );
+    assert!(!dir.join("e.accum").exists() && !dir.join("d.png").exists());
+}
+
+/// The pixels whose 3 × 3 neighbourhood shows one flat, non-emitting
+/// surface (the guides' normals agree): away from edges, where a pixel's
+/// error is noise and blur rather than the edge's anti-aliasing.
+fn interior(guides: &Guides) -> Vec<bool> {
+    let (w, h) = (guides.normal.width() as i64, guides.normal.height() as i64);
+    let at = |x: i64, y: i64| guides.normal.get(x as u32, y as u32);
+    (0..w * h)
+        .map(|i| {
+            let (x, y) = (i % w, i / w);
+            if x == 0
+                || y == 0
+                || x == w - 1
+                || y == h - 1
+                || guides.emission.get(x as u32, y as u32).max_element() > 0.0
+            {
+                return false;
+            }
+            let n = at(x, y);
+            n.length() > 0.99
+                && (-1..=1).all(|dy| (-1..=1).all(|dx| at(x + dx, y + dy).dot(n) > 0.99 * n.length_squared()))
+        })
+        .collect()
+}
+
+/// Relative RMS error of the luminance over the pixels `mask` selects.
+fn relative_rms_where(image: &HdrImage, reference: &HdrImage, mask: &[bool]) -> f64 {
+    let (mut sum, mut n) = (0.0, 0usize);
+    for ((a, r), &inside) in image.pixels().iter().zip(reference.pixels()).zip(mask) {
+        let r = luminance(*r) as f64;
+        if inside && r > 0.0 {
+            sum += ((luminance(*a) as f64 - r) / r).powi(2);
+            n += 1;
+        }
+    }
+    (sum / n.max(1) as f64).sqrt()
 }

@@ -606,6 +606,12 @@ pub(crate) struct RenderArgs {
     #[command(flatten)]
     pub(crate) tone: ToneArgs,
 
+    /// Smooth the noise of a PNG across surfaces, keeping edges (an albedo-, normal- and
+    /// depth-guided filter): auto denoises PNG output of the direct and path integrators and
+    /// never EXR or .accum files, which keep the unbiased estimate
+    #[arg(long, value_enum, default_value_t = Denoise::Auto)]
+    pub(crate) denoise: Denoise,
+
     /// Radiance of camera rays that hit nothing and see no environment, as R,G,B
     #[arg(long, value_parser = parse_colour, default_value = "0.05,0.05,0.06", allow_hyphen_values = true)]
     pub(crate) background: Vec3,
@@ -681,6 +687,17 @@ fn parse_noise(text: &str) -> Result<f32, String> {
 fn aov_parser() -> impl TypedValueParser<Value = Integrator> {
     let aovs = Integrator::value_variants().iter().filter(|i| i.is_aov()).filter_map(ValueEnum::to_possible_value);
     PossibleValuesParser::new(aovs).map(|name| ValueEnum::from_str(&name, false).expect("one of the possible values"))
+}
+
+/// Whether `rtgi render` denoises its image.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub(crate) enum Denoise {
+    /// PNG output of the direct and path integrators
+    Auto,
+    /// Every image of a light-simulating integrator, EXR included
+    On,
+    /// Never: the image is the samples' mean
+    Off,
 }
 
 /// How an image becomes 8-bit PNG (EXR keeps linear floats): shared by `render` and `merge`.

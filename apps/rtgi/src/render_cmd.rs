@@ -5,12 +5,12 @@ use anyhow::{Result, bail};
 use rtgi_image::{HdrImage, Legibility, OutputFormat, ToneMap, check_writable, legibility};
 use rtgi_render::adaptive::AdaptiveOutcome;
 use rtgi_render::{
-    Accumulation, EffectPlan, EnvironmentSpec, Integrator, PixelSampler, RenderIdentity, RenderSettings, recipe,
-    render, render_adaptive,
+    Accumulation, DenoiseSettings, EffectPlan, EnvironmentSpec, GUIDE_SAMPLES, Guides, Integrator, PixelSampler,
+    RenderIdentity, RenderSettings, denoise, recipe, render, render_adaptive,
 };
 
 use crate::cli::ToneArgs;
-use crate::cli::{RenderArgs, reshaped};
+use crate::cli::{Denoise, RenderArgs, reshaped};
 use crate::common::{
     LoadedScene, Phrasing, Structure, apply_lighting, check_output_folder, load_scene, prepare_render, prepare_view,
     refuse_inputs_as_outputs,
@@ -62,6 +62,20 @@ pub(crate) struct Given<'a> {
     pub(crate) accel: &'a dyn rtgi_accel::Accel,
 }
 
+/// Whether the image is denoised: `--denoise auto` denoises PNG output of
+/// the integrators that simulate light (EXR and accumulations keep the
+/// unbiased mean), `on` any image of those integrators.
+fn denoises(choice: Denoise, simulates_light: bool, output: &Path) -> bool {
+    let png = OutputFormat::from_path(output).is_ok_and(|f| f == OutputFormat::Png);
+    simulates_light
+        && !is_accumulation(output)
+        && match choice {
+            Denoise::Auto => png,
+            Denoise::On => true,
+            Denoise::Off => false,
+        }
+}
+
 /// `rtgi render`, returning the image it wrote.
 pub(crate) fn render_image(args: &RenderArgs) -> Result<Rendered> {
     render_given(args, None)
@@ -88,6 +102,21 @@ pub(crate) fn render_given(args: &RenderArgs, given: Option<Given<'_>>) -> Resul
             "--samples and --tile render a part of an image: write it to an .{ACCUMULATION_EXTENSION} file \
              (-o part.{ACCUMULATION_EXTENSION}) and put the parts together with 'rtgi merge'"
         );
+    }
+    if args.denoise == Denoise::On {
+        if is_accumulation(&output) {
+            bail!(
+                "--denoise on: {} keeps the samples' sums, which a filter cannot apply to; denoise the image \
+                 (-o image.png or .exr) instead",
+                output.display()
+            );
+        }
+        if !args.lighting.integrator.simulates_light() {
+            bail!(
+                "--denoise on is for the direct and path integrators: the {} integrator's image is not noisy light",
+                args.lighting.integrator
+            );
+        }
     }
     if job.is_part() && !args.aov.is_empty() {
         bail!("--aov is for whole renders, not with --samples or --tile");
@@ -186,6 +215,10 @@ pub(crate) fn render_given(args: &RenderArgs, given: Option<Given<'_>>) -> Resul
         );
     }
     let renderer = Renderer { scene: &scene, accel: accel.as_ref(), camera: &camera, settings: &settings };
+    // The denoiser learns each pixel's noise from the image at half its samples.
+    let denoising = denoises(args.denoise, settings.integrator.simulates_light(), &output);
+    let halfway = (denoising && !job.is_part() && spp >= 2).then_some(spp / 2);
+    let mut half_image = None;
     let rendered = match adaptive {
         Some(_) => {
             let mut rounds_printed = Ok(());
@@ -208,7 +241,9 @@ pub(crate) fn render_given(args: &RenderArgs, given: Option<Given<'_>>) -> Resul
             Done::Adapted(image, outcome)
         }
         None => {
-            let accumulation = render_progressively(args, &renderer, started, from_script, resumed, &mut printed)?;
+            let (accumulation, half) =
+                render_progressively(args, &renderer, started, from_script, resumed, halfway, &mut printed)?;
+            half_image = half;
             Done::Progressive(accumulation)
         }
     };
@@ -225,6 +260,17 @@ pub(crate) fn render_given(args: &RenderArgs, given: Option<Given<'_>>) -> Resul
     let image = match &rendered {
         Done::Progressive((accumulation, ..)) => (done > 0).then(|| accumulation.image()),
         Done::Adapted(image, _) => Some(image.clone()),
+    };
+    let mut denoise_ms = None;
+    let image = match image {
+        Some(raw) if denoising => {
+            let started = Instant::now();
+            let guides = pool.install(|| Guides::render(&scene, accel.as_ref(), &camera, &settings));
+            let clean = pool.install(|| denoise(&raw, half_image.as_ref(), &guides, &DenoiseSettings::default()))?;
+            denoise_ms = Some(started.elapsed().as_secs_f64() * 1e3);
+            Some(clean)
+        }
+        other => other,
     };
     let tone_map = match &image {
         Some(image) => tone_map(&args.tone, simulates_light, image),
@@ -278,6 +324,12 @@ pub(crate) fn render_given(args: &RenderArgs, given: Option<Given<'_>>) -> Resul
             );
             say!("{}", adaptive_summary(args, outcome, spp, settings.sampler));
         }
+    }
+    if let Some(ms) = denoise_ms {
+        say!(
+            "denoised    {ms:.1} ms (guided by albedo, normal, depth and emission at {GUIDE_SAMPLES} spp; --denoise off keeps \
+             the samples' mean)"
+        );
     }
     if job.is_part() {
         say!("part        rows {rows:?}, samples {samples:?} of every pixel");
@@ -364,8 +416,9 @@ fn render_progressively(
     started: Instant,
     from_script: bool,
     resumed: Option<Accumulation>,
+    halfway: Option<u32>,
     printed: &mut Result<()>,
-) -> Result<(Accumulation, Ending, Totals)> {
+) -> Result<((Accumulation, Ending, Totals), Option<HdrImage>)> {
     let job = &args.job;
     let settings = renderer.settings;
     let (rows, samples) = job.share(settings.height, settings.samples_per_pixel)?;
@@ -414,9 +467,10 @@ fn render_progressively(
     let pixels = rows.len() as u64 * settings.width as u64;
     let progress = Progress::new(pixels, before, samples.end);
     let progress = if from_script { progress.with_forecast() } else { progress };
-    let (ending, totals) = run_passes(renderer, job, started, &mut accumulation, samples.end, &progress)?;
+    let (ending, totals, half) =
+        run_passes(renderer, job, started, &mut accumulation, (samples.end, halfway), &progress)?;
     progress.finish();
-    Ok((accumulation, ending, totals))
+    Ok(((accumulation, ending, totals), half))
 }
 
 /// Refuses what cannot go with adaptive sampling: whether a pixel goes on

@@ -11,6 +11,7 @@ use std::time::{Duration, Instant};
 use anyhow::{Result, bail};
 use clap::Args;
 use rtgi_accel::Accel;
+use rtgi_image::HdrImage;
 use rtgi_render::{Accumulation, PassControl, RenderSettings, render_pass};
 use rtgi_scene::{Camera, Scene};
 
@@ -149,15 +150,18 @@ pub(crate) struct Renderer<'a> {
 
 /// Renders passes into `accumulation` until its samples reach `last`, the
 /// time limit (counted from `started`) is reached or a signal arrives;
-/// saves a checkpoint every `--checkpoint-every` seconds.
+/// saves a checkpoint every `--checkpoint-every` seconds. With `halfway`,
+/// a pass ends at that many samples and the image then is returned too
+/// (the denoiser's estimate of each pixel's noise).
 pub(crate) fn run_passes(
     renderer: &Renderer<'_>,
     args: &JobArgs,
     started: Instant,
     accumulation: &mut Accumulation,
-    last: u32,
+    (last, halfway): (u32, Option<u32>),
     progress: &Progress,
-) -> Result<(Ending, Totals)> {
+) -> Result<(Ending, Totals, Option<HdrImage>)> {
+    let mut half = None;
     let deadline = args.time_limit.map(|seconds| started + Duration::from_secs_f64(seconds));
     let checkpoint = args.checkpoint_path();
     let pixels = accumulation.rows().len() as u64 * renderer.settings.width as u64;
@@ -186,10 +190,13 @@ pub(crate) fn run_passes(
             }
             target = target.min(left);
         }
-        let count = match seconds_per_sample {
+        let mut count = match seconds_per_sample {
             None => 1,
             Some(t) => ((target / t).floor() as u32).clamp(1, remaining),
         };
+        if let Some(halfway) = halfway.filter(|&h| h > accumulation.samples().end) {
+            count = count.min(halfway - accumulation.samples().end);
+        }
         let control = PassControl { progress: &|done| progress.add(done), cancelled: &stop_requested };
         let Renderer { scene, accel, camera, settings } = *renderer;
         let pass_start = Instant::now();
@@ -199,6 +206,9 @@ pub(crate) fn run_passes(
                 totals.rays += stats.rays;
                 totals.render_seconds += stats.render_ms * 1e-3;
                 seconds_per_sample = Some(pass_start.elapsed().as_secs_f64() / count as f64);
+                if halfway == Some(accumulation.samples().end) {
+                    half = Some(accumulation.image());
+                }
             }
             Err(_cancelled) => {
                 // The pass's samples are dropped; the loop's top says why it stopped.
@@ -216,7 +226,7 @@ pub(crate) fn run_passes(
             progress.say(&format!("checkpoint {}: {} samples per pixel", path.display(), accumulation.samples().end));
         }
     };
-    Ok((ending, totals))
+    Ok((ending, totals, half))
 }
 
 /// A render stopped by a signal, after writing what it had: the command

@@ -32,6 +32,8 @@ pub enum Integrator {
     Depth,
     /// The closest hit's position.
     Position,
+    /// The light the closest hit emits towards the camera (its texture included).
+    Emission,
     /// Boxes (red) and triangles (green) tested to find the closest hit.
     Cost,
     /// Light arriving directly from lights and emitters, after one reflection.
@@ -48,6 +50,7 @@ impl Integrator {
         Integrator::Normal,
         Integrator::Depth,
         Integrator::Position,
+        Integrator::Emission,
         Integrator::Cost,
         Integrator::Direct,
         Integrator::Path,
@@ -61,6 +64,7 @@ impl Integrator {
             Integrator::Normal => "normal",
             Integrator::Depth => "depth",
             Integrator::Position => "position",
+            Integrator::Emission => "emission",
             Integrator::Cost => "cost",
             Integrator::Direct => "direct",
             Integrator::Path => "path",
@@ -77,7 +81,12 @@ impl Integrator {
     pub fn is_aov(self) -> bool {
         matches!(
             self,
-            Integrator::Albedo | Integrator::Normal | Integrator::Depth | Integrator::Position | Integrator::Cost
+            Integrator::Albedo
+                | Integrator::Normal
+                | Integrator::Depth
+                | Integrator::Position
+                | Integrator::Emission
+                | Integrator::Cost
         )
     }
 }

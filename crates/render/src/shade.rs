@@ -14,17 +14,22 @@ const AMBIENT: f32 = 0.2;
 /// surface's own emission (times its texture). Both sides of a surface are
 /// lit. `textures` says whether to look textures up (the plan's choice).
 pub fn shade_primary(scene: &Scene, ray: &Ray, hit: &Hit, textures: bool) -> Vec3 {
-    let triangle = &scene.triangles[hit.triangle as usize];
-    let material = &scene.materials[triangle.material as usize];
-    let emission = material.emission
-        * material.emission_texture.filter(|_| textures).map_or(Vec3::ONE, |t| {
-            let uv = scene.interpolate(triangle, hit.beta, hit.gamma, |v| v.uv);
-            scene.textures[t.0 as usize].sample(uv).truncate()
-        });
+    let emission = emission(scene, hit, textures);
     let albedo = albedo(scene, hit, textures);
     let normal = shading_normal(scene, hit);
     let cosine = normal.dot(-ray.direction.normalize()).abs();
     albedo * (AMBIENT + (1.0 - AMBIENT) * cosine) + emission
+}
+
+/// The light the surface emits at the hit: emission times its texture (if `textures`).
+pub fn emission(scene: &Scene, hit: &Hit, textures: bool) -> Vec3 {
+    let triangle = &scene.triangles[hit.triangle as usize];
+    let material = &scene.materials[triangle.material as usize];
+    material.emission
+        * material.emission_texture.filter(|_| textures).map_or(Vec3::ONE, |t| {
+            let uv = scene.interpolate(triangle, hit.beta, hit.gamma, |v| v.uv);
+            scene.textures[t.0 as usize].sample(uv).truncate()
+        })
 }
 
 /// The surface colour at the hit: base colour times texture (if `textures`).
@@ -73,6 +78,7 @@ pub(crate) fn aov<A: Accel + ?Sized>(
         Integrator::Normal => shading_normal(scene, &hit),
         Integrator::Depth => Vec3::splat(hit.t * ray.direction.length()),
         Integrator::Position => ray.at(hit.t),
+        Integrator::Emission => emission(scene, &hit, textures),
         other => unreachable!("{other} is not an AOV"),
     }
 }
