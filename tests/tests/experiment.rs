@@ -41,6 +41,7 @@ fn every_knob_writes_its_table_json_and_plots() {
         "direct",
         "clamp",
         "adaptive",
+        "denoise",
         "analytic",
         "effects",
         "intersector",

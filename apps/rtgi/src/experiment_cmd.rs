@@ -44,6 +44,7 @@ fn report_scenes(knob: Knob) -> &'static [&'static str] {
         Knob::Depth => &[CORNELL, SPONZA],
         Knob::Clamp => &[CORNELL, ROOM, CONFERENCE],
         Knob::Adaptive => &[CORNELL, ROOM],
+        Knob::Denoise => &[CORNELL, SPONZA, CONFERENCE],
         Knob::Accel => &[CORNELL, BUNNY, SPONZA, CONFERENCE],
         Knob::Effects => &[CORNELL, HELMET],
         Knob::Traversal | Knob::Packets => &[BUNNY],

@@ -22,15 +22,37 @@ pub(crate) fn render_with(subject: &Subject, accel: &dyn Accel, settings: &Rende
     (image, start.elapsed().as_secs_f64() * 1e3)
 }
 
+/// Renders `subject` with `settings` and denoises the image as `rtgi
+/// render` does for PNG output (`rtgi_render::render_denoised`); returns
+/// the image and the time of the render, its guides and the filter in ms.
+pub(crate) fn render_denoised(subject: &Subject, settings: &RenderSettings) -> (HdrImage, f64) {
+    let start = Instant::now();
+    let denoise = rtgi_render::DenoiseSettings::default();
+    let (clean, _) =
+        rtgi_render::render_denoised(&subject.scene, subject.accel.as_ref(), &subject.camera, settings, &denoise);
+    (clean, start.elapsed().as_secs_f64() * 1e3)
+}
+
 /// Renders `options.repeats` times with seeds 0, 1, 2... and measures the
 /// time and the error against `reference`: RMSE, relative MSE, the split
 /// into squared bias and variance over the seeds, and (in the point's
 /// values) the efficiency `1 / (MSE · seconds)`.
 pub(crate) fn measure(subject: &Subject, settings: &RenderSettings, options: &Options, reference: &Reference) -> Point {
+    measure_with(subject, settings, options, reference, render)
+}
+
+/// [`measure`], each image made by `make` (a render, or a render and a filter).
+pub(crate) fn measure_with(
+    subject: &Subject,
+    settings: &RenderSettings,
+    options: &Options,
+    reference: &Reference,
+    make: fn(&Subject, &RenderSettings) -> (HdrImage, f64),
+) -> Point {
     let mut times = Vec::new();
     let mut errors = SeedErrors::new(&reference.image, reference.info.noise_rmse);
     for repeat in 0..options.repeats.max(1) {
-        let (image, ms) = render(subject, &RenderSettings { seed: repeat as u64, ..settings.clone() });
+        let (image, ms) = make(subject, &RenderSettings { seed: repeat as u64, ..settings.clone() });
         times.push(ms);
         errors.add(&image);
     }

@@ -9,6 +9,7 @@ mod accel;
 mod adaptive;
 mod analytic;
 mod clamp;
+mod denoise;
 mod depth;
 mod direct;
 mod effects;
@@ -41,6 +42,8 @@ pub enum Knob {
     Clamp,
     /// Adaptive sampling (noise targets) against fixed samples per pixel.
     Adaptive,
+    /// The edge-avoiding denoiser against the samples' mean.
+    Denoise,
     /// Each estimator's bias against answers known in closed form (white furnaces).
     Analytic,
     /// Each decision of the effects planner reversed.
@@ -66,6 +69,7 @@ impl Knob {
         Knob::Direct,
         Knob::Clamp,
         Knob::Adaptive,
+        Knob::Denoise,
         Knob::Analytic,
         Knob::Effects,
         Knob::Intersector,
@@ -84,6 +88,7 @@ impl Knob {
             Knob::Direct => "direct",
             Knob::Clamp => "clamp",
             Knob::Adaptive => "adaptive",
+            Knob::Denoise => "denoise",
             Knob::Analytic => "analytic",
             Knob::Effects => "effects",
             Knob::Intersector => "intersector",
@@ -116,6 +121,9 @@ impl Knob {
             Knob::Clamp => "how much bias does clamping indirect light add for the variance it removes?",
             Knob::Adaptive => {
                 "does sampling until each pixel meets a noise target beat the same samples everywhere, at equal time?"
+            }
+            Knob::Denoise => {
+                "does the denoiser lower the error at equal time, and how much bias does it trade for the noise?"
             }
             Knob::Analytic => {
                 "is any estimator (sampler, direct-light strategy, roulette) biased against an answer known exactly?"
@@ -196,6 +204,7 @@ pub(crate) fn run(
         Knob::Direct => direct::run(subject, options, report, progress),
         Knob::Clamp => clamp::run(subject, options, report, progress),
         Knob::Adaptive => adaptive::run(subject, options, report, progress),
+        Knob::Denoise => denoise::run(subject, options, report, progress),
         Knob::Analytic => analytic::run(options, report, progress),
         Knob::Effects => effects::run(subject, options, report, progress),
         Knob::Intersector => intersector::run(subject, options, report, progress),

@@ -1,0 +1,109 @@
+//! `denoise`: the edge-avoiding denoiser (`rtgi render --denoise`, on by
+//! default for PNG output) against the samples' mean. Both are measured at
+//! the same sample counts, the denoised renders' time including their
+//! guides and the filter, and compared in error against time and at equal
+//! time. The filter trades variance for bias (blur, and the fireflies it
+//! takes out): the squared bias over the seeds shows how much.
+
+use rtgi_render::RenderSettings;
+
+use crate::panel::{Entry, Panel};
+use crate::plot::{Curve, Plot};
+use crate::reference::reference;
+use crate::report::{Report, Series, Table, format_ms, measurement_cells, measurement_header};
+use crate::runner::{equal_time, measure_with, ms_per_sample, render, render_denoised, time_and_error};
+use crate::verdict::{Spread, compare};
+use crate::{ExperimentError, Options, Steps, Subject};
+
+/// How an image is made: a render, or a render and the filter (its time in ms too).
+type MakeImage = fn(&Subject, &RenderSettings) -> (rtgi_image::HdrImage, f64);
+
+/// The sample count whose denoised render sets the equal-time budget.
+const BUDGET_SPP: u32 = 16;
+
+pub(super) fn run(
+    subject: &Subject,
+    options: &Options,
+    mut report: Report,
+    progress: &dyn Fn(&str),
+) -> Result<Report, ExperimentError> {
+    super::require_light_transport(subject, "denoise")?;
+    let counts: &[u32] = if options.quick { &[1, 4] } else { &[1, 4, 16, 64] };
+    let budget_spp = if options.quick { 4 } else { BUDGET_SPP };
+    let base = RenderSettings { adaptive: None, ..subject.settings.clone() };
+    let mut steps = Steps::new(2 + 2 * counts.len(), progress);
+    steps.next("reference");
+    let reference = reference(subject, &base, options.reference_spp(), options.cache.as_deref(), progress)?;
+    let mut table = Table {
+        title: "the samples' mean and the denoised image, at each sample count (denoised times include the \
+                guides and the filter)"
+            .to_owned(),
+        header: measurement_header(&["image", "spp"]),
+        rows: Vec::new(),
+    };
+    let kinds: [(&str, MakeImage); 2] = [("mean of the samples", render), ("denoised", render_denoised)];
+    let mut curves = Vec::new();
+    for (name, make) in kinds {
+        let mut series = Series { name: name.to_owned(), points: Vec::new() };
+        for &spp in counts {
+            steps.next(&format!("{name} at {spp} spp"));
+            let settings = RenderSettings { samples_per_pixel: spp, ..base.clone() };
+            let point = measure_with(subject, &settings, options, &reference, make);
+            let mut row = vec![name.to_owned(), spp.to_string()];
+            row.extend(measurement_cells(&point));
+            table.rows.push(row);
+            series.points.push(point);
+        }
+        curves.push(Curve::error_against_time(name, &time_and_error(&series)));
+        report.series.push(series);
+    }
+    // The most efficient of each, compared.
+    let best = |series: &Series| {
+        series
+            .points
+            .iter()
+            .filter_map(|p| Some((Spread::efficiency(p)?, p.label.clone())))
+            .max_by(|a, b| a.0.value.total_cmp(&b.0.value))
+    };
+    if let (Some((raw, raw_label)), Some((clean, clean_label))) = (best(&report.series[0]), best(&report.series[1])) {
+        report.findings.push(compare(
+            "efficiency 1/(MSE·time)",
+            &format!("the most efficient denoised render ({clean_label} spp)"),
+            &clean,
+            &format!("the most efficient mean of the samples ({raw_label} spp)"),
+            &raw,
+        ));
+    }
+    report.plots.push(Plot::error_against_time(
+        "denoise-tradeoff.svg",
+        "RMSE against render time: the samples' mean and the denoised image".to_owned(),
+        curves,
+    ));
+
+    // Equal time: the denoised render at the budget's count sets the time;
+    // the mean of the samples gets as many samples as fit it.
+    let at = |series: &Series| series.points.iter().find(|p| p.x == budget_spp as f64).cloned();
+    if let (Some(raw), Some(clean)) = (at(&report.series[0]), at(&report.series[1])) {
+        steps.next("equal-time panel");
+        let budget = clean.time.expect("measured").median_ms;
+        let configuration = (
+            "mean of the samples".to_owned(),
+            RenderSettings { samples_per_pixel: budget_spp, ..base.clone() },
+            ms_per_sample(&raw, budget_spp),
+        );
+        let mut entries = equal_time(subject, &reference, &[configuration], budget);
+        let settings = RenderSettings { samples_per_pixel: budget_spp, seed: 0, ..base.clone() };
+        for (label, make) in kinds.iter().rev() {
+            let (image, time_ms) = make(subject, &settings);
+            let rmse = rtgi_image::compare(&image, &reference.image).expect("same size").rmse;
+            entries.push(Entry { label: format!("{label}, {budget_spp} spp"), image, time_ms, rmse });
+        }
+        let title = format!("The samples' mean and the denoised image at equal time ({} ms)", format_ms(budget));
+        let panel = Panel::new("denoise-equal-time.png", title, reference.image.clone(), entries);
+        report.findings.push(panel.caption());
+        report.panels.push(panel);
+    }
+    report.tables.push(table);
+    report.reference = Some(reference.info);
+    Ok(report)
+}
