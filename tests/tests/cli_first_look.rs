@@ -86,7 +86,7 @@ fn a_wrong_aov_name_lists_the_aovs() {
     assert_eq!(run.code, Some(2), "{run:?}");
     assert_eq!(
         run.stderr.trim(),
-        "error: invalid value 'normals' for '--aov <AOV>' (possible values: albedo, normal, depth, position, cost); \
+        "error: invalid value 'normals' for '--aov <AOV>' (possible values: albedo, normal, depth, position, emission, cost); \
          did you mean 'normal'?",
         "{run:?}"
     );
