@@ -22,6 +22,11 @@ const ROOM_CORNER_INSET: f32 = 0.08;
 const ROOM_CAMERA_HEIGHT: f32 = 0.6;
 const ROOM_TARGET_HEIGHT: f32 = 0.2;
 
+/// How much more surface detail the back of a one-material model must show
+/// than its front for the back to be the side shown (see [`frame_scene`]):
+/// scans are roughly symmetric, and +Z is the usual front.
+const BACK_DETAIL_MARGIN: f32 = 1.3;
+
 /// The part of the frame the model's bounds fill, across the narrower side.
 const FILL: f32 = 0.9;
 
@@ -69,6 +74,12 @@ pub fn default_camera<A: Accel + ?Sized>(scene: &Scene, accel: &A, aspect: f32) 
 ///   upper corner of the bounds, a little inside, looking down across the
 ///   middle of the floor (a room as a photographer shows it).
 ///
+/// A model of one material (a scan: a statue, an animal) is shown from
+/// its back instead when the back shows clearly more surface detail
+/// ([`BACK_DETAIL_MARGIN`]): its face, hands and folds are the detail, and
+/// scans do not agree on which way they face. Models of several materials
+/// are judged by the materials each side shows, like every other candidate.
+///
 /// A grid of probe rays counts the distinct materials each view shows; a
 /// view whose rays mostly hit back faces or start against a surface is
 /// inside geometry ([`camera_blocked`]) and is passed over. The view that
@@ -87,6 +98,7 @@ pub fn frame_scene<A: Accel + ?Sized>(scene: &Scene, accel: &A, vertical_fov: f3
     let along_room = if extent.x > extent.z { -Vec3::X } else { -Vec3::Z };
     let inside = Camera::look_at(centre, centre + along_room, Vec3::Y, vertical_fov);
     let product = framed_tightly(scene, &three_quarter_view(&bounds, vertical_fov, aspect), aspect);
+    let product = front_or_back(scene, accel, product, vertical_fov, aspect);
     // A room closed on all sides is seen from a corner; an open courtyard
     // keeps the views that show its sky.
     let enclosed = crate::sky_visibility(accel, centre) < crate::ENCLOSED;
@@ -122,6 +134,30 @@ fn room_corner_views(bounds: &Aabb, vertical_fov: f32) -> [Camera; 4] {
 
 /// The three-quarter view of `bounds` (see [`frame_scene`]).
 pub fn three_quarter_view(bounds: &Aabb, vertical_fov: f32, aspect: f32) -> Camera {
+    three_quarter_view_from(bounds, vertical_fov, aspect, 1.0)
+}
+
+/// The product shot of a model `scene`, or the same shot from its back
+/// (the view turned 180 degrees about the vertical through the model's
+/// centre): whichever shows more, by the materials in view, and for a model
+/// of one material by its surface detail.
+fn front_or_back<A: Accel + ?Sized>(scene: &Scene, accel: &A, front: Camera, vertical_fov: f32, aspect: f32) -> Camera {
+    let back = framed_tightly(scene, &three_quarter_view_from(&scene.bounds(), vertical_fov, aspect, -1.0), aspect);
+    if camera_blocked(scene, accel, &back, aspect).is_some() {
+        return front;
+    }
+    let (front_materials, back_materials) =
+        (materials_shown(scene, accel, &front, aspect), materials_shown(scene, accel, &back, aspect));
+    if back_materials != front_materials || scene.materials.len() > 1 {
+        return if back_materials > front_materials { back } else { front };
+    }
+    let (front_detail, back_detail) =
+        (detail_shown(scene, accel, &front, aspect), detail_shown(scene, accel, &back, aspect));
+    if back_detail > BACK_DETAIL_MARGIN * front_detail { back } else { front }
+}
+
+/// [`three_quarter_view`] from the model's front (`facing` 1) or back (`facing` −1).
+fn three_quarter_view_from(bounds: &Aabb, vertical_fov: f32, aspect: f32, facing: f32) -> Camera {
     let (centre, extent) = if bounds.is_empty() {
         (Vec3::ZERO, Vec3::ONE)
     } else {
@@ -129,7 +165,7 @@ pub fn three_quarter_view(bounds: &Aabb, vertical_fov: f32, aspect: f32) -> Came
     };
     let (azimuth, elevation) = (THREE_QUARTER_AZIMUTH.to_radians(), THREE_QUARTER_ELEVATION.to_radians());
     // Long along Z: its side is its face.
-    let front = if extent.z > 1.5 * extent.x { Vec3::X } else { Vec3::Z };
+    let front = facing * if extent.z > 1.5 * extent.x { Vec3::X } else { Vec3::Z };
     let side = Vec3::Y.cross(front);
     let horizontal = front * azimuth.cos() + side * azimuth.sin();
     let towards_camera = horizontal * elevation.cos() + Vec3::Y * elevation.sin();
@@ -227,6 +263,36 @@ pub fn camera_blocked<A: Accel + ?Sized>(scene: &Scene, accel: &A, camera: &Came
     (fraction > 0.5).then_some(fraction)
 }
 
+/// The surface detail a view shows: over the pairs of neighbouring probe
+/// rays that both hit, how much their surfaces' normals differ (1 − |cos|
+/// of their angle, summed). Smooth backs and flat walls show little; faces,
+/// hands and folds much.
+fn detail_shown<A: Accel + ?Sized>(scene: &Scene, accel: &A, camera: &Camera, aspect: f32) -> f32 {
+    let (width, height) = probe_grid(aspect);
+    let normals: Vec<Option<Vec3>> = probe_rays(camera, aspect)
+        .iter()
+        .map(|ray| {
+            let hit = accel.intersect(ray)?;
+            let triangle = &scene.triangles[hit.triangle as usize];
+            let [a, b, c] = triangle.vertices.map(|v| scene.vertices[v as usize].position);
+            (b - a).cross(c - a).try_normalize()
+        })
+        .collect();
+    let at = |x: u32, y: u32| normals[(y * width + x) as usize];
+    let mut detail = 0.0;
+    for y in 0..height {
+        for x in 0..width {
+            let Some(n) = at(x, y) else { continue };
+            for (nx, ny) in [(x + 1, y), (x, y + 1)] {
+                if let Some(m) = (nx < width && ny < height).then(|| at(nx, ny)).flatten() {
+                    detail += 1.0 - n.dot(m).abs();
+                }
+            }
+        }
+    }
+    detail
+}
+
 /// How many materials cover at least two of the probe rays' hits.
 fn materials_shown<A: Accel + ?Sized>(scene: &Scene, accel: &A, camera: &Camera, aspect: f32) -> usize {
     let mut hits_per_material = vec![0u32; scene.materials.len()];
@@ -241,10 +307,15 @@ fn materials_shown<A: Accel + ?Sized>(scene: &Scene, accel: &A, camera: &Camera,
 /// The probe rays of a view: one through the centre of each pixel of a
 /// grid [`PROBE_RESOLUTION`] high, as wide as the aspect asks (up to four times).
 fn probe_rays(camera: &Camera, aspect: f32) -> Vec<rtgi_math::Ray> {
-    let height = PROBE_RESOLUTION;
-    let width = ((PROBE_RESOLUTION as f32 * aspect).round() as u32).clamp(1, 4 * PROBE_RESOLUTION);
+    let (width, height) = probe_grid(aspect);
     let rays = CameraRays::new(camera, width, height);
     (0..height).flat_map(|y| (0..width).map(move |x| (x, y))).map(|(x, y)| rays.ray(x, y, Vec2::splat(0.5))).collect()
+}
+
+/// The probe grid's width and height for an image of `aspect`.
+fn probe_grid(aspect: f32) -> (u32, u32) {
+    let width = ((PROBE_RESOLUTION as f32 * aspect).round() as u32).clamp(1, 4 * PROBE_RESOLUTION);
+    (width, PROBE_RESOLUTION)
 }
 
 #[cfg(test)]
@@ -359,6 +430,64 @@ mod tests {
                 // The room light hangs inside the room, between the floor in view and the ceiling.
                 let lamp = crate::room_light(&scene, accel.as_ref(), &camera).position;
                 assert!(bounds.contains_point(lamp) && lamp.y > 1.0 && lamp.y < 3.0, "{lamp}");
+            }
+        }
+    }
+
+    /// A "statue" of one material, 2 × 3 × 1, facing −Z: the box's back
+    /// (+Z) is flat, its front (`detailed`) covered in small pyramids, as a
+    /// face, hands and folds cover a scan's front.
+    fn statue(detailed: bool) -> Scene {
+        let mut obj = String::new();
+        let (min, max) = (Vec3::new(-1.0, 0.0, -0.5), Vec3::new(1.0, 3.0, 0.5));
+        for i in 0..8 {
+            let pick = |bit: u32, lo: f32, hi: f32| if i & bit == 0 { lo } else { hi };
+            obj.push_str(&format!("v {} {} {}\n", pick(1, min.x, max.x), pick(2, min.y, max.y), pick(4, min.z, max.z)));
+        }
+        let faces = [[1, 5, 7, 3], [2, 4, 8, 6], [1, 2, 6, 5], [3, 7, 8, 4], [1, 3, 4, 2], [5, 6, 8, 7]];
+        for (index, face) in faces.iter().enumerate() {
+            if !(detailed && index == 4) {
+                obj.push_str(&format!("f {} {} {} {}\n", face[0], face[1], face[2], face[3]));
+            }
+        }
+        if detailed {
+            let mut next = 9;
+            let (columns, rows) = (8, 12);
+            for column in 0..columns {
+                for row in 0..rows {
+                    let x = |k: u32| min.x + (max.x - min.x) * k as f32 / columns as f32;
+                    let y = |k: u32| min.y + (max.y - min.y) * k as f32 / rows as f32;
+                    let corners = [(column, row), (column, row + 1), (column + 1, row + 1), (column + 1, row)];
+                    for (cx, cy) in corners {
+                        obj.push_str(&format!("v {} {} {}\n", x(cx), y(cy), min.z));
+                    }
+                    let apex = Vec3::new(0.5 * (x(column) + x(column + 1)), 0.5 * (y(row) + y(row + 1)), min.z - 0.12);
+                    obj.push_str(&format!("v {} {} {}\n", apex.x, apex.y, apex.z));
+                    // Wound to face −Z, outwards.
+                    for k in 0..4 {
+                        obj.push_str(&format!("f {} {} {}\n", next + k, next + (k + 1) % 4, next + 4));
+                    }
+                    next += 5;
+                }
+            }
+        }
+        Scene::load_from_bytes("statue.obj", obj.as_bytes(), &|_| None).expect("the statue loads")
+    }
+
+    #[test]
+    fn a_scan_is_seen_from_the_side_with_its_detail_and_a_plain_one_from_the_front() {
+        use rtgi_accel::{AccelKind, BuildParams};
+        for detailed in [true, false] {
+            let scene = statue(detailed);
+            assert_eq!(scene.materials.len(), 1);
+            let accel = AccelKind::Sah.build(&scene.triangle_positions(), &BuildParams::default());
+            let camera = frame_scene(&scene, accel.as_ref(), 40f32.to_radians(), 1.0);
+            let offset = camera.position - scene.bounds().centroid();
+            assert!(offset.y > 0.0 && offset.x.abs() > 0.1, "a three-quarter view from above: {offset}");
+            if detailed {
+                assert!(offset.z < 0.0, "the detailed front faces -Z, the camera is at {offset}");
+            } else {
+                assert!(offset.z > 0.0, "a plain block is seen from +Z, the camera is at {offset}");
             }
         }
     }
