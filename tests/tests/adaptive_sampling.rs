@@ -277,7 +277,8 @@ fn the_denoised_cornell_box_is_closer_to_the_converged_one_at_every_sample_count
     let mut previous = f64::INFINITY;
     for spp in [4u32, 16, 64] {
         let settings = settings(CORNELL_SIZE, spp, 3);
-        let (clean, raw) = render_denoised(scene, accel.as_ref(), camera, &settings, &DenoiseSettings::default());
+        let denoise = DenoiseSettings::for_samples(spp);
+        let (clean, raw) = render_denoised(scene, accel.as_ref(), camera, &settings, &denoise);
         let guides = Guides::render(scene, accel.as_ref(), camera, &settings);
         let inside = interior(&guides);
         let (raw_inside, clean_inside) =

@@ -266,7 +266,8 @@ pub(crate) fn render_given(args: &RenderArgs, given: Option<Given<'_>>) -> Resul
         Some(raw) if denoising => {
             let started = Instant::now();
             let guides = pool.install(|| Guides::render(&scene, accel.as_ref(), &camera, &settings));
-            let clean = pool.install(|| denoise(&raw, half_image.as_ref(), &guides, &DenoiseSettings::default()))?;
+            let denoise_settings = DenoiseSettings::for_samples(done);
+            let clean = pool.install(|| denoise(&raw, half_image.as_ref(), &guides, &denoise_settings))?;
             denoise_ms = Some(started.elapsed().as_secs_f64() * 1e3);
             Some(clean)
         }

@@ -27,7 +27,7 @@ pub(crate) fn render_with(subject: &Subject, accel: &dyn Accel, settings: &Rende
 /// the image and the time of the render, its guides and the filter in ms.
 pub(crate) fn render_denoised(subject: &Subject, settings: &RenderSettings) -> (HdrImage, f64) {
     let start = Instant::now();
-    let denoise = rtgi_render::DenoiseSettings::default();
+    let denoise = rtgi_render::DenoiseSettings::for_samples(settings.samples_per_pixel);
     let (clean, _) =
         rtgi_render::render_denoised(&subject.scene, subject.accel.as_ref(), &subject.camera, settings, &denoise);
     (clean, start.elapsed().as_secs_f64() * 1e3)

@@ -76,7 +76,7 @@ pub fn default_camera<A: Accel + ?Sized>(scene: &Scene, accel: &A, aspect: f32) 
 ///
 /// A model of one material (a scan: a statue, an animal) is shown from
 /// its back instead when the back shows clearly more surface detail
-/// ([`BACK_DETAIL_MARGIN`]): its face, hands and folds are the detail, and
+/// (1.3 times as much): its face, hands and folds are the detail, and
 /// scans do not agree on which way they face. Models of several materials
 /// are judged by the materials each side shows, like every other candidate.
 ///

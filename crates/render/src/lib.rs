@@ -58,7 +58,9 @@ pub use adaptive::{AdaptiveSampling, render_adaptive};
 pub use bounce_sampling::BounceSampling;
 pub use camera::CameraRays;
 pub use default_lighting::{ENCLOSED, default_sky, default_sun, room_light, sky_visibility};
-pub use denoise::{DenoiseError, DenoiseSettings, GUIDE_SAMPLES, Guides, denoise, render_denoised};
+pub use denoise::{
+    DenoiseError, DenoiseSettings, FIREFLY_FROM_SAMPLES, GUIDE_SAMPLES, Guides, denoise, render_denoised,
+};
 pub use distribution::Distribution1D;
 pub use effect_set::EffectSet;
 pub use effects::{Effect, EffectOverrides, EffectPlan, PlannedEffect, Reversal};
