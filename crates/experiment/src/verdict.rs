@@ -34,6 +34,11 @@ impl Spread {
         })
     }
 
+    /// The point of `points` with the highest [`Spread::efficiency`], and that efficiency.
+    pub fn most_efficient(points: &[Point]) -> Option<(Spread, &Point)> {
+        points.iter().filter_map(|p| Some((Spread::efficiency(p)?, p))).max_by(|a, b| a.0.value.total_cmp(&b.0.value))
+    }
+
     /// Whether the two ranges do not overlap.
     pub fn resolved_from(&self, other: &Spread) -> bool {
         self.high < other.low || other.high < self.low

@@ -95,9 +95,12 @@ impl DenoiseSettings {
     /// samples: the defaults; below [`FIREFLY_FROM_SAMPLES`], fireflies kept
     /// and the brightness tolerance widened by `sqrt(16 / spp)`.
     pub fn for_samples(samples_per_pixel: u32) -> Self {
-        let firefly = if samples_per_pixel >= FIREFLY_FROM_SAMPLES { 2.0 } else { f32::INFINITY };
-        let few = (FIREFLY_FROM_SAMPLES as f32 / samples_per_pixel.max(1) as f32).sqrt().max(1.0);
-        Self { firefly, luminance: Self::default().luminance * few, ..Self::default() }
+        let defaults = Self::default();
+        if samples_per_pixel >= FIREFLY_FROM_SAMPLES {
+            return defaults;
+        }
+        let few = (FIREFLY_FROM_SAMPLES as f32 / samples_per_pixel.max(1) as f32).sqrt();
+        Self { firefly: f32::INFINITY, luminance: defaults.luminance * few, ..defaults }
     }
 }
 
@@ -317,36 +320,24 @@ pub fn denoise(
     // else from its neighbourhood's spread (which counts the image's own
     // detail as noise too, and so blurs more).
     let brightness: Vec<f32> = light.iter().map(|c| luminance(*c)).collect();
-    let single: Vec<f32> = match half {
+    let mut variance: Vec<f32> = match half {
         Some(half) => {
             // The mean of all samples is the average of two independent
             // halves A and B, so its variance is about (A − B)² / 4 = (A − mean)².
-            (0..w * h)
-                .map(|i| luminance((sanitised(half.pixels()[i]) - image.pixels()[i]) / modulation[i]).powi(2))
-                .collect()
+            // One pixel's (A − mean)² is itself noisy: averaged over its neighbourhood.
+            let single: Vec<f32> = (0..w * h)
+                .map(|i| {
+                    luminance((sanitised(half.pixels()[i]) - sanitised(image.pixels()[i])) / modulation[i]).powi(2)
+                })
+                .collect();
+            neighbourhood_mean(&single, w, h)
         }
-        None => vec![0.0; w * h],
+        None => {
+            let squares: Vec<f32> = brightness.iter().map(|b| b * b).collect();
+            let (mean, mean_square) = (neighbourhood_mean(&brightness, w, h), neighbourhood_mean(&squares, w, h));
+            mean.iter().zip(&mean_square).map(|(m, m2)| (m2 - m * m).max(0.0)).collect()
+        }
     };
-    let mut variance: Vec<f32> = (0..w * h)
-        .into_par_iter()
-        .map(|i| {
-            let (x, y) = (i % w, i / w);
-            let (mut n, mut sum, mut squares, mut noise) = (0f32, 0f32, 0f32, 0f32);
-            for j in neighbours(x, y, w, h, 1) {
-                n += 1.0;
-                sum += brightness[j];
-                squares += brightness[j] * brightness[j];
-                noise += single[j];
-            }
-            if half.is_some() {
-                // One pixel's (A − mean)² is itself noisy: averaged over its neighbourhood.
-                noise / n
-            } else {
-                let mean = sum / n;
-                (squares / n - mean * mean).max(0.0)
-            }
-        })
-        .collect();
     for pass in 0..settings.passes {
         let step = 1usize << pass;
         let brightness: Vec<f32> = light.iter().map(|c| luminance(*c)).collect();
@@ -417,6 +408,18 @@ fn agreement(a: &Texel, b: &Texel, gap: f32, settings: &DenoiseSettings) -> f32 
     let depth_tolerance = settings.depth * a.slope * gap + 1e-3 * a.depth.abs();
     let depth_difference = (a.depth - b.depth).abs() / depth_tolerance.max(f32::MIN_POSITIVE);
     normal * (-(albedo_difference * albedo_difference) - depth_difference).exp()
+}
+
+/// Each pixel's mean of `values` over its 3 × 3 neighbourhood (fewer at the image's edges).
+fn neighbourhood_mean(values: &[f32], w: usize, h: usize) -> Vec<f32> {
+    (0..w * h)
+        .into_par_iter()
+        .map(|i| {
+            let (sum, n) =
+                neighbours(i % w, i / w, w, h, 1).fold((0f32, 0f32), |(sum, n), j| (sum + values[j], n + 1.0));
+            sum / n
+        })
+        .collect()
 }
 
 /// The indices of the pixels within `radius` of (x, y), the pixel's own included.

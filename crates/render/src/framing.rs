@@ -274,8 +274,8 @@ fn detail_shown<A: Accel + ?Sized>(scene: &Scene, accel: &A, camera: &Camera, as
         .map(|ray| {
             let hit = accel.intersect(ray)?;
             let triangle = &scene.triangles[hit.triangle as usize];
-            let [a, b, c] = triangle.vertices.map(|v| scene.vertices[v as usize].position);
-            (b - a).cross(c - a).try_normalize()
+            let normal = rtgi_math::geometric_normal(&triangle.vertices.map(|v| scene.vertices[v as usize].position));
+            (normal != Vec3::ZERO).then_some(normal)
         })
         .collect();
     let at = |x: u32, y: u32| normals[(y * width + x) as usize];

@@ -80,12 +80,7 @@ pub(super) fn run(
             .series
             .iter()
             .find(|s| s.name == name)
-            .and_then(|s| {
-                s.points
-                    .iter()
-                    .filter_map(|p| Some((Spread::efficiency(p)?, p)))
-                    .max_by(|a, b| a.0.value.total_cmp(&b.0.value))
-            })
+            .and_then(|s| Spread::most_efficient(&s.points))
             .map(|(spread, p)| (spread, p.label.clone()))
     };
     let fixed = best(&format!("{}, every pixel alike", PixelSampler::Stratified));

@@ -58,13 +58,7 @@ pub(super) fn run(
         report.series.push(series);
     }
     // The most efficient of each, compared.
-    let best = |series: &Series| {
-        series
-            .points
-            .iter()
-            .filter_map(|p| Some((Spread::efficiency(p)?, p.label.clone())))
-            .max_by(|a, b| a.0.value.total_cmp(&b.0.value))
-    };
+    let best = |series: &Series| Spread::most_efficient(&series.points).map(|(spread, p)| (spread, p.label.clone()));
     if let (Some((raw, raw_label)), Some((clean, clean_label))) = (best(&report.series[0]), best(&report.series[1])) {
         report.findings.push(compare(
             "efficiency 1/(MSE·time)",
