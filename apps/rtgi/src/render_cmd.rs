@@ -267,7 +267,10 @@ pub(crate) fn render_given(args: &RenderArgs, given: Option<Given<'_>>) -> Resul
             let started = Instant::now();
             let guides = pool.install(|| Guides::render(&scene, accel.as_ref(), &camera, &settings));
             let denoise_settings = DenoiseSettings::for_samples(done);
-            let clean = pool.install(|| denoise(&raw, half_image.as_ref(), &guides, &denoise_settings))?;
+            // The half image tells the noise only as the first of two equal
+            // halves: a render stopped early (time limit, signal) has fewer.
+            let half = half_image.as_ref().filter(|_| done == spp);
+            let clean = pool.install(|| denoise(&raw, half, &guides, &denoise_settings))?;
             denoise_ms = Some(started.elapsed().as_secs_f64() * 1e3);
             Some(clean)
         }
