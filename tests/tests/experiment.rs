@@ -40,6 +40,7 @@ fn every_knob_writes_its_table_json_and_plots() {
         "packets",
         "direct",
         "clamp",
+        "filter-glossy",
         "adaptive",
         "denoise",
         "analytic",
@@ -127,6 +128,7 @@ fn every_knob_writes_its_table_json_and_plots() {
         ("spp", "spp-equal-time.png"),
         ("depth", "depth-equal-time.png"),
         ("clamp", "clamp-equal-time.png"),
+        ("filter-glossy", "filter-glossy-equal-time.png"),
         ("adaptive", "adaptive-equal-time.png"),
         ("direct", "direct-small-light-equal-time.png"),
     ] {

@@ -285,6 +285,14 @@ pub(crate) struct LightingArgs {
     #[arg(long, visible_alias = "clamp", value_parser = parse_positive, allow_negative_numbers = true)]
     pub(crate) clamp_indirect: Option<f32>,
 
+    /// Path regularisation, as Cycles' "filter glossy": after a bounce sampled with a density
+    /// below this value (diffuse bounces: about 0.3 and less), mirrors, glass and sharp highlights
+    /// are widened (to a GGX width of up to 0.5), so caustics and highlights seen through diffuse
+    /// bounces are found by light sampling instead of as fireflies; biased (blurrier caustics).
+    /// 0 turns it off [default: off]
+    #[arg(long, value_parser = parse_non_negative)]
+    pub(crate) filter_glossy: Option<f32>,
+
     /// Light from far away: a radiance R,G,B, an equirectangular .exr image or a .floats sky of
     /// the course framework
     #[arg(long, value_parser = parse_environment, allow_hyphen_values = true)]
@@ -323,6 +331,10 @@ fn parse_number(text: &str, accept: impl Fn(f32) -> bool, allowed: &str) -> Resu
 
 fn parse_positive(text: &str) -> Result<f32, String> {
     parse_number(text, |v| v > 0.0, "a finite number greater than 0")
+}
+
+fn parse_non_negative(text: &str) -> Result<f32, String> {
+    parse_number(text, |v| v >= 0.0, "a finite number of at least 0")
 }
 
 /// Exposure in stops: 2^±64 already turns any radiance black or white.

@@ -97,6 +97,7 @@ impl LightingArgs {
             bounce_sampling: self.bounce_sampling,
             direct_strategy: self.direct_strategy,
             indirect_clamp: self.clamp_indirect,
+            filter_glossy: self.filter_glossy.filter(|&v| v > 0.0),
             environment: self.environment.clone(),
             environment_scale: self.environment_scale,
             effects: self.effects.clone(),
@@ -122,6 +123,14 @@ impl Phrasing {
         }
     }
 
+    /// How to keep +Y up.
+    pub(crate) fn up_y(self) -> &'static str {
+        match self {
+            Phrasing::Options => "--up 0,1,0",
+            Phrasing::Script => "the camera's up (0 1 0)",
+        }
+    }
+
     /// How to add light.
     pub(crate) fn add_light(self) -> &'static str {
         match self {
@@ -136,6 +145,16 @@ impl Phrasing {
 pub(crate) fn report_camera(chosen: &ChosenCamera, phrasing: Phrasing) {
     if let Some(choice) = &chosen.file_choice {
         eprintln!("note: the view is {choice}");
+    }
+    if let Some(share) = chosen.up.base_share {
+        eprintln!(
+            "note: {} is up: the model stands on a flat base facing {} ({:.1}% of its surface) and has none across \
+             Y, so the view, the default sky and the sun turn with it; {} keeps +Y",
+            chosen.up.name(),
+            rtgi_render::up_axis::axis_name(-chosen.up.up),
+            100.0 * share,
+            phrasing.up_y()
+        );
     }
     if let Some(fraction) = chosen.blocked {
         eprintln!(

@@ -30,6 +30,8 @@ const GLOSSY: &str = "project:direct-glossy.toml";
 /// The project's closed room lit only by light bounced off its ceiling:
 /// transport noise, with no emitter in view.
 const ROOM: &str = "project:indirect-room.toml";
+/// The project's Cornell box with a glass and a mirror sphere: caustics.
+const CAUSTICS: &str = "project:caustics.toml";
 
 /// The scenes each knob is measured on in the report: the Cornell box
 /// (small, closed, converges; its error at high spp is mostly the
@@ -43,6 +45,7 @@ fn report_scenes(knob: Knob) -> &'static [&'static str] {
         Knob::Spp => &[CORNELL, BUNNY, ROOM, GLOSSY],
         Knob::Depth => &[CORNELL, SPONZA],
         Knob::Clamp => &[CORNELL, ROOM, CONFERENCE],
+        Knob::FilterGlossy => &[CAUSTICS, CONFERENCE, SPONZA],
         Knob::Adaptive => &[CORNELL, ROOM],
         Knob::Denoise => &[CORNELL, SPONZA, CONFERENCE],
         Knob::Accel => &[CORNELL, BUNNY, SPONZA, CONFERENCE],

@@ -111,13 +111,15 @@ fn key(subject: &Subject, settings: &RenderSettings) -> String {
 /// The settings that change what a render converges to (not its noise).
 pub(crate) fn describe(settings: &RenderSettings) -> String {
     format!(
-        "{}x{} {} depth {} background {:?} clamp {:?} environment {:?} effects {:?}",
+        "{}x{} {} depth {} background {:?} clamp {:?} filter glossy {:?} up {:?} environment {:?} effects {:?}",
         settings.width,
         settings.height,
         settings.integrator,
         settings.max_depth,
         settings.background,
         settings.indirect_clamp,
+        settings.filter_glossy,
+        settings.up,
         settings.environment.as_ref().map(|e| match e {
             rtgi_render::Environment::Uniform(radiance) => format!("uniform {radiance:?}"),
             rtgi_render::Environment::Map(_) => format!("map of mean {:?}", e.mean_radiance()),

@@ -226,7 +226,13 @@ impl Bsdf {
                 }
                 let lobe = rough_dielectric(wo, wi, ior, alpha)?;
                 let value = self.eval(wo, wi);
-                return (lobe.pdf > 0.0).then_some(BsdfSample { wi, value, pdf: lobe.pdf, delta: false, eta: lobe.eta });
+                return (lobe.pdf > 0.0).then_some(BsdfSample {
+                    wi,
+                    value,
+                    pdf: lobe.pdf,
+                    delta: false,
+                    eta: lobe.eta,
+                });
             }
             Bsdf::RoughThinDielectric { ior, alpha, .. } => {
                 // Reflect or transmit with the sheet's reflectance at the
@@ -544,7 +550,9 @@ impl Bsdf {
             }
             Bsdf::Dielectric { ior, tint } => Bsdf::RoughDielectric { ior, tint, alpha },
             Bsdf::ThinDielectric { ior, tint } => Bsdf::RoughThinDielectric { ior, tint, alpha },
-            Bsdf::RoughDielectric { ior, tint, alpha: own } => Bsdf::RoughDielectric { ior, tint, alpha: own.max(alpha) },
+            Bsdf::RoughDielectric { ior, tint, alpha: own } => {
+                Bsdf::RoughDielectric { ior, tint, alpha: own.max(alpha) }
+            }
             Bsdf::RoughThinDielectric { ior, tint, alpha: own } => {
                 Bsdf::RoughThinDielectric { ior, tint, alpha: own.max(alpha) }
             }

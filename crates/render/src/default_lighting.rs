@@ -3,18 +3,23 @@
 //! its shape. A uniform white sky, the earlier default, lights every side
 //! the same and washes a white model out against its background.
 
+use std::borrow::Cow;
 use std::sync::LazyLock;
 
 use rtgi_accel::Accel;
 use rtgi_image::HdrImage;
+use rtgi_math::glam::Quat;
 use rtgi_math::{Ray, Vec3};
 use rtgi_scene::{Camera, Light, LightKind, Scene};
 
+use crate::up_axis::turned_up;
 use crate::{Environment, EnvironmentMap};
 
-/// Texels of the sky's equirectangular image (its gradient is smooth).
-const SKY_WIDTH: u32 = 64;
-const SKY_HEIGHT: u32 = 32;
+/// Texels of the sky's equirectangular image: it varies with elevation
+/// only, and its texels are constant (for exact sampling), so it takes
+/// many rows: with 32, the sky behind a model showed bands 6 degrees apart.
+const SKY_WIDTH: u32 = 16;
+const SKY_HEIGHT: u32 = 512;
 
 /// Radiance straight up, at the horizon, and of the ground below it.
 const ZENITH: Vec3 = Vec3::new(0.32, 0.48, 0.85);
@@ -53,15 +58,21 @@ fn sky_radiance(up: f32) -> Vec3 {
     }
 }
 
-/// The default sky: blue overhead, white at the horizon, grey ground.
-pub fn default_sky() -> &'static Environment {
-    &SKY
+/// The default sky: blue overhead, white at the horizon, grey ground,
+/// overhead being `up` (the model's, [`crate::up_axis`]).
+pub fn default_sky(up: Vec3) -> Cow<'static, Environment> {
+    let turn = turned_up(up);
+    match &*SKY {
+        Environment::Map(map) if turn != Quat::IDENTITY => Cow::Owned(Environment::Map(map.clone().turned(turn))),
+        sky => Cow::Borrowed(sky),
+    }
 }
 
-/// The default sun, a directional light.
-pub fn default_sun() -> Light {
+/// The default sun, a directional light, its elevation measured from `up`.
+pub fn default_sun(up: Vec3) -> Light {
     let (elevation, azimuth) = (SUN_ELEVATION_DEGREES.to_radians(), SUN_AZIMUTH_DEGREES.to_radians());
-    let towards_sun = Vec3::new(azimuth.sin() * elevation.cos(), elevation.sin(), azimuth.cos() * elevation.cos());
+    let towards_sun =
+        turned_up(up) * Vec3::new(azimuth.sin() * elevation.cos(), elevation.sin(), azimuth.cos() * elevation.cos());
     Light {
         name: "default sun".into(),
         kind: LightKind::Directional,
@@ -108,20 +119,20 @@ const ROOM_LIGHT_HEIGHT: f32 = 0.5;
 /// camera looks at is lit directly, not only by bounces. The shade keeps
 /// the ceiling over the lamp dark: a bare bulb close to it made a hot spot
 /// that every bounce off the ceiling turned into a firefly.
-pub fn room_light<A: Accel + ?Sized>(scene: &Scene, accel: &A, camera: &Camera) -> Light {
+pub fn room_light<A: Accel + ?Sized>(scene: &Scene, accel: &A, camera: &Camera, up: Vec3) -> Light {
+    let up_direction = up.try_normalize().unwrap_or(Vec3::Y);
     let size = scene.bounds().extent().length().max(1e-6);
     let view = Ray::new(camera.position, camera.direction);
     let looked_at = accel.intersect(&view).map_or(camera.position + camera.direction, |hit| view.at(hit.t));
     let below = camera.position.lerp(looked_at, 0.5);
-    let up = Ray::new(below, Vec3::Y);
-    let rise = accel.intersect(&up).map_or(0.1 * size, |hit| ROOM_LIGHT_HEIGHT * hit.t);
-    let position = below + Vec3::Y * rise;
+    let rise = accel.intersect(&Ray::new(below, up_direction)).map_or(0.1 * size, |hit| ROOM_LIGHT_HEIGHT * hit.t);
+    let position = below + up_direction * rise;
     let distance = position.distance(looked_at).max(1e-6);
     Light {
         name: "default room light".into(),
         kind: LightKind::Point,
         position,
-        direction: Vec3::NEG_Y,
+        direction: -up_direction,
         color: SUN_COLOUR,
         intensity: std::f32::consts::PI * distance * distance,
         range: None,
@@ -139,7 +150,8 @@ mod tests {
         assert!(luminance(zenith) < 0.7 * luminance(horizon));
         assert!(luminance(ground) < luminance(zenith));
         assert!(zenith.z > zenith.x, "the zenith is blue");
-        let Environment::Map(map) = default_sky() else { panic!("the sky is a map") };
+        let sky = default_sky(Vec3::Y);
+        let Environment::Map(map) = &*sky else { panic!("the sky is a map") };
         let top = map.image().get(0, 0);
         let bottom = map.image().get(0, SKY_HEIGHT - 1);
         assert!(
@@ -149,8 +161,29 @@ mod tests {
 
     #[test]
     fn the_sun_shines_down_from_the_front() {
-        let sun = default_sun();
+        let sun = default_sun(Vec3::Y);
         assert!(sun.direction.y < -0.7 && sun.direction.z < 0.0);
         assert!((sun.direction.length() - 1.0).abs() < 1e-6);
+    }
+
+    #[test]
+    fn sky_and_sun_follow_the_models_up() {
+        // +Z up: the zenith's blue overhead at +Z, the ground below -Z, the
+        // sun high over +Z and in front (-Y, where a Z-up model's front view looks from).
+        let sky = default_sky(Vec3::Z);
+        let luminance = |c: Vec3| c.dot(Vec3::new(0.2126, 0.7152, 0.0722));
+        assert!((sky.radiance(Vec3::Z) - sky_radiance(1.0)).length() < 0.01, "{}", sky.radiance(Vec3::Z));
+        assert!(luminance(sky.radiance(Vec3::NEG_Z)) < luminance(sky.radiance(Vec3::Y)));
+        // The Y-up sky's horizon is +Z up's horizon too where they agree.
+        assert_eq!(sky.radiance(Vec3::X), default_sky(Vec3::Y).radiance(Vec3::X));
+        let sun = default_sun(Vec3::Z);
+        assert!(sun.direction.z < -0.7 && sun.direction.y > 0.0, "{}", sun.direction);
+        // Its sampling density still matches its draws, turned.
+        let mut rng = rtgi_math::Rng::new(1, 2);
+        for _ in 0..200 {
+            let (direction, radiance, pdf) = sky.sample(rtgi_math::Vec2::new(rng.next_f32(), rng.next_f32()));
+            assert!((sky.pdf(direction) - pdf).abs() <= 1e-3 * pdf, "{direction}: {pdf} vs {}", sky.pdf(direction));
+            assert_eq!(sky.radiance(direction), radiance);
+        }
     }
 }

@@ -161,6 +161,9 @@ pub struct EffectPlan {
     /// The clamp on light brought in after two or more bounces
     /// ([`RenderSettings::indirect_clamp`]), when indirect light is simulated.
     pub indirect_clamp: Option<f32>,
+    /// Path regularisation's threshold ([`RenderSettings::filter_glossy`]),
+    /// when indirect light is simulated and some lobe is sharp enough to widen.
+    pub filter_glossy: Option<f32>,
 }
 
 /// The effects whose code the light-transport loop is compiled with or
@@ -522,7 +525,10 @@ impl EffectPlan {
         let default_environment = default_environment && environment;
         let max_depth = if indirect { max_depth } else { max_depth.min(1) };
         let indirect_clamp = settings.indirect_clamp.filter(|_| indirect);
-        Self { integrator, effects, default_environment, max_depth, indirect_clamp }
+        // Only glossy and transmitting lobes can be widened.
+        let sharp_lobes = effects.iter().any(|e| e.enabled && matches!(e.effect, Effect::Glossy | Effect::Refraction));
+        let filter_glossy = settings.filter_glossy.filter(|_| indirect && sharp_lobes);
+        Self { integrator, effects, default_environment, max_depth, indirect_clamp, filter_glossy }
     }
 
     /// The effects the plan simulates.
@@ -604,6 +610,14 @@ impl fmt::Display for EffectPlan {
                 f,
                 "  clamp         light brought in after two or more bounces is clamped at {clamp}: fewer fireflies, \
                  but caustics and glossy highlights come out darker (biased; leave out --clamp for the exact image)"
+            )?;
+        }
+        if let Some(threshold) = self.filter_glossy {
+            writeln!(
+                f,
+                "  filter-glossy after a bounce of density below {threshold}, mirrors, glass and sharp highlights are \
+                 widened: fewer fireflies from caustics, but they come out blurred (biased; leave out \
+                 --filter-glossy for the exact image)"
             )?;
         }
         Ok(())

@@ -6,6 +6,7 @@ use rtgi_math::{Aabb, Vec2, Vec3};
 use rtgi_scene::{Camera, Scene};
 
 use crate::CameraRays;
+use crate::up_axis::{detect_up, turned_up};
 
 /// Probe rays per side of a candidate view.
 const PROBE_RESOLUTION: u32 = 24;
@@ -22,10 +23,14 @@ const ROOM_CORNER_INSET: f32 = 0.08;
 const ROOM_CAMERA_HEIGHT: f32 = 0.6;
 const ROOM_TARGET_HEIGHT: f32 = 0.2;
 
-/// How much more surface detail the back of a one-material model must show
-/// than its front for the back to be the side shown (see [`frame_scene`]):
-/// scans are roughly symmetric, and +Z is the usual front.
-const BACK_DETAIL_MARGIN: f32 = 1.3;
+/// How much more surface detail another side of a one-material model must
+/// show than its front to be the side shown (see [`frame_scene`]): scans
+/// are roughly symmetric, and +Z is the usual front.
+const SIDE_DETAIL_MARGIN: f32 = 1.3;
+
+/// A model whose bounds are at most this fraction of their size thick is
+/// flat, and seen straight on ([`flat_view`]).
+const FLAT_THICKNESS: f32 = 0.01;
 
 /// The part of the frame the model's bounds fill, across the narrower side.
 const FILL: f32 = 0.9;
@@ -63,9 +68,9 @@ pub fn default_camera<A: Accel + ?Sized>(scene: &Scene, accel: &A, aspect: f32) 
 /// - a three-quarter view, like a product shot: from the front (+Z, the
 ///   side glTF models face and scanned models usually do) turned 35
 ///   degrees towards +X and raised 25 degrees, moved until the model's
-///   vertices fill 90% of the frame, centred ([`framed_tightly`]); for a model much longer
-///   along Z than along X (a vehicle facing +X or -X), the same view taken
-///   from its long side;
+///   vertices fill 90% of the frame, centred ([`framed_tightly`]); for a model
+///   of several materials much longer along Z than along X (a vehicle facing
+///   +X or -X), the same view taken from its long side;
 /// - the bounds seen straight from +Z (the classic view into a Cornell box);
 /// - from +Z and 35 degrees above (looking into open courtyards);
 /// - from the bounds' centre, looking along its longer horizontal axis
@@ -74,11 +79,20 @@ pub fn default_camera<A: Accel + ?Sized>(scene: &Scene, accel: &A, aspect: f32) 
 ///   upper corner of the bounds, a little inside, looking down across the
 ///   middle of the floor (a room as a photographer shows it).
 ///
-/// A model of one material (a scan: a statue, an animal) is shown from
-/// its back instead when the back shows clearly more surface detail
-/// (1.3 times as much): its face, hands and folds are the detail, and
-/// scans do not agree on which way they face. Models of several materials
-/// are judged by the materials each side shows, like every other candidate.
+/// The product shot is taken from the side of the model that shows the
+/// most: its back or one of its sides instead of its front when that side
+/// shows clearly more surface detail (1.3 times as much), for a model of
+/// one material (a scan: a statue, an animal): its face, hands and folds
+/// are the detail, and scans do not agree on which way they face. Models of
+/// several materials are judged by the materials each side shows, like
+/// every other candidate.
+///
+/// A flat model (a cut-out, thinner than a hundredth of its size) is seen
+/// straight on instead, from +Z, or from above when it lies flat across Y.
+///
+/// These directions are for a model with +Y up. A model standing on a flat
+/// base across another axis (a Z-up scan or CAD part, [`detect_up`]) gets
+/// them turned with its up ([`frame_scene_up`]).
 ///
 /// A grid of probe rays counts the distinct materials each view shows; a
 /// view whose rays mostly hit back faces or start against a surface is
@@ -87,22 +101,48 @@ pub fn default_camera<A: Accel + ?Sized>(scene: &Scene, accel: &A, aspect: f32) 
 /// product shot while boxes and architecture are seen from where they have
 /// something to show.
 pub fn frame_scene<A: Accel + ?Sized>(scene: &Scene, accel: &A, vertical_fov: f32, aspect: f32) -> Camera {
+    frame_scene_up(scene, accel, vertical_fov, aspect, detect_up(scene).up)
+}
+
+/// [`frame_scene`] for a model whose up is `up` (not judged from its base):
+/// every "above", "side" and "front" of the views turns with it, +Z up
+/// putting the front at −Y ([`crate::up_axis::turned_up`]).
+pub fn frame_scene_up<A: Accel + ?Sized>(scene: &Scene, accel: &A, vertical_fov: f32, aspect: f32, up: Vec3) -> Camera {
+    let axes = Axes::new(up);
     let bounds = scene.bounds();
-    let front = Camera::framing(&bounds, vertical_fov, aspect);
-    let centre = front.position + front.direction;
-    let distance = front.direction.length();
+    if let Some(view) = flat_view(scene, accel, &bounds, vertical_fov, aspect) {
+        return view;
+    }
+    let framing = Camera::framing(&bounds, vertical_fov, aspect);
+    let centre = framing.position + framing.direction;
+    let distance = framing.direction.length();
+    // Built as `Camera::framing` builds its +Z view, so that a +Y-up model's is that view bit for bit.
+    let front = Camera {
+        position: centre + axes.front * distance,
+        direction: Vec3::ZERO - axes.front * distance,
+        up: axes.up,
+        ..framing
+    };
     let elevation = 35f32.to_radians();
-    let above_direction = Vec3::new(0.0, elevation.sin(), elevation.cos());
-    let above = Camera::look_at(centre + distance * above_direction, centre, Vec3::Y, vertical_fov);
-    let extent = bounds.extent();
-    let along_room = if extent.x > extent.z { -Vec3::X } else { -Vec3::Z };
-    let inside = Camera::look_at(centre, centre + along_room, Vec3::Y, vertical_fov);
-    let product = framed_tightly(scene, &three_quarter_view(&bounds, vertical_fov, aspect), aspect);
-    let product = front_or_back(scene, accel, product, vertical_fov, aspect);
+    let above_direction = axes.up * elevation.sin() + axes.front * elevation.cos();
+    let above = Camera::look_at(centre + distance * above_direction, centre, axes.up, vertical_fov);
+    let extent = axes.extent(&bounds);
+    let along_room = if extent.x > extent.z { -axes.side } else { -axes.front };
+    let inside = Camera::look_at(centre, centre + along_room, axes.up, vertical_fov);
+    // Vehicles are long and of many materials: their long side is their
+    // face. A long scan of one material (a bust deep from front to back) is
+    // judged by its detail from every side.
+    let long_side_first = scene.materials.len() > 1;
+    let product = framed_tightly(
+        scene,
+        &three_quarter_view_from(&bounds, vertical_fov, aspect, 0, &axes, long_side_first),
+        aspect,
+    );
+    let product = best_side(scene, accel, product, vertical_fov, aspect, &axes);
     // A room closed on all sides is seen from a corner; an open courtyard
     // keeps the views that show its sky.
     let enclosed = crate::sky_visibility(accel, centre) < crate::ENCLOSED;
-    let corners = if enclosed { room_corner_views(&bounds, vertical_fov).to_vec() } else { Vec::new() };
+    let corners = if enclosed { room_corner_views(&bounds, vertical_fov, &axes).to_vec() } else { Vec::new() };
 
     let mut best: Option<(Camera, usize)> = None;
     for candidate in [product, front, above, inside].into_iter().chain(corners) {
@@ -118,59 +158,164 @@ pub fn frame_scene<A: Accel + ?Sized>(scene: &Scene, accel: &A, vertical_fov: f3
     best.map_or(product, |(camera, _)| camera)
 }
 
+/// A flat model (a cut-out, a drawing: its bounds at most
+/// [`FLAT_THICKNESS`] of their size thick) seen straight on, framed
+/// tightly: any view from the side shows it foreshortened to a sliver. Seen
+/// from the side of the axis it is flat across that faces +Z or +Y (where a
+/// flat model across Y, lying down, is seen from above with −Z up).
+fn flat_view<A: Accel + ?Sized>(
+    scene: &Scene,
+    accel: &A,
+    bounds: &Aabb,
+    vertical_fov: f32,
+    aspect: f32,
+) -> Option<Camera> {
+    if bounds.is_empty() {
+        return None;
+    }
+    let extent = bounds.extent();
+    let axis = (0..3).min_by(|&a, &b| extent[a].total_cmp(&extent[b]))?;
+    if extent[axis] > FLAT_THICKNESS * extent.max_element() {
+        return None;
+    }
+    let mut towards_camera = Vec3::ZERO;
+    towards_camera[axis] = 1.0;
+    let up = if axis == 1 { Vec3::NEG_Z } else { Vec3::Y };
+    let distance = extent.length().max(1e-6);
+    let centre = bounds.centroid();
+    let straight = Camera::look_at(centre + towards_camera * distance, centre, up, vertical_fov);
+    let view = framed_tightly(scene, &straight, aspect);
+    camera_blocked(scene, accel, &view, aspect).is_none().then_some(view)
+}
+
 /// Views from inside the four upper corners of `bounds`, each looking
 /// across to the middle of the floor on the far side of the centre: how a
 /// photographer shows a room (the whole floor, furniture and the far walls),
 /// where a view from the centre sees one wall.
-fn room_corner_views(bounds: &Aabb, vertical_fov: f32) -> [Camera; 4] {
-    let extent = bounds.extent();
-    let target = bounds.min + extent * Vec3::new(0.5, ROOM_TARGET_HEIGHT, 0.5);
+fn room_corner_views(bounds: &Aabb, vertical_fov: f32, axes: &Axes) -> [Camera; 4] {
+    let target = axes.point(bounds, Vec3::new(0.5, ROOM_TARGET_HEIGHT, 0.5));
     [(0.0, 0.0), (1.0, 0.0), (0.0, 1.0), (1.0, 1.0)].map(|(x, z)| {
         let inset = |side: f32| ROOM_CORNER_INSET + side * (1.0 - 2.0 * ROOM_CORNER_INSET);
-        let position = bounds.min + extent * Vec3::new(inset(x), ROOM_CAMERA_HEIGHT, inset(z));
-        Camera::look_at(position, target, Vec3::Y, vertical_fov)
+        let position = axes.point(bounds, Vec3::new(inset(x), ROOM_CAMERA_HEIGHT, inset(z)));
+        Camera::look_at(position, target, axes.up, vertical_fov)
     })
 }
 
-/// The three-quarter view of `bounds` (see [`frame_scene`]).
+/// The three-quarter view of `bounds` (see [`frame_scene`]), +Y up.
 pub fn three_quarter_view(bounds: &Aabb, vertical_fov: f32, aspect: f32) -> Camera {
-    three_quarter_view_from(bounds, vertical_fov, aspect, 1.0)
+    three_quarter_view_from(bounds, vertical_fov, aspect, 0, &Axes::new(Vec3::Y), true)
 }
 
-/// The product shot of a model `scene`, or the same shot from its back
-/// (the view turned 180 degrees about the vertical through the model's
-/// centre): whichever shows more, by the materials in view, and for a model
-/// of one material by its surface detail.
-fn front_or_back<A: Accel + ?Sized>(scene: &Scene, accel: &A, front: Camera, vertical_fov: f32, aspect: f32) -> Camera {
-    let back = framed_tightly(scene, &three_quarter_view_from(&scene.bounds(), vertical_fov, aspect, -1.0), aspect);
-    if camera_blocked(scene, accel, &back, aspect).is_some() {
-        return front;
-    }
-    let (front_materials, back_materials) =
-        (materials_shown(scene, accel, &front, aspect), materials_shown(scene, accel, &back, aspect));
-    if back_materials != front_materials || scene.materials.len() > 1 {
-        return if back_materials > front_materials { back } else { front };
-    }
-    let (front_detail, back_detail) =
-        (detail_shown(scene, accel, &front, aspect), detail_shown(scene, accel, &back, aspect));
-    if back_detail > BACK_DETAIL_MARGIN * front_detail { back } else { front }
+/// The directions the automatic views are taken in: up, the front the
+/// product shot looks from, and the side to the front's right (+Y, +Z and
+/// +X for a +Y-up model), turned together to the model's up.
+struct Axes {
+    up: Vec3,
+    front: Vec3,
+    side: Vec3,
 }
 
-/// [`three_quarter_view`] from the model's front (`facing` 1) or back (`facing` −1).
-fn three_quarter_view_from(bounds: &Aabb, vertical_fov: f32, aspect: f32, facing: f32) -> Camera {
+impl Axes {
+    fn new(up: Vec3) -> Self {
+        let turn = turned_up(up);
+        Self { up: turn * Vec3::Y, front: turn * Vec3::Z, side: turn * Vec3::X }
+    }
+
+    /// The size of `bounds` along (side, up, front).
+    fn extent(&self, bounds: &Aabb) -> Vec3 {
+        let extent = bounds.extent();
+        Vec3::new(self.side.abs().dot(extent), self.up.abs().dot(extent), self.front.abs().dot(extent))
+    }
+
+    /// The point of `bounds` at `fractions` of its size along (side, up,
+    /// front), from its lowest along each (for +Y up, `min + extent *
+    /// fractions`, bit for bit).
+    fn point(&self, bounds: &Aabb, fractions: Vec3) -> Vec3 {
+        let extent = self.extent(bounds);
+        let lowest = Vec3::select((self.side + self.up + self.front).cmplt(Vec3::ZERO), bounds.max, bounds.min);
+        lowest
+            + self.side * (extent.x * fractions.x)
+            + self.up * (extent.y * fractions.y)
+            + self.front * (extent.z * fractions.z)
+    }
+}
+
+/// The product shot of a model `scene` from the side that shows the most:
+/// its front, its back or either side (the view turned about the vertical
+/// through the model's centre in quarter turns), by the materials in view,
+/// and for a model of one material by its surface detail (a bust facing
+/// along X is seen from the side its face is on). Ties keep the front, then
+/// the back.
+fn best_side<A: Accel + ?Sized>(
+    scene: &Scene,
+    accel: &A,
+    front: Camera,
+    vertical_fov: f32,
+    aspect: f32,
+    axes: &Axes,
+) -> Camera {
+    let bounds = scene.bounds();
+    let others: Vec<Camera> = [2, 1, 3]
+        .into_iter()
+        .map(|quarter| {
+            let view = three_quarter_view_from(&bounds, vertical_fov, aspect, quarter, axes, scene.materials.len() > 1);
+            framed_tightly(scene, &view, aspect)
+        })
+        .filter(|view| camera_blocked(scene, accel, view, aspect).is_none())
+        .collect();
+    let front_materials = materials_shown(scene, accel, &front, aspect);
+    let materials: Vec<usize> = others.iter().map(|view| materials_shown(scene, accel, view, aspect)).collect();
+    if scene.materials.len() > 1 || materials.iter().any(|&m| m != front_materials) {
+        let mut best = (front, front_materials);
+        for (view, shown) in others.into_iter().zip(materials) {
+            if shown > best.1 {
+                best = (view, shown);
+            }
+        }
+        return best.0;
+    }
+    let front_detail = detail_shown(scene, accel, &front, aspect);
+    let mut best = (front, SIDE_DETAIL_MARGIN * front_detail);
+    for view in others {
+        let detail = detail_shown(scene, accel, &view, aspect);
+        if detail > best.1 {
+            best = (view, detail);
+        }
+    }
+    best.0
+}
+
+/// [`three_quarter_view`] from the model's front turned `quarter` quarter
+/// turns about its up: 0 the front, 2 the back, 1 and 3 the two sides.
+fn three_quarter_view_from(
+    bounds: &Aabb,
+    vertical_fov: f32,
+    aspect: f32,
+    quarter: u32,
+    axes: &Axes,
+    long_side_first: bool,
+) -> Camera {
     let (centre, extent) = if bounds.is_empty() {
         (Vec3::ZERO, Vec3::ONE)
     } else {
         (bounds.centroid(), bounds.extent().max(Vec3::splat(1e-6)))
     };
     let (azimuth, elevation) = (THREE_QUARTER_AZIMUTH.to_radians(), THREE_QUARTER_ELEVATION.to_radians());
-    // Long along Z: its side is its face.
-    let front = facing * if extent.z > 1.5 * extent.x { Vec3::X } else { Vec3::Z };
-    let side = Vec3::Y.cross(front);
+    // Long from front to back: its side is its face (a vehicle).
+    let along = axes.extent(bounds);
+    let facing = if long_side_first && along.z > 1.5 * along.x { axes.side } else { axes.front };
+    let turned = axes.up.cross(facing);
+    let front = match quarter % 4 {
+        0 => facing,
+        1 => turned,
+        2 => -facing,
+        _ => -turned,
+    };
+    let side = axes.up.cross(front);
     let horizontal = front * azimuth.cos() + side * azimuth.sin();
-    let towards_camera = horizontal * elevation.cos() + Vec3::Y * elevation.sin();
+    let towards_camera = horizontal * elevation.cos() + axes.up * elevation.sin();
     let forward = -towards_camera;
-    let right = forward.cross(Vec3::Y).normalize();
+    let right = forward.cross(axes.up).normalize();
     let up = right.cross(forward);
     // The distance at which every corner of the box is inside FILL of the frame.
     let tan_vertical = FILL * (0.5 * vertical_fov).tan();
@@ -185,7 +330,7 @@ fn three_quarter_view_from(bounds: &Aabb, vertical_fov: f32, aspect: f32, facing
         let (x, y, z) = (offset.dot(right), offset.dot(up), offset.dot(forward));
         distance = distance.max(x.abs() / tan_horizontal - z).max(y.abs() / tan_vertical - z);
     }
-    Camera::look_at(centre + towards_camera * distance, centre, Vec3::Y, vertical_fov)
+    Camera::look_at(centre + towards_camera * distance, centre, axes.up, vertical_fov)
 }
 
 /// `camera` moved along its own axes, its direction kept, to the closest
@@ -428,7 +573,7 @@ mod tests {
                 assert!(camera.direction.y < 0.0, "looks down across the room: {camera:?}");
                 assert!(materials_shown(&scene, accel.as_ref(), &camera, 1.0) == 5, "{camera:?}");
                 // The room light hangs inside the room, between the floor in view and the ceiling.
-                let lamp = crate::room_light(&scene, accel.as_ref(), &camera).position;
+                let lamp = crate::room_light(&scene, accel.as_ref(), &camera, Vec3::Y).position;
                 assert!(bounds.contains_point(lamp) && lamp.y > 1.0 && lamp.y < 3.0, "{lamp}");
             }
         }
@@ -475,8 +620,52 @@ mod tests {
     }
 
     #[test]
+    fn a_flat_cut_out_is_seen_straight_on() {
+        use rtgi_accel::{AccelKind, BuildParams};
+        // A zig-zag strip in the XY plane, and the same lying in XZ.
+        let mut obj = String::new();
+        for i in 0..12 {
+            obj.push_str(&format!("v {} {} 0\nv {} {} 0\n", i as f32, (i % 2) as f32 * 0.5, i as f32, 1.0));
+        }
+        for i in 0..11 {
+            let (a, b) = (2 * i + 1, 2 * i + 3);
+            obj.push_str(&format!("f {a} {b} {} {}\n", b + 1, a + 1));
+        }
+        for (lying, towards) in [(false, Vec3::Z), (true, Vec3::Y)] {
+            let mut scene = Scene::load_from_bytes("strip.obj", obj.as_bytes(), &|_| None).expect("the strip loads");
+            if lying {
+                for vertex in &mut scene.vertices {
+                    vertex.position = Vec3::new(vertex.position.x, vertex.position.z, vertex.position.y);
+                }
+            }
+            let accel = AccelKind::Sah.build(&scene.triangle_positions(), &BuildParams::default());
+            let camera = frame_scene(&scene, accel.as_ref(), 40f32.to_radians(), 1.0);
+            let from = (camera.position - scene.bounds().centroid()).normalize();
+            assert!(from.dot(towards) > 0.999, "lying {lying}: seen from {from}");
+        }
+    }
+
+    #[test]
+    fn a_statue_on_a_base_across_z_is_seen_upright_from_its_front_at_minus_y() {
+        use rtgi_accel::{AccelKind, BuildParams};
+        for (axis, up) in [(2, Vec3::Z), (1, Vec3::Y)] {
+            let scene = crate::up_axis::test_models::column(axis, true);
+            let accel = AccelKind::Sah.build(&scene.triangle_positions(), &BuildParams::default());
+            let camera = frame_scene(&scene, accel.as_ref(), 40f32.to_radians(), 1.0);
+            let centre = scene.bounds().centroid();
+            assert!((camera.up.normalize() - up).length() < 1e-5, "{axis}: up {}", camera.up);
+            // From above, in the product shot's direction turned with the model.
+            let from = (camera.position - centre).normalize();
+            assert!(from.dot(up) > 0.2, "{axis}: seen from {from}");
+            let front = crate::up_axis::turned_up(up) * Vec3::Z;
+            assert!(from.dot(front) > 0.5, "{axis}: seen from {from}, the front is {front}");
+        }
+    }
+
+    #[test]
     fn a_scan_is_seen_from_the_side_with_its_detail_and_a_plain_one_from_the_front() {
         use rtgi_accel::{AccelKind, BuildParams};
+        // Its back, or one of its sides.
         for detailed in [true, false] {
             let scene = statue(detailed);
             assert_eq!(scene.materials.len(), 1);
@@ -490,6 +679,17 @@ mod tests {
                 assert!(offset.z > 0.0, "a plain block is seen from +Z, the camera is at {offset}");
             }
         }
+        // Turned so that its detail faces +X (and no deeper than wide): seen from that side.
+        let mut turned = statue(true);
+        for vertex in &mut turned.vertices {
+            let p = vertex.position;
+            vertex.position = Vec3::new(-0.5 * p.z, p.y, p.x);
+            vertex.normal = Vec3::new(-vertex.normal.z, vertex.normal.y, vertex.normal.x);
+        }
+        let accel = AccelKind::Sah.build(&turned.triangle_positions(), &BuildParams::default());
+        let camera = frame_scene(&turned, accel.as_ref(), 40f32.to_radians(), 1.0);
+        let offset = camera.position - turned.bounds().centroid();
+        assert!(offset.x > offset.z.abs(), "the detail faces +X, the camera is at {offset}");
     }
 
     #[test]

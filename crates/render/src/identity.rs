@@ -48,12 +48,14 @@ impl RenderIdentity {
             max_depth,
             direct_strategy,
             indirect_clamp,
+            filter_glossy,
             russian_roulette,
             roulette_start,
             bounce_sampling,
             environment,
             effects,
             default_lighting,
+            up,
             // Adaptive renders are never accumulated ([`crate::render_pass`] refuses them).
             adaptive: _,
         } = settings;
@@ -63,7 +65,8 @@ impl RenderIdentity {
             Some(Environment::Map(map)) => {
                 let bits =
                     map.image().pixels().iter().flat_map(|p| p.to_array()).flat_map(|c| c.to_bits().to_le_bytes());
-                format!("map {}x{} {:016x}", map.image().width(), map.image().height(), Fnv::new().bytes(bits).0)
+                let (w, h) = (map.image().width(), map.image().height());
+                format!("map {w}x{h} {:016x} turned {:?}", Fnv::new().bytes(bits).0, map.turn())
             }
         };
         let settings = [
@@ -73,11 +76,13 @@ impl RenderIdentity {
             ("max depth", max_depth.to_string()),
             ("direct strategy", format!("{direct_strategy:?}")),
             ("indirect clamp", format!("{indirect_clamp:?}")),
+            ("filter glossy", format!("{filter_glossy:?}")),
             ("russian roulette", russian_roulette.to_string()),
             ("roulette start", roulette_start.to_string()),
             ("bounce sampling", bounce_sampling.to_string()),
             ("environment", environment),
             ("effects", format!("{effects:?}")),
+            ("up", format!("{up:?}")),
             ("default lighting", format!("{default_lighting:?}")),
         ];
         Self {

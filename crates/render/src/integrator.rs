@@ -185,6 +185,7 @@ pub(crate) struct Transport<'a, A: Accel + ?Sized> {
     max_depth: u32,
     strategy: DirectStrategy,
     indirect_clamp: Option<f32>,
+    filter_glossy: Option<f32>,
     russian_roulette: bool,
     roulette_start: u32,
     bounce_sampling: BounceSampling,
@@ -218,9 +219,6 @@ fn power_heuristic(a: f32, b: f32) -> f32 {
     if a2.is_infinite() { 1.0 } else { a2 / (a2 + b2).max(f32::MIN_POSITIVE) }
 }
 
-static DEFAULT_SUN: std::sync::LazyLock<rtgi_scene::Light> =
-    std::sync::LazyLock::new(crate::default_lighting::default_sun);
-
 impl<'a, A: Accel + ?Sized> Transport<'a, A> {
     pub(crate) fn new(
         scene: &'a Scene,
@@ -236,7 +234,11 @@ impl<'a, A: Accel + ?Sized> Transport<'a, A> {
             // The default sun comes with the default sky.
             lights: LightSet::new(
                 scene,
-                if plan.default_environment { std::slice::from_ref(&*DEFAULT_SUN) } else { &[] },
+                &plan
+                    .default_environment
+                    .then(|| crate::default_lighting::default_sun(settings.up))
+                    .into_iter()
+                    .collect::<Vec<_>>(),
                 plan.has(Effect::Emission),
                 environment,
             ),
@@ -246,6 +248,7 @@ impl<'a, A: Accel + ?Sized> Transport<'a, A> {
             max_depth: plan.max_depth,
             strategy: settings.direct_strategy,
             indirect_clamp: settings.indirect_clamp,
+            filter_glossy: plan.filter_glossy,
             russian_roulette: settings.russian_roulette,
             roulette_start: settings.roulette_start,
             bounce_sampling: settings.bounce_sampling,
@@ -284,6 +287,9 @@ impl<'a, A: Accel + ?Sized> Transport<'a, A> {
         let mut previous_pdf: Option<f32> = None;
         // The product of the η² of the refractions so far (pbrt's etaScale).
         let mut radiance_scale = 1.0f32;
+        // The least density of the path's bounces so far (not counting
+        // deltas), which path regularisation widens later lobes by.
+        let mut least_pdf = f32::INFINITY;
         let mut depth = 0;
         loop {
             let mut u: [f32; dim::COUNT] = std::array::from_fn(|_| rng.next_f32());
@@ -330,7 +336,12 @@ impl<'a, A: Accel + ?Sized> Transport<'a, A> {
             if depth == self.max_depth {
                 break;
             }
-            let interaction = self.interact::<S>(&hit, triangle, material, wo, u[dim::LOBE]);
+            let mut interaction = self.interact::<S>(&hit, triangle, material, wo, u[dim::LOBE]);
+            if compiled(S, Effect::Glossy)
+                && let Some(width) = self.regularisation_width(least_pdf)
+            {
+                interaction.bsdf = interaction.bsdf.regularised(width);
+            }
             let (frame, bsdf) = (&interaction.frame, &interaction.bsdf);
             let wo_local = frame.to_local(wo);
             let reflects_only = !bsdf.transmits();
@@ -377,6 +388,9 @@ impl<'a, A: Accel + ?Sized> Transport<'a, A> {
             // see that, or paths inside glass die for nothing.
             radiance_scale *= sample.eta * sample.eta;
             previous_pdf = (!sample.delta).then_some(sample.pdf);
+            if !sample.delta {
+                least_pdf = least_pdf.min(sample.pdf);
+            }
             depth += 1;
             // Russian roulette ends paths that carry little, in proportion;
             // paths that lose nothing (mirrors, glass) are left to the depth limit.
@@ -405,6 +419,19 @@ impl<'a, A: Accel + ?Sized> Transport<'a, A> {
             }
             _ => contribution,
         }
+    }
+
+    /// The GGX width path regularisation widens a vertex's lobes to, given
+    /// the least density of the path's bounces before it: Cycles' "filter
+    /// glossy" rule, 0.5·sqrt(1 − density / threshold) below the threshold.
+    /// A diffuse bounce (density cos θ / π ≤ 0.32) with the threshold 1
+    /// gives 0.41 to 0.5; a sharp glossy bounce (density in the tens) none,
+    /// so a mirror seen in a mirror stays sharp. `None`: no regularisation
+    /// (off, or no bounce yet: what the camera sees directly is exact).
+    #[inline]
+    fn regularisation_width(&self, least_pdf: f32) -> Option<f32> {
+        let blur = least_pdf / self.filter_glossy?;
+        (blur < 1.0).then(|| 0.5 * (1.0 - blur).sqrt())
     }
 
     /// The weight of emitted light found by a BSDF-sampled ray, given the

@@ -50,6 +50,7 @@ pub mod recipe;
 mod sampler;
 mod shade;
 mod shading_normal;
+pub mod up_axis;
 pub mod view_lighting;
 
 pub use accumulation::{Accumulation, FIXED_POINT_BITS, MergeError, PartSpan, PixelSum, SAMPLE_LIMIT};
@@ -65,7 +66,8 @@ pub use distribution::Distribution1D;
 pub use effect_set::EffectSet;
 pub use effects::{Effect, EffectOverrides, EffectPlan, PlannedEffect, Reversal};
 pub use framing::{
-    DEFAULT_VERTICAL_FOV_DEGREES, camera_blocked, default_camera, frame_scene, framed_tightly, three_quarter_view,
+    DEFAULT_VERTICAL_FOV_DEGREES, camera_blocked, default_camera, frame_scene, frame_scene_up, framed_tightly,
+    three_quarter_view,
 };
 pub use identity::{Difference, RenderIdentity, scene_fingerprint};
 pub use integrator::{DirectStrategy, Integrator, ROULETTE_START};
@@ -119,6 +121,14 @@ pub struct RenderSettings {
     /// after two or more bounces: removes the fireflies of caustics at the
     /// price of a bias (darker caustics and highlights). `None` keeps every path exact.
     pub indirect_clamp: Option<f32>,
+    /// Path regularisation, as Cycles' "filter glossy": after a bounce
+    /// sampled with a density below this value (a diffuse or rough one),
+    /// every later lobe is widened to a GGX width of up to 0.5
+    /// ([`crate::integrator`]'s `regularisation_width`), so that caustics
+    /// and sharp highlights seen through diffuse bounces are found by light
+    /// sampling instead of as fireflies. Biased (blurrier caustics);
+    /// `None` keeps every lobe as the material says.
+    pub filter_glossy: Option<f32>,
     /// Russian roulette: after two bounces, end paths that carry little
     /// light with a probability that grows as they dim, and weigh the
     /// survivors up. Unbiased; off, every path runs to `max_depth`.
@@ -138,6 +148,10 @@ pub struct RenderSettings {
     /// an enclosed camera), and whether a probe of the view found the
     /// scene's own lights too weak for it.
     pub default_lighting: DefaultLighting,
+    /// Which way is up in the scene: the zenith of the default sky and the
+    /// side the default sun shines from ([`up_axis`]; +Y by default, +Z
+    /// for a model found standing on a base across Z).
+    pub up: Vec3,
     /// Adaptive sampling: `samples_per_pixel` is then the most a pixel
     /// takes, in rounds, each pixel stopping at the noise target or all at
     /// the time bound ([`adaptive`]); `None` renders every pixel's samples.
@@ -178,12 +192,14 @@ impl Default for RenderSettings {
             max_depth: 8,
             direct_strategy: DirectStrategy::Mis,
             indirect_clamp: None,
+            filter_glossy: None,
             russian_roulette: true,
             roulette_start: ROULETTE_START,
             bounce_sampling: BounceSampling::Bsdf,
             environment: None,
             effects: EffectOverrides::default(),
             default_lighting: DefaultLighting::Auto,
+            up: Vec3::Y,
             adaptive: None,
         }
     }
@@ -418,7 +434,8 @@ fn render_transport<A: Accel + ?Sized>(
     plan: &EffectPlan,
     pass: &Pass<'_>,
 ) -> Option<(Vec<PixelSum>, u64)> {
-    let environment = if plan.default_environment { Some(default_sky()) } else { pass.settings.environment.as_ref() };
+    let sky = plan.default_environment.then(|| default_sky(pass.settings.up));
+    let environment = sky.as_deref().or(pass.settings.environment.as_ref());
     let transport = Transport::new(scene, accel, plan, environment, pass.settings);
     fn run<const S: u16, A: Accel + ?Sized>(
         transport: &Transport<'_, A>,

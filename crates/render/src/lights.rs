@@ -11,6 +11,7 @@ use std::path::{Path, PathBuf};
 use std::str::FromStr;
 
 use rtgi_image::{HdrImage, ImageError};
+use rtgi_math::glam::Quat;
 use rtgi_math::{Ray, SurfacePoint, TriangleShape, Vec2, Vec3, luminance, parse_vec3};
 use rtgi_scene::{Light, LightKind, Scene, SurfaceModel, TextureId};
 
@@ -27,12 +28,15 @@ pub enum Environment {
 }
 
 /// An equirectangular environment: +Y is up, the image's top row is the
-/// zenith, and its centre column looks along -Z (the default camera's view).
-/// Texels are constant over their solid angle (no filtering), which is what
-/// makes the sampling density exact.
+/// zenith, and its centre column looks along -Z (the default camera's view),
+/// unless it is turned ([`EnvironmentMap::turned`]: the default sky of a
+/// +Z-up model). Texels are constant over their solid angle (no
+/// filtering), which is what makes the sampling density exact.
 #[derive(Clone, Debug, PartialEq)]
 pub struct EnvironmentMap {
     image: HdrImage,
+    /// From the map's +Y-up frame to the world's.
+    turn: Quat,
     /// Chooses a row by its total brightness (weighted by its solid angle).
     rows: Distribution1D,
     /// Chooses a column within each row.
@@ -141,7 +145,8 @@ impl Environment {
             Environment::Map(map) => {
                 let (w, h) = (map.image.width(), map.image.height());
                 let pixels = map.image.pixels().iter().map(|p| *p * scale).collect();
-                Environment::Map(EnvironmentMap::new(HdrImage::from_pixels(w, h, pixels).expect("the map's size")))
+                let scaled = EnvironmentMap::new(HdrImage::from_pixels(w, h, pixels).expect("the map's size"));
+                Environment::Map(scaled.turned(map.turn))
             }
         }
     }
@@ -151,7 +156,7 @@ impl Environment {
         match self {
             Environment::Uniform(radiance) => *radiance,
             Environment::Map(map) => {
-                let (x, y) = map.texel_of(direction);
+                let (x, y) = map.texel_of(map.turn.inverse() * direction);
                 map.image.get(x, y)
             }
         }
@@ -167,7 +172,7 @@ impl Environment {
                 let (column, p_column, u) = map.columns[row].sample(u.x);
                 let (w, h) = (map.image.width() as f32, map.image.height() as f32);
                 let uv = Vec2::new((column as f32 + u) / w, (row as f32 + v) / h);
-                let direction = direction_of(uv);
+                let direction = map.turn * direction_of(uv);
                 let sin_theta = (PI * uv.y).sin();
                 let pdf = if sin_theta > 0.0 { p_row * p_column * w * h / (2.0 * PI * PI * sin_theta) } else { 0.0 };
                 (direction, map.image.get(column as u32, row as u32), pdf)
@@ -180,6 +185,7 @@ impl Environment {
         match self {
             Environment::Uniform(_) => 1.0 / (4.0 * PI),
             Environment::Map(map) => {
+                let direction = map.turn.inverse() * direction;
                 let (x, y) = map.texel_of(direction);
                 let (w, h) = (map.image.width() as f32, map.image.height() as f32);
                 // From x and z rather than 1 - y², which loses everything near the poles.
@@ -223,7 +229,17 @@ impl EnvironmentMap {
         let rows = Distribution1D::new(
             columns.iter().enumerate().map(|(y, c)| c.total() as f32 * (PI * (y as f32 + 0.5) / h as f32).sin()),
         );
-        Self { image, rows, columns }
+        Self { image, rows, columns, turn: Quat::IDENTITY }
+    }
+
+    /// The map turned by `turn` (from its +Y-up frame to the world's).
+    pub fn turned(self, turn: Quat) -> Self {
+        Self { turn, ..self }
+    }
+
+    /// The rotation from the map's +Y-up frame to the world's.
+    pub fn turn(&self) -> Quat {
+        self.turn
     }
 
     /// The equirectangular image.

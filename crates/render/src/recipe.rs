@@ -14,10 +14,11 @@ use rtgi_scene::{Camera, Light, Scene};
 
 use crate::camera_choice::{ViewScore, best_file_camera, score_view, surface_points};
 use crate::effects::{materials_in_use, reflects_surroundings};
+use crate::up_axis::{UpAxis, detect_up};
 use crate::view_lighting::{REFLECTED_SHARE, UNLIT_VIEW, view_light};
 use crate::{
     BounceSampling, DEFAULT_VERTICAL_FOV_DEGREES, DefaultLighting, DirectStrategy, ENCLOSED, EffectOverrides,
-    EffectPlan, EnvironmentSpec, Integrator, PixelSampler, RenderSettings, camera_blocked, frame_scene, room_light,
+    EffectPlan, EnvironmentSpec, Integrator, PixelSampler, RenderSettings, camera_blocked, frame_scene_up, room_light,
     sky_visibility,
 };
 
@@ -118,6 +119,10 @@ pub struct ChosenCamera {
     /// that meet the back of a surface or start against one, when that
     /// suggests it is inside geometry (the automatic framing avoids such views).
     pub blocked: Option<f32>,
+    /// Which way is up in the scene (for the default sky and sun): the
+    /// options' `up`, else for the automatic view the model's, judged by
+    /// its base ([`crate::up_axis::detect_up`]), else +Y.
+    pub up: UpAxis,
 }
 
 /// The scene's camera as `choice` says, for images of `aspect` (width / height).
@@ -128,6 +133,10 @@ pub fn choose_camera(
     aspect: f32,
 ) -> Result<ChosenCamera, RecipeError> {
     let (mut file_choice, mut automatic_view) = (None, None);
+    // The model's up, judged once and only where the automatic view may be used.
+    let given_up = choice.up.and_then(|up| up.try_normalize()).map(|up| UpAxis { up, base_share: None });
+    let model_up = std::cell::OnceCell::new();
+    let model_up = || *model_up.get_or_init(|| given_up.unwrap_or_else(|| detect_up(scene)));
     let chosen = match choice.index {
         Some(index) if index >= scene.cameras.len() => {
             return Err(RecipeError::CameraIndex { index, count: scene.cameras.len() });
@@ -140,7 +149,8 @@ pub fn choose_camera(
             let points = surface_points(scene);
             let (best, score) = best_file_camera(scene, accel, aspect, &points).expect("the scene has cameras");
             let automatic = (!score.sees_it_whole()).then(|| {
-                let view = frame_scene(scene, accel, DEFAULT_VERTICAL_FOV_DEGREES.to_radians(), aspect);
+                let view =
+                    frame_scene_up(scene, accel, DEFAULT_VERTICAL_FOV_DEGREES.to_radians(), aspect, model_up().up);
                 let seen = score_view(accel, &view, aspect, &points);
                 (view, seen)
             });
@@ -176,7 +186,7 @@ pub fn choose_camera(
             if choice.at.is_some() {
                 Camera::framing(&scene.bounds(), fov, aspect)
             } else {
-                frame_scene(scene, accel, fov, aspect)
+                frame_scene_up(scene, accel, fov, aspect, model_up().up)
             }
         }),
     };
@@ -197,7 +207,8 @@ pub fn choose_camera(
         return Err(RecipeError::DegenerateCamera);
     }
     let blocked = if automatic { None } else { camera_blocked(scene, accel, &camera, aspect) };
-    Ok(ChosenCamera { camera, file_choice, blocked })
+    let up = if chosen.is_none() { model_up() } else { given_up.unwrap_or(UpAxis::Y) };
+    Ok(ChosenCamera { camera, file_choice, blocked, up })
 }
 
 /// The lighting options: lights added to the scene, the integrator and its
@@ -218,6 +229,8 @@ pub struct Lighting {
     pub direct_strategy: DirectStrategy,
     /// The indirect-light clamp, if any.
     pub indirect_clamp: Option<f32>,
+    /// Path regularisation's threshold ([`RenderSettings::filter_glossy`]), if any.
+    pub filter_glossy: Option<f32>,
     /// The environment (a colour or a map's file), if any.
     pub environment: Option<EnvironmentSpec>,
     /// Multiplies the environment's radiance.
@@ -241,6 +254,7 @@ pub fn apply_lighting(
     settings.bounce_sampling = lighting.bounce_sampling;
     settings.direct_strategy = lighting.direct_strategy;
     settings.indirect_clamp = lighting.indirect_clamp;
+    settings.filter_glossy = lighting.filter_glossy;
     settings.effects = lighting.effects.clone();
     settings.environment = lighting
         .environment
@@ -274,7 +288,7 @@ pub fn light_enclosed_camera(
     if !EffectPlan::new(scene, settings).default_environment || sky_visibility(accel, camera.position) >= ENCLOSED {
         return None;
     }
-    let light = room_light(scene, accel, camera);
+    let light = room_light(scene, accel, camera, settings.up);
     scene.lights.push(light.clone());
     Some(light)
 }
@@ -298,7 +312,7 @@ pub fn judge_view_lighting(
     {
         return;
     }
-    let Some(view) = view_light(scene, accel, camera, aspect) else { return };
+    let Some(view) = view_light(scene, accel, camera, aspect, settings.up) else { return };
     if let Some(fraction) = view.own_fraction()
         && fraction < UNLIT_VIEW
     {
@@ -336,6 +350,7 @@ pub fn prepare(
 ) -> Result<Prepared, RecipeError> {
     let aspect = settings.width as f32 / settings.height.max(1) as f32;
     let camera = choose_camera(scene, accel, choice, aspect)?;
+    settings.up = camera.up.up;
     judge_view_lighting(scene, accel, &camera.camera, aspect, settings);
     let room_light = light_enclosed_camera(scene, accel, &camera.camera, settings);
     Ok(Prepared { camera, room_light })

@@ -9,7 +9,7 @@
 //! small fraction of the second, the view is unlit.
 
 use rtgi_accel::Accel;
-use rtgi_math::{Rng, SurfacePoint, Vec2, luminance};
+use rtgi_math::{Rng, SurfacePoint, Vec2, Vec3, luminance};
 use rtgi_scene::{Camera, Scene};
 
 use crate::lights::LightSet;
@@ -48,10 +48,16 @@ impl ViewLight {
 
 /// The light on the surfaces `camera` sees ([`ViewLight`]); `None` when
 /// the view shows no surface.
-pub fn view_light<A: Accel + ?Sized>(scene: &Scene, accel: &A, camera: &Camera, aspect: f32) -> Option<ViewLight> {
+pub fn view_light<A: Accel + ?Sized>(
+    scene: &Scene,
+    accel: &A,
+    camera: &Camera,
+    aspect: f32,
+    up: Vec3,
+) -> Option<ViewLight> {
     let own = LightSet::new(scene, &[], true, None);
-    let sky_environment = default_sky();
-    let sky = LightSet::new(scene, std::slice::from_ref(&default_sun()), false, Some(sky_environment));
+    let sky_environment = default_sky(up);
+    let sky = LightSet::new(scene, &[default_sun(up)], false, Some(&sky_environment));
     let width = ((PROBES_PER_SIDE as f32 * aspect).round() as u32).clamp(1, 4 * PROBES_PER_SIDE);
     let rays = CameraRays::new(camera, width, PROBES_PER_SIDE);
     let mut rng = Rng::new(0x0176_4b17, 0);
@@ -77,7 +83,7 @@ pub fn view_light<A: Accel + ?Sized>(scene: &Scene, accel: &A, camera: &Camera, 
                     f64::from(luminance(sample.radiance) * cosine / sample.pdf)
                 };
                 own_total += irradiance(&own, None);
-                sky_total += irradiance(&sky, Some(sky_environment));
+                sky_total += irradiance(&sky, Some(&sky_environment));
                 samples += 1;
             }
         }

@@ -13,6 +13,7 @@ mod denoise;
 mod depth;
 mod direct;
 mod effects;
+mod filter_glossy;
 mod intersector;
 mod packets;
 mod precision;
@@ -40,6 +41,8 @@ pub enum Knob {
     Direct,
     /// The indirect-light clamp: bias traded for variance.
     Clamp,
+    /// Path regularisation (Cycles' "filter glossy") against the clamp.
+    FilterGlossy,
     /// Adaptive sampling (noise targets) against fixed samples per pixel.
     Adaptive,
     /// The edge-avoiding denoiser against the samples' mean.
@@ -68,6 +71,7 @@ impl Knob {
         Knob::Packets,
         Knob::Direct,
         Knob::Clamp,
+        Knob::FilterGlossy,
         Knob::Adaptive,
         Knob::Denoise,
         Knob::Analytic,
@@ -87,6 +91,7 @@ impl Knob {
             Knob::Packets => "packets",
             Knob::Direct => "direct",
             Knob::Clamp => "clamp",
+            Knob::FilterGlossy => "filter-glossy",
             Knob::Adaptive => "adaptive",
             Knob::Denoise => "denoise",
             Knob::Analytic => "analytic",
@@ -119,6 +124,10 @@ impl Knob {
                 "which sampling of direct light (light, BSDF or MIS) gives the least error in equal time, and where?"
             }
             Knob::Clamp => "how much bias does clamping indirect light add for the variance it removes?",
+            Knob::FilterGlossy => {
+                "does widening mirrors, glass and sharp highlights after a diffuse bounce (path regularisation) \
+                 remove the fireflies of caustics at less bias than the clamp, raw and denoised?"
+            }
             Knob::Adaptive => {
                 "does sampling until each pixel meets a noise target beat the same samples everywhere, at equal time?"
             }
@@ -203,6 +212,7 @@ pub(crate) fn run(
         Knob::Packets => packets::run(subject, options, report, progress),
         Knob::Direct => direct::run(subject, options, report, progress),
         Knob::Clamp => clamp::run(subject, options, report, progress),
+        Knob::FilterGlossy => filter_glossy::run(subject, options, report, progress),
         Knob::Adaptive => adaptive::run(subject, options, report, progress),
         Knob::Denoise => denoise::run(subject, options, report, progress),
         Knob::Analytic => analytic::run(options, report, progress),
