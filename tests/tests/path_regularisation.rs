@@ -8,7 +8,7 @@
 use rtgi_accel::{Accel, AccelKind, BuildParams};
 use rtgi_image::HdrImage;
 use rtgi_math::luminance;
-use rtgi_render::{EffectPlan, RenderSettings, render};
+use rtgi_render::{EffectPlan, FilterGlossy, RenderSettings, render};
 use rtgi_scene::{Camera, Scene};
 use rtgi_tests::workspace_root;
 
@@ -20,7 +20,8 @@ fn project_scene(name: &str) -> (Scene, Box<dyn Accel>, Camera) {
     (scene, accel, camera)
 }
 
-fn settings(filter_glossy: Option<f32>, seed: u64) -> RenderSettings {
+fn settings(threshold: Option<f32>, seed: u64) -> RenderSettings {
+    let filter_glossy = threshold.map(FilterGlossy::all_lobes);
     RenderSettings { width: 48, height: 48, samples_per_pixel: 16, seed, filter_glossy, ..RenderSettings::default() }
 }
 
@@ -71,7 +72,31 @@ fn a_scene_without_sharp_lobes_is_rendered_bit_for_bit_as_without_it_and_the_pla
 
     let (caustics, _, _) = project_scene("caustics.toml");
     let plan = EffectPlan::new(&caustics, &settings(Some(1.0), 0));
-    assert_eq!(plan.filter_glossy, Some(1.0));
+    assert_eq!(plan.filter_glossy, Some(FilterGlossy::all_lobes(1.0)));
     assert!(plan.to_string().contains("filter-glossy"), "{plan}");
     assert_eq!(EffectPlan::new(&caustics, &settings(None, 0)).filter_glossy, None);
+}
+
+#[test]
+fn denoised_previews_widen_mirrors_and_glass_and_exact_outputs_do_not() {
+    const RTGI: &str = env!("CARGO_BIN_EXE_rtgi-under-test");
+    let dir = rtgi_tests::scratch_dir("regularisation-cli");
+    let scene = workspace_root().join("scenes/caustics.toml");
+    let scene = scene.to_str().unwrap();
+    let render = |output: &str, extra: &[&str]| {
+        let out = dir.join(output);
+        let mut args =
+            vec!["render", scene, "-o", out.to_str().unwrap(), "--width", "24", "--height", "24", "--spp", "2"];
+        args.extend_from_slice(extra);
+        let run = rtgi_tests::run_cli(RTGI, &args);
+        assert!(run.success, "{run:?}");
+        run.stdout
+    };
+    let preview = render("a.png", &[]);
+    assert!(preview.contains("filter-glossy") && preview.contains("mirrors and smooth glass are widened"), "{preview}");
+    assert!(!render("a.exr", &[]).contains("are widened"), "EXR output stays exact");
+    assert!(!render("b.png", &["--filter-glossy", "0"]).contains("are widened"));
+    assert!(!render("c.png", &["--denoise", "off"]).contains("are widened"), "an undenoised PNG stays exact");
+    let all = render("d.exr", &["--filter-glossy", "2"]);
+    assert!(all.contains("below 2, mirrors, glass and sharp highlights are widened"), "{all}");
 }

@@ -289,7 +289,8 @@ pub(crate) struct LightingArgs {
     /// below this value (diffuse bounces: about 0.3 and less), mirrors, glass and sharp highlights
     /// are widened (to a GGX width of up to 0.5), so caustics and highlights seen through diffuse
     /// bounces are found by light sampling instead of as fireflies; biased (blurrier caustics).
-    /// 0 turns it off [default: off]
+    /// 0 turns it off [default: for denoised PNG previews, mirrors and smooth glass only, at 1;
+    /// off for EXR and .accum, which stay exact]
     #[arg(long, value_parser = parse_non_negative)]
     pub(crate) filter_glossy: Option<f32>,
 

@@ -97,7 +97,7 @@ impl LightingArgs {
             bounce_sampling: self.bounce_sampling,
             direct_strategy: self.direct_strategy,
             indirect_clamp: self.clamp_indirect,
-            filter_glossy: self.filter_glossy.filter(|&v| v > 0.0),
+            filter_glossy: self.filter_glossy.filter(|&v| v > 0.0).map(rtgi_render::FilterGlossy::all_lobes),
             environment: self.environment.clone(),
             environment_scale: self.environment_scale,
             effects: self.effects.clone(),

@@ -161,9 +161,9 @@ pub struct EffectPlan {
     /// The clamp on light brought in after two or more bounces
     /// ([`RenderSettings::indirect_clamp`]), when indirect light is simulated.
     pub indirect_clamp: Option<f32>,
-    /// Path regularisation's threshold ([`RenderSettings::filter_glossy`]),
+    /// Path regularisation ([`RenderSettings::filter_glossy`]),
     /// when indirect light is simulated and some lobe is sharp enough to widen.
-    pub filter_glossy: Option<f32>,
+    pub filter_glossy: Option<crate::FilterGlossy>,
 }
 
 /// The effects whose code the light-transport loop is compiled with or
@@ -612,12 +612,13 @@ impl fmt::Display for EffectPlan {
                  but caustics and glossy highlights come out darker (biased; leave out --clamp for the exact image)"
             )?;
         }
-        if let Some(threshold) = self.filter_glossy {
+        if let Some(filter) = self.filter_glossy {
             writeln!(
                 f,
-                "  filter-glossy after a bounce of density below {threshold}, mirrors, glass and sharp highlights are \
-                 widened: fewer fireflies from caustics, but they come out blurred (biased; leave out \
-                 --filter-glossy for the exact image)"
+                "  filter-glossy after a bounce of density below {}, {} are widened: fewer fireflies from \
+                 caustics, but they come out blurred (biased; --filter-glossy 0 keeps the exact image)",
+                filter.threshold,
+                filter.lobes()
             )?;
         }
         Ok(())

@@ -185,7 +185,7 @@ pub(crate) struct Transport<'a, A: Accel + ?Sized> {
     max_depth: u32,
     strategy: DirectStrategy,
     indirect_clamp: Option<f32>,
-    filter_glossy: Option<f32>,
+    filter_glossy: Option<crate::FilterGlossy>,
     russian_roulette: bool,
     roulette_start: u32,
     bounce_sampling: BounceSampling,
@@ -338,9 +338,9 @@ impl<'a, A: Accel + ?Sized> Transport<'a, A> {
             }
             let mut interaction = self.interact::<S>(&hit, triangle, material, wo, u[dim::LOBE]);
             if compiled(S, Effect::Glossy)
-                && let Some(width) = self.regularisation_width(least_pdf)
+                && let Some(filter) = &self.filter_glossy
             {
-                interaction.bsdf = interaction.bsdf.regularised(width);
+                interaction.bsdf = filter.apply(interaction.bsdf, least_pdf);
             }
             let (frame, bsdf) = (&interaction.frame, &interaction.bsdf);
             let wo_local = frame.to_local(wo);
@@ -419,19 +419,6 @@ impl<'a, A: Accel + ?Sized> Transport<'a, A> {
             }
             _ => contribution,
         }
-    }
-
-    /// The GGX width path regularisation widens a vertex's lobes to, given
-    /// the least density of the path's bounces before it: Cycles' "filter
-    /// glossy" rule, 0.5·sqrt(1 − density / threshold) below the threshold.
-    /// A diffuse bounce (density cos θ / π ≤ 0.32) with the threshold 1
-    /// gives 0.41 to 0.5; a sharp glossy bounce (density in the tens) none,
-    /// so a mirror seen in a mirror stays sharp. `None`: no regularisation
-    /// (off, or no bounce yet: what the camera sees directly is exact).
-    #[inline]
-    fn regularisation_width(&self, least_pdf: f32) -> Option<f32> {
-        let blur = least_pdf / self.filter_glossy?;
-        (blur < 1.0).then(|| 0.5 * (1.0 - blur).sqrt())
     }
 
     /// The weight of emitted light found by a BSDF-sampled ray, given the

@@ -47,6 +47,7 @@ pub mod lights;
 pub mod probes;
 pub mod rays;
 pub mod recipe;
+mod regularisation;
 mod sampler;
 mod shade;
 mod shading_normal;
@@ -72,6 +73,7 @@ pub use framing::{
 pub use identity::{Difference, RenderIdentity, scene_fingerprint};
 pub use integrator::{DirectStrategy, Integrator, ROULETTE_START};
 pub use lights::{Environment, EnvironmentMap, EnvironmentSpec, EnvironmentSpecError, LightSet};
+pub use regularisation::FilterGlossy;
 pub use sampler::{PixelSample, PixelSampler, VertexNumbers};
 pub use shade::{albedo, alpha_accepts, emission, has_alpha, shade_primary, shading_normal};
 
@@ -121,14 +123,12 @@ pub struct RenderSettings {
     /// after two or more bounces: removes the fireflies of caustics at the
     /// price of a bias (darker caustics and highlights). `None` keeps every path exact.
     pub indirect_clamp: Option<f32>,
-    /// Path regularisation, as Cycles' "filter glossy": after a bounce
-    /// sampled with a density below this value (a diffuse or rough one),
-    /// every later lobe is widened to a GGX width of up to 0.5
-    /// ([`crate::integrator`]'s `regularisation_width`), so that caustics
-    /// and sharp highlights seen through diffuse bounces are found by light
-    /// sampling instead of as fireflies. Biased (blurrier caustics);
-    /// `None` keeps every lobe as the material says.
-    pub filter_glossy: Option<f32>,
+    /// Path regularisation ([`FilterGlossy`]): after a diffuse or rough
+    /// bounce, sharp lobes are widened to a GGX width of up to 0.5, so that
+    /// caustics seen through diffuse bounces are found by light sampling
+    /// instead of as fireflies. Biased (blurrier caustics); `None` keeps
+    /// every lobe as the material says.
+    pub filter_glossy: Option<FilterGlossy>,
     /// Russian roulette: after two bounces, end paths that carry little
     /// light with a probability that grows as they dim, and weigh the
     /// survivors up. Unbiased; off, every path runs to `max_depth`.

@@ -229,8 +229,8 @@ pub struct Lighting {
     pub direct_strategy: DirectStrategy,
     /// The indirect-light clamp, if any.
     pub indirect_clamp: Option<f32>,
-    /// Path regularisation's threshold ([`RenderSettings::filter_glossy`]), if any.
-    pub filter_glossy: Option<f32>,
+    /// Path regularisation ([`RenderSettings::filter_glossy`]), if any.
+    pub filter_glossy: Option<crate::FilterGlossy>,
     /// The environment (a colour or a map's file), if any.
     pub environment: Option<EnvironmentSpec>,
     /// Multiplies the environment's radiance.

@@ -63,6 +63,9 @@ pub(crate) fn load(
         materials.borrow_mut().extend(library.materials);
         Ok((placeholders, names.into_iter().collect()))
     };
+    if let Some(why) = binary_content(bytes) {
+        return Err(error(why));
+    }
     let (models, _) = tobj::load_obj_buf(&mut &bytes[..], &LOAD_OPTIONS, loader).map_err(|e| error(e.to_string()))?;
     // Checked after tobj's parse, whose errors name what is malformed.
     if statements.faces == 0 {
@@ -323,6 +326,26 @@ fn load_textures(scene: &mut Scene, files: Vec<Result<ReadFile, String>>) {
     }
 }
 
+/// Why `bytes` cannot be an OBJ file's text, if they are binary: a NUL
+/// byte or invalid UTF-8 in the first 64 KiB (tobj would only say "read
+/// error"), with what the file looks like when its first bytes say.
+fn binary_content(bytes: &[u8]) -> Option<String> {
+    let head = &bytes[..bytes.len().min(1 << 16)];
+    let at = match std::str::from_utf8(head) {
+        // A character cut at the end of the window is no error.
+        Err(e) if e.error_len().is_some() => e.valid_up_to(),
+        _ => head.iter().position(|&b| b == 0)?,
+    };
+    let looks_like = if bytes.starts_with(b"ply") {
+        "; it begins like a PLY file, which rtgi does not read (convert it to .obj)"
+    } else if bytes.starts_with(b"glTF") {
+        "; it begins like a binary glTF file: name it .glb"
+    } else {
+        ""
+    };
+    Some(format!("binary data at byte {at}, where an OBJ file is text{looks_like}"))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -370,6 +393,20 @@ mod tests {
         assert!(err.to_string().starts_with("bad.obj: "), "{err}");
         let err = load_from_text("v 0 0 0\nf 1 2 3\n", "", "range.obj").unwrap_err();
         assert!(err.to_string().starts_with("range.obj: "), "{err}");
+    }
+
+    #[test]
+    fn a_binary_file_named_obj_is_an_error_saying_what_it_seems_to_be() {
+        let ply = b"ply\nformat binary_little_endian 1.0\nend_header\n\x00\x01\xff\xfe";
+        let err = load_from_bytes_for_test(ply, "igea.obj");
+        assert!(err.starts_with("igea.obj: not a valid OBJ file: binary data at byte "), "{err}");
+        assert!(err.contains("PLY"), "{err}");
+        let err = load_from_bytes_for_test(b"v 0 0 0\n\x00", "nul.obj");
+        assert!(err.contains("binary data at byte 8"), "{err}");
+    }
+
+    fn load_from_bytes_for_test(bytes: &[u8], name: &str) -> String {
+        crate::Scene::load_from_bytes(name, bytes, &|_| None).unwrap_err().to_string()
     }
 
     #[test]

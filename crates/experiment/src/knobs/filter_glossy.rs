@@ -8,7 +8,7 @@
 //! denoised (the PNG default), with the error split into squared bias and
 //! variance over the seeds.
 
-use rtgi_render::RenderSettings;
+use rtgi_render::{FilterGlossy, RenderSettings};
 
 use crate::plot::{Curve, Plot};
 use crate::reference::reference;
@@ -51,7 +51,7 @@ pub(super) fn run(
         adaptive: None,
         ..subject.settings.clone()
     };
-    let mut steps = Steps::new(1 + 2 * (thresholds.len() + 2), progress);
+    let mut steps = Steps::new(1 + 2 * (thresholds.len() + 3), progress);
     steps.next("reference, exact");
     let reference = reference(subject, &base, options.reference_spp(), options.cache.as_deref(), progress)?;
     let mean = reference.image.pixels().iter().map(|p| p.max_element() as f64).sum::<f64>()
@@ -64,10 +64,18 @@ pub(super) fn run(
         for &threshold in thresholds {
             configurations.push(Configuration {
                 label: format!("filter glossy {threshold}{kind}"),
-                settings: RenderSettings { filter_glossy: Some(threshold), ..base.clone() },
+                settings: RenderSettings { filter_glossy: Some(FilterGlossy::all_lobes(threshold)), ..base.clone() },
                 make,
             });
         }
+        configurations.push(Configuration {
+            label: format!("filter mirrors and glass 1{kind}"),
+            settings: RenderSettings {
+                filter_glossy: Some(FilterGlossy { threshold: 1.0, deltas_only: true }),
+                ..base.clone()
+            },
+            make,
+        });
         configurations.push(Configuration {
             label: format!("clamp {CLAMP_FACTOR}× mean{kind}"),
             settings: RenderSettings { indirect_clamp: Some(clamp), ..base.clone() },
