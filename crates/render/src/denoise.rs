@@ -208,6 +208,10 @@ struct Texel {
     albedo: Vec3,
     /// Unit normal, or zero where the camera sees nothing.
     normal: Vec3,
+    /// The length of the mean of the guide rays' normals: 1 where they saw
+    /// one surface, less where they saw several (a crease, a silhouette),
+    /// whose normals then lie about acos(spread) from `normal`.
+    spread: f32,
     depth: f32,
     /// The largest change of distance to a neighbouring pixel.
     slope: f32,
@@ -283,6 +287,7 @@ pub fn denoise(
             Texel {
                 albedo: guides.albedo.pixels()[i],
                 normal: guides.normal.pixels()[i].try_normalize().unwrap_or(Vec3::ZERO),
+                spread: guides.normal.pixels()[i].length().clamp(f32::MIN_POSITIVE, 1.0),
                 depth,
                 slope,
                 emission: guides.emission.pixels()[i].max_element(),
@@ -403,7 +408,10 @@ fn agreement(a: &Texel, b: &Texel, gap: f32, settings: &DenoiseSettings) -> f32 
     if (a.emission - b.emission).abs() > 0.1 * a.emission.max(b.emission) {
         return 0.0;
     }
-    let normal = a.normal.dot(b.normal).max(0.0).powi(settings.normal);
+    // A pixel that saw several surfaces (a crease) agrees in full with the
+    // normals within its spread: taken as one surface, it would agree with
+    // none, keep its noise and show the crease as a dotted line.
+    let normal = (a.normal.dot(b.normal) / a.spread).clamp(0.0, 1.0).powi(settings.normal);
     let albedo_difference = (a.albedo - b.albedo).abs().max_element() / settings.albedo;
     let depth_tolerance = settings.depth * a.slope * gap + 1e-3 * a.depth.abs();
     let depth_difference = (a.depth - b.depth).abs() / depth_tolerance.max(f32::MIN_POSITIVE);
@@ -489,6 +497,32 @@ mod tests {
         let blind = DenoiseSettings { normal: 0, luminance: 1e6, ..DenoiseSettings::default() };
         let blurred = denoise(&input, None, &guides, &blind).unwrap();
         assert!((blurred.get(SIDE / 2 - 1, SIDE / 2).x - 0.3).abs() > 0.06);
+    }
+
+    #[test]
+    fn the_pixels_on_a_crease_are_smoothed_with_both_sides() {
+        // The fold's middle column saw both halves, in shares that change
+        // from row to row as a slanted crease crosses pixels (a quarter, a
+        // half, three quarters of the guide rays): its guide normal is the
+        // unnormalised mean, its light the same mixture. No two neighbours
+        // on the column saw the same mixture.
+        let (clean, mut guides) = folded_wall();
+        let crease = SIDE / 2;
+        let mut clean = clean;
+        let share = |y: u32| [0.25f32, 0.5, 0.75][y as usize % 3];
+        for y in 0..SIDE {
+            guides.normal.set(crease, y, Vec3::Z * share(y) + Vec3::Y * (1.0 - share(y)));
+            clean.set(crease, y, Vec3::splat(0.3 * share(y) + 0.9 * (1.0 - share(y))));
+        }
+        let input = noisy(&clean, 0.5, 2);
+        let output = denoise(&input, None, &guides, &DenoiseSettings::default()).unwrap();
+        let column_error = |image: &HdrImage| {
+            let sum: f32 = (0..SIDE).map(|y| (image.get(crease, y).x - clean.get(crease, y).x).powi(2)).sum();
+            (sum / SIDE as f32).sqrt()
+        };
+        let (before, after) = (column_error(&input), column_error(&output));
+        // Without the spread, 0.85 times (measured): the mixed pixels keep their noise.
+        assert!(after < 0.75 * before, "the crease's RMSE {before} before, {after} after");
     }
 
     #[test]
