@@ -189,6 +189,26 @@ fn info_numbers_cameras_and_names_texture_files() {
     assert!(run.stdout.contains("KHR_xmp (ignored)"), "{}", run.stdout);
 }
 
+#[test]
+fn info_says_why_it_counts_more_vertices_than_positions() {
+    // Two triangles sharing an edge, each with its own normal: the shared
+    // corners are split, 6 vertices at 4 positions.
+    let dir = scratch_dir("info-vertices");
+    let obj = dir.join("fold.obj");
+    std::fs::write(
+        &obj,
+        "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 1\nvn 0 0 1\nvn 0 1 0\nf 1//1 2//1 3//1\nf 2//2 4//2 3//2\n",
+    )
+    .unwrap();
+    let run = rtgi(&["info", path_str(&obj)]);
+    assert!(run.success, "{run:?}");
+    assert!(
+        run.stdout.contains("vertices    6 (4 distinct positions: corners at one position are split"),
+        "{}",
+        run.stdout
+    );
+}
+
 /// A glTF triangle (0,0,0), (1,0,0), (0,1,0) with two perspective cameras
 /// of aspect ratio 1.5 at z = 3: the first turned away, the second facing it.
 fn two_camera_gltf(dir: &Path) -> std::path::PathBuf {

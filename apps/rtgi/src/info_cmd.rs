@@ -18,6 +18,9 @@ struct Info {
     scene: String,
     triangles: usize,
     vertices: usize,
+    /// Distinct vertex positions: fewer than `vertices` where corners at one
+    /// position were split because their normals or texture coordinates differ.
+    positions: usize,
     materials: Vec<MaterialInfo>,
     textures: Vec<TextureInfo>,
     lights: Vec<LightInfo>,
@@ -83,6 +86,12 @@ pub(crate) fn run(args: &InfoArgs) -> Result<()> {
         scene: name,
         triangles: scene.triangles.len(),
         vertices: scene.vertices.len(),
+        positions: scene
+            .vertices
+            .iter()
+            .map(|v| v.position.to_array().map(f32::to_bits))
+            .collect::<std::collections::HashSet<_>>()
+            .len(),
         materials: scene
             .materials
             .iter()
@@ -164,7 +173,16 @@ fn print_text(info: &Info) -> Result<()> {
     let v = |a: [f32; 3]| format!("({}, {}, {})", a[0], a[1], a[2]);
     outln!("scene       {}", info.scene)?;
     outln!("triangles   {}", info.triangles)?;
-    outln!("vertices    {}", info.vertices)?;
+    if info.positions < info.vertices {
+        outln!(
+            "vertices    {} ({} distinct positions: corners at one position are split where their normals or \
+             texture coordinates differ)",
+            info.vertices,
+            info.positions
+        )?;
+    } else {
+        outln!("vertices    {}", info.vertices)?;
+    }
     if let Some([min, max]) = info.bounds {
         outln!("bounds      {} to {}", v(min), v(max))?;
     }
