@@ -63,6 +63,15 @@ pub struct Reference {
     pub info: ReferenceInfo,
 }
 
+impl Reference {
+    /// The mean over pixels of the brightest channel's radiance: the scale
+    /// clamps are given in.
+    pub fn mean_radiance(&self) -> f64 {
+        let pixels = self.image.pixels();
+        pixels.iter().map(|p| p.max_element() as f64).sum::<f64>() / pixels.len().max(1) as f64
+    }
+}
+
 /// FNV-1a, 64 bits: a stable hash for cache keys (std's hasher may change between Rust versions).
 #[derive(Clone, Copy)]
 struct Fnv(u64);

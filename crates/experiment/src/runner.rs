@@ -41,13 +41,17 @@ pub(crate) fn measure(subject: &Subject, settings: &RenderSettings, options: &Op
     measure_with(subject, settings, options, reference, render)
 }
 
+/// How a knob makes an image: [`render`], or [`render_denoised`]; returns
+/// the image and its time in ms.
+pub(crate) type MakeImage = fn(&Subject, &RenderSettings) -> (HdrImage, f64);
+
 /// [`measure`], each image made by `make` (a render, or a render and a filter).
 pub(crate) fn measure_with(
     subject: &Subject,
     settings: &RenderSettings,
     options: &Options,
     reference: &Reference,
-    make: fn(&Subject, &RenderSettings) -> (HdrImage, f64),
+    make: MakeImage,
 ) -> Point {
     let mut times = Vec::new();
     let mut errors = SeedErrors::new(&reference.image, reference.info.noise_rmse);

@@ -234,11 +234,7 @@ impl<'a, A: Accel + ?Sized> Transport<'a, A> {
             // The default sun comes with the default sky.
             lights: LightSet::new(
                 scene,
-                &plan
-                    .default_environment
-                    .then(|| crate::default_lighting::default_sun(settings.up))
-                    .into_iter()
-                    .collect::<Vec<_>>(),
+                plan.default_environment.then(|| crate::default_lighting::default_sun(settings.up)).as_slice(),
                 plan.has(Effect::Emission),
                 environment,
             ),

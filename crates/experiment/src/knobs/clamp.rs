@@ -31,8 +31,7 @@ pub(super) fn run(
     let mut steps = Steps::new(2 + limits.len(), progress);
     steps.next("reference, unclamped");
     let reference = reference(subject, &base, options.reference_spp(), options.cache.as_deref(), progress)?;
-    let mean = reference.image.pixels().iter().map(|p| p.max_element() as f64).sum::<f64>()
-        / reference.image.pixels().len().max(1) as f64;
+    let mean = reference.mean_radiance();
     let mut table = Table {
         title: format!(
             "{spp} spp per render, clamps as multiples of the reference's mean radiance {}",

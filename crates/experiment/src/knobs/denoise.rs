@@ -11,12 +11,9 @@ use crate::panel::{Entry, Panel};
 use crate::plot::{Curve, Plot};
 use crate::reference::reference;
 use crate::report::{Report, Series, Table, format_ms, measurement_cells, measurement_header};
-use crate::runner::{equal_time, measure_with, ms_per_sample, render, render_denoised, time_and_error};
+use crate::runner::{MakeImage, equal_time, measure_with, ms_per_sample, render, render_denoised, time_and_error};
 use crate::verdict::{Spread, compare};
 use crate::{ExperimentError, Options, Steps, Subject};
-
-/// How an image is made: a render, or a render and the filter (its time in ms too).
-type MakeImage = fn(&Subject, &RenderSettings) -> (rtgi_image::HdrImage, f64);
 
 /// The sample count whose denoised render sets the equal-time budget.
 const BUDGET_SPP: u32 = 16;

@@ -13,7 +13,7 @@ use rtgi_render::{FilterGlossy, RenderSettings};
 use crate::plot::{Curve, Plot};
 use crate::reference::reference;
 use crate::report::{Point, Report, Series, Table, format_bias, format_number, measurement_cells, measurement_header};
-use crate::runner::{add_equal_time_panel, measure_with, ms_per_sample, render, render_denoised};
+use crate::runner::{MakeImage, add_equal_time_panel, measure_with, ms_per_sample, render, render_denoised};
 use crate::verdict::{Spread, compare};
 use crate::{ExperimentError, Options, Steps, Subject};
 
@@ -24,9 +24,6 @@ const THRESHOLDS: [f32; 4] = [0.1, 0.3, 1.0, 3.0];
 /// The clamp compared, as a multiple of the reference's mean radiance: the
 /// mildest that the clamp experiment finds with a resolved gain.
 const CLAMP_FACTOR: f64 = 4.0;
-
-/// How an image is made: a render, or a render and the denoiser.
-type MakeImage = fn(&Subject, &RenderSettings) -> (rtgi_image::HdrImage, f64);
 
 /// One configuration measured: its label, settings and how its image is made.
 struct Configuration {
@@ -54,8 +51,7 @@ pub(super) fn run(
     let mut steps = Steps::new(1 + 2 * (thresholds.len() + 3), progress);
     steps.next("reference, exact");
     let reference = reference(subject, &base, options.reference_spp(), options.cache.as_deref(), progress)?;
-    let mean = reference.image.pixels().iter().map(|p| p.max_element() as f64).sum::<f64>()
-        / reference.image.pixels().len().max(1) as f64;
+    let mean = reference.mean_radiance();
     let clamp = (CLAMP_FACTOR * mean) as f32;
 
     let mut configurations = Vec::new();
