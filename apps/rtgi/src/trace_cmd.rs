@@ -7,7 +7,7 @@ use anyhow::{Context, Result, bail};
 use rayon::prelude::*;
 use rtgi_accel::Accel;
 use rtgi_math::{Ray, Vec3};
-use rtgi_render::{alpha_accepts, has_alpha};
+use rtgi_render::{AlphaTest, has_alpha};
 
 use crate::cli::TraceArgs;
 use crate::common::{LoadedScene, check_output_folder, load_scene, refuse_inputs_as_outputs};
@@ -47,9 +47,10 @@ pub(crate) fn run(args: &TraceArgs) -> Result<()> {
     let accel = pool.install(|| args.accel.build(&scene))?;
     let build_ms = build_start.elapsed().as_secs_f64() * 1e3;
 
-    let cut_outs = has_alpha(&scene) && !args.no_alpha;
-    let accept = |triangle, beta, gamma| alpha_accepts(&scene, triangle, beta, gamma, BLEND_THRESHOLD);
-    let filter: Option<&(dyn Fn(u32, f32, f32) -> bool + Sync)> = cut_outs.then_some(&accept);
+    let alpha_test = (has_alpha(&scene) && !args.no_alpha).then(|| AlphaTest::new(&scene));
+    let accept =
+        |triangle, beta, gamma| alpha_test.as_ref().is_none_or(|t| t.accepts(triangle, beta, gamma, BLEND_THRESHOLD));
+    let filter: Option<&(dyn Fn(u32, f32, f32) -> bool + Sync)> = alpha_test.is_some().then_some(&accept);
 
     let mut output = PartialFile::create(&out)?;
     let mut hits = Vec::with_capacity(CHUNK_RAYS);
@@ -72,7 +73,7 @@ pub(crate) fn run(args: &TraceArgs) -> Result<()> {
         eprintln!(
             "alpha  {materials} of {} materials have cut-outs: {}",
             scene.materials.len(),
-            if cut_outs {
+            if alpha_test.is_some() {
                 "rays pass through their holes (blended ones where alpha is at most 0.5); --no-alpha traces them solid"
             } else {
                 "traced solid (--no-alpha)"

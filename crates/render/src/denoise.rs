@@ -38,6 +38,7 @@ use rtgi_image::HdrImage;
 use rtgi_math::{Rng, Vec2, Vec3, luminance};
 use rtgi_scene::{Camera, Scene};
 
+use crate::alpha::AlphaTest;
 use crate::effects::{Effect, EffectPlan};
 use crate::shade::{albedo, closest_hit, emission, shading_normal};
 use crate::{Accumulation, CameraRays, PassControl, RenderIdentity, RenderSettings, render_pass};
@@ -127,6 +128,7 @@ impl Guides {
     pub fn render<A: Accel + ?Sized>(scene: &Scene, accel: &A, camera: &Camera, settings: &RenderSettings) -> Guides {
         let plan = EffectPlan::new(scene, settings);
         let (alpha, textures) = (plan.has(Effect::Alpha), plan.has(Effect::Textures));
+        let cut_outs = alpha.then(|| AlphaTest::new(scene));
         let (width, height) = (settings.width, settings.height);
         let rays = CameraRays::new(camera, width, height);
         let pixels: Vec<[Vec3; 4]> = (0..width as u64 * height as u64)
@@ -139,7 +141,8 @@ impl Guides {
                 for sample in 0..GUIDE_SAMPLES {
                     let offset = Vec2::new((sample % 2) as f32 * 0.5 + 0.25, (sample / 2 % 2) as f32 * 0.5 + 0.25);
                     let ray = rays.ray(x, y, offset);
-                    let Some(hit) = closest_hit(scene, accel, &ray, alpha.then(|| rng.next_f32())) else { continue };
+                    let cut_outs = cut_outs.as_ref().map(|test| (test, rng.next_f32()));
+                    let Some(hit) = closest_hit(accel, &ray, cut_outs) else { continue };
                     sums[0] += albedo(scene, &hit, textures);
                     sums[1] += shading_normal(scene, &hit);
                     sums[2] += Vec3::splat(hit.t * ray.direction.length());

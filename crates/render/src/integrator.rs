@@ -11,10 +11,11 @@ use rtgi_accel::{Accel, Hit};
 use rtgi_math::{Frame, Ray, Rng, SurfacePoint, TriangleShape, Vec2, Vec3, Vec4, luminance};
 use rtgi_scene::{Material, Scene, SurfaceModel, Triangle};
 
+use crate::alpha::AlphaTest;
 use crate::bsdf::{Bsdf, energy_conserving};
 use crate::effects::{Effect, EffectPlan, is_glossy, transmits};
 use crate::lights::{Environment, LightSet};
-use crate::shade::{alpha_accepts, closest_hit};
+use crate::shade::closest_hit;
 use crate::shading_normal::bent_towards_view;
 use crate::{BounceSampling, EffectSet, PathStart, RenderSettings};
 
@@ -194,6 +195,8 @@ pub(crate) struct Transport<'a, A: Accel + ?Sized> {
     normal_maps: bool,
     /// Normal and elongation of every triangle, for the points spawning rays.
     shapes: Vec<TriangleShape>,
+    /// The alpha test of cut-outs, where the plan has them.
+    cut_outs: Option<AlphaTest<'a>>,
 }
 
 /// A surface hit, ready to scatter light.
@@ -251,6 +254,7 @@ impl<'a, A: Accel + ?Sized> Transport<'a, A> {
             glossy: plan.has(Effect::Glossy),
             refraction: plan.has(Effect::Refraction),
             normal_maps: plan.has(Effect::NormalMaps),
+            cut_outs: plan.has(Effect::Alpha).then(|| AlphaTest::new(scene)),
             shapes: scene
                 .triangles
                 .iter()
@@ -259,15 +263,21 @@ impl<'a, A: Accel + ?Sized> Transport<'a, A> {
         }
     }
 
+    /// The alpha test with the sample's number, in loops compiled for cut-outs.
+    #[inline]
+    fn cut_outs<const S: u16>(&self, u_alpha: f32) -> Option<(&AlphaTest<'a>, f32)> {
+        compiled(S, Effect::Alpha).then_some(())?;
+        self.cut_outs.as_ref().map(|test| (test, u_alpha))
+    }
+
     fn closest<const S: u16>(&self, ray: &Ray, u_alpha: f32) -> Option<Hit> {
-        closest_hit(self.scene, self.accel, ray, compiled(S, Effect::Alpha).then_some(u_alpha))
+        closest_hit(self.accel, ray, self.cut_outs::<S>(u_alpha))
     }
 
     fn occluded<const S: u16>(&self, ray: &Ray, u_alpha: f32) -> bool {
-        if compiled(S, Effect::Alpha) {
-            self.accel.occluded_filtered(ray, &|t, b, g| alpha_accepts(self.scene, t, b, g, u_alpha))
-        } else {
-            self.accel.occluded(ray)
+        match self.cut_outs::<S>(u_alpha) {
+            Some((test, u)) => self.accel.occluded_filtered(ray, &|t, b, g| test.accepts(t, b, g, u)),
+            None => self.accel.occluded(ray),
         }
     }
 

@@ -31,6 +31,7 @@ pub struct ReadmeDoctests;
 mod accumulation;
 mod accumulation_file;
 pub mod adaptive;
+mod alpha;
 mod bounce_sampling;
 pub mod bsdf;
 mod camera;
@@ -57,6 +58,7 @@ pub mod view_lighting;
 pub use accumulation::{Accumulation, FIXED_POINT_BITS, MergeError, PartSpan, PixelSum, SAMPLE_LIMIT};
 pub use accumulation_file::{AccumulationFileError, MergeFilesError};
 pub use adaptive::{AdaptiveSampling, render_adaptive};
+pub use alpha::{AlphaTest, alpha_accepts, has_alpha};
 pub use bounce_sampling::BounceSampling;
 pub use camera::CameraRays;
 pub use default_lighting::{ENCLOSED, default_sky, default_sun, room_light, sky_visibility};
@@ -75,7 +77,7 @@ pub use integrator::{DirectStrategy, Integrator, ROULETTE_START};
 pub use lights::{Environment, EnvironmentMap, EnvironmentSpec, EnvironmentSpecError, LightSet};
 pub use regularisation::FilterGlossy;
 pub use sampler::{PixelSample, PixelSampler, VertexNumbers};
-pub use shade::{albedo, alpha_accepts, emission, has_alpha, shade_primary, shading_normal};
+pub use shade::{albedo, emission, shade_primary, shading_normal};
 
 use std::ops::Range;
 use std::time::Instant;
@@ -377,6 +379,7 @@ pub(crate) fn render_sums_of<A: Accel + ?Sized>(
     // The views of the closest hit follow the plan for alpha and textures too.
     let plan = EffectPlan::new(scene, settings);
     let (alpha, textures) = (plan.has(Effect::Alpha), plan.has(Effect::Textures));
+    let cut_outs = alpha.then(|| AlphaTest::new(scene));
     // Camera rays are traced together, a 4×4 block of pixels at a time,
     // unless alpha masks need the filtered query.
     let batch = |rays: &[Ray], hits: &mut [Option<Hit>]| accel.intersect_batch(rays, hits);
@@ -387,7 +390,7 @@ pub(crate) fn render_sums_of<A: Accel + ?Sized>(
             *rays += 1;
             let hit = match start.first_hit {
                 Some(hit) => hit,
-                None => shade::closest_hit(scene, accel, &start.ray, alpha.then(|| rng.next_f32())),
+                None => shade::closest_hit(accel, &start.ray, cut_outs.as_ref().map(|test| (test, rng.next_f32()))),
             };
             match hit {
                 Some(hit) => shade_primary(scene, &start.ray, &hit, textures),
@@ -397,7 +400,7 @@ pub(crate) fn render_sums_of<A: Accel + ?Sized>(
         Integrator::Direct | Integrator::Path => render_transport(scene, accel, &plan, &pass),
         aov => render_samples(&Pass { first_hits: None, ..pass }, |start, rng, rays| {
             *rays += 1;
-            shade::aov(aov, scene, accel, (alpha, textures), &start.ray, rng)
+            shade::aov(aov, scene, accel, (cut_outs.as_ref(), textures), &start.ray, rng)
         }),
     }
     .ok_or(Cancelled)?;

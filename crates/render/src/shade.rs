@@ -1,8 +1,9 @@
 use rtgi_accel::{Accel, Hit, TraversalCounters};
 use rtgi_math::{Ray, Rng, Vec3};
-use rtgi_scene::{AlphaMode, Scene};
+use rtgi_scene::Scene;
 
 use crate::Integrator;
+use crate::alpha::AlphaTest;
 
 /// The part of the light that a surface facing away from the viewer still
 /// reflects in the simple shading, so that such faces stay readable.
@@ -43,12 +44,16 @@ pub fn albedo(scene: &Scene, hit: &Hit, textures: bool) -> Vec3 {
     material.base_color * texture
 }
 
-/// The closest hit of `ray`; with `alpha` set to the sample's uniform
-/// number, surfaces with alpha let it through ([`alpha_accepts`]).
+/// The closest hit of `ray`; with `cut_outs`, the alpha test and the
+/// sample's uniform number, surfaces with alpha let it through.
 #[inline]
-pub(crate) fn closest_hit<A: Accel + ?Sized>(scene: &Scene, accel: &A, ray: &Ray, alpha: Option<f32>) -> Option<Hit> {
-    match alpha {
-        Some(u) => accel.intersect_filtered(ray, &|t, b, g| alpha_accepts(scene, t, b, g, u)),
+pub(crate) fn closest_hit<A: Accel + ?Sized>(
+    accel: &A,
+    ray: &Ray,
+    cut_outs: Option<(&AlphaTest<'_>, f32)>,
+) -> Option<Hit> {
+    match cut_outs {
+        Some((test, u)) => accel.intersect_filtered(ray, &|t, b, g| test.accepts(t, b, g, u)),
         None => accel.intersect(ray),
     }
 }
@@ -59,7 +64,7 @@ pub(crate) fn aov<A: Accel + ?Sized>(
     kind: Integrator,
     scene: &Scene,
     accel: &A,
-    (alpha, textures): (bool, bool),
+    (cut_outs, textures): (Option<&AlphaTest<'_>>, bool),
     ray: &Ray,
     rng: &mut Rng,
 ) -> Vec3 {
@@ -67,7 +72,7 @@ pub(crate) fn aov<A: Accel + ?Sized>(
     let hit = if kind == Integrator::Cost {
         accel.intersect_counted(ray, &mut counters)
     } else {
-        closest_hit(scene, accel, ray, alpha.then(|| rng.next_f32()))
+        closest_hit(accel, ray, cut_outs.map(|test| (test, rng.next_f32())))
     };
     if kind == Integrator::Cost {
         return Vec3::new(counters.nodes_visited as f32, counters.triangles_tested as f32, hit.is_some() as u32 as f32);
@@ -92,37 +97,4 @@ pub fn shading_normal(scene: &Scene, hit: &Hit) -> Vec3 {
         let [a, b, c] = triangle.vertices.map(|v| scene.vertices[v as usize].position);
         (b - a).cross(c - a).normalize_or(Vec3::Z)
     })
-}
-
-/// Whether any material of the scene has alpha that makes holes: masked
-/// or blended surfaces. Renders of scenes without skip the per-hit test.
-pub fn has_alpha(scene: &Scene) -> bool {
-    scene.materials.iter().any(|m| m.alpha_mode != AlphaMode::Opaque)
-}
-
-/// Whether a hit on `triangle` at `(beta, gamma)` counts: masked surfaces
-/// are holes where their alpha (base colour alpha times the texture's) is
-/// below the cutoff; blended surfaces are hit with probability alpha, decided
-/// by comparing it with the sample's uniform number `u` (stochastic
-/// transparency, which averages to the blend over samples).
-pub fn alpha_accepts(scene: &Scene, triangle: u32, beta: f32, gamma: f32, u: f32) -> bool {
-    let triangle = &scene.triangles[triangle as usize];
-    let material = &scene.materials[triangle.material as usize];
-    let alpha = || {
-        // Interpolated once, and one channel read from each texture: this
-        // runs for every candidate hit on a cut-out.
-        let textured = material.base_color_texture.is_some() || material.alpha_texture.is_some();
-        let uv = if textured { scene.interpolate(triangle, beta, gamma, |v| v.uv) } else { Default::default() };
-        let texture = material.base_color_texture.map_or(1.0, |t| scene.textures[t.0 as usize].sample_channel(uv, 3));
-        let mask = material.alpha_texture.map_or(1.0, |t| {
-            let mask = &scene.textures[t.0 as usize];
-            mask.sample_channel(uv, if mask.has_alpha() { 3 } else { 0 })
-        });
-        material.opacity * texture * mask
-    };
-    match material.alpha_mode {
-        AlphaMode::Opaque => true,
-        AlphaMode::Mask { cutoff } => alpha() >= cutoff,
-        AlphaMode::Blend => alpha() > u,
-    }
 }

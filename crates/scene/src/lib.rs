@@ -38,6 +38,7 @@ mod mesh;
 mod mtl;
 pub mod obj;
 mod resolve;
+mod texel_range;
 mod texture;
 
 pub use camera::Camera;

@@ -1,8 +1,10 @@
 use std::ops::{Add, Mul};
 use std::path::Path;
-use std::sync::LazyLock;
+use std::sync::{LazyLock, OnceLock};
 
 use rtgi_math::{Vec2, Vec4};
+
+use crate::texel_range::TexelRanges;
 
 /// The widest and tallest texture read, in texels (16384: four times the
 /// largest textures of the shared scenes; a 16384² RGBA image takes 1 GiB).
@@ -41,6 +43,12 @@ impl Wrap {
     #[inline]
     fn apply(self, i: i64, n: u32) -> u32 {
         let n = n as i64;
+        // Inside the image every mode is the identity; the 64-bit divisions
+        // of `rem_euclid` below cost more than the rest of a bilinear
+        // lookup, which runs for every shaded hit and every cut-out test.
+        if (0..n).contains(&i) {
+            return i as u32;
+        }
         let index = match self {
             Wrap::Repeat => i.rem_euclid(n),
             Wrap::ClampToEdge => i.clamp(0, n - 1),
@@ -70,7 +78,35 @@ pub struct Texture {
     /// Whether any texel is less than fully opaque: asked for every
     /// candidate hit on a cut-out surface, so found once.
     has_alpha: bool,
+    /// Per channel, the range of its bytes over each 2 × 2 block, made when
+    /// [`Texture::channel_bounds`] first asks for that channel.
+    ranges: [LazyRanges; 4],
 }
+
+/// A [`TexelRanges`] made on first use. It is derived from the texels, so
+/// it takes no part in comparing textures.
+#[derive(Clone, Default)]
+struct LazyRanges(OnceLock<TexelRanges>);
+
+impl PartialEq for LazyRanges {
+    fn eq(&self, _: &Self) -> bool {
+        true
+    }
+}
+
+/// Where a bilinear lookup reads: the texels' columns and rows (after the
+/// wrap modes) and the weights of the second of each.
+struct Footprint {
+    columns: [u32; 2],
+    rows: [u32; 2],
+    fx: f32,
+    fy: f32,
+}
+
+/// A bilinear value's relative rounding error is below 7 units in the
+/// last place (three products and sums per axis, and `1 - f`); bounds
+/// from the texels' range are widened by this factor to cover it.
+const FILTER_ROUNDING: f32 = 1.0 / (1 << 20) as f32;
 
 impl std::fmt::Debug for Texture {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
@@ -107,6 +143,7 @@ impl Texture {
             texels,
             encoding,
             wrap: [Wrap::Repeat; 2],
+            ranges: Default::default(),
         })
     }
 
@@ -163,6 +200,7 @@ impl Texture {
             encoding: ColorEncoding::Srgb,
             wrap: [Wrap::Repeat; 2],
             has_alpha: false,
+            ranges: Default::default(),
         }
     }
 
@@ -214,13 +252,32 @@ impl Texture {
     /// alpha), with the same bits, for lookups that need no more: the alpha
     /// test of a cut-out runs for every candidate hit.
     pub fn sample_channel(&self, uv: Vec2, channel: usize) -> f32 {
-        self.filtered(uv, |x, y| {
-            let byte = self.texels[(y * self.width + x) as usize][channel];
-            match self.encoding {
-                ColorEncoding::Srgb if channel < 3 => SRGB_TO_LINEAR[byte as usize],
-                ColorEncoding::Srgb | ColorEncoding::Linear => byte as f32 * (1.0 / 255.0),
-            }
-        })
+        self.filtered(uv, |x, y| self.decode_channel(self.texels[(y * self.width + x) as usize][channel], channel))
+    }
+
+    /// Bounds `(low, high)` on [`Texture::sample_channel`]`(uv, channel)`,
+    /// read from one entry of a table of the channel's range over each 2 × 2
+    /// block of texels (made on first use) instead of four texels: where
+    /// the texels around `uv` are all alike (a cut-out's wholly opaque or wholly clear
+    /// parts), the bounds are as good as the value. `None` where `uv` is
+    /// not finite.
+    pub fn channel_bounds(&self, uv: Vec2, channel: usize) -> Option<(f32, f32)> {
+        let footprint = self.footprint(uv)?;
+        let ranges = self.ranges[channel].0.get_or_init(|| TexelRanges::of(&self.texels, self.width as usize, channel));
+        let [low, high] = ranges.spanning(footprint.columns, footprint.rows);
+        Some((
+            self.decode_channel(low, channel) * (1.0 - FILTER_ROUNDING),
+            self.decode_channel(high, channel) * (1.0 + FILTER_ROUNDING),
+        ))
+    }
+
+    /// The linear value of one byte of channel `channel`.
+    #[inline(always)]
+    fn decode_channel(&self, byte: u8, channel: usize) -> f32 {
+        match self.encoding {
+            ColorEncoding::Srgb if channel < 3 => SRGB_TO_LINEAR[byte as usize],
+            ColorEncoding::Srgb | ColorEncoding::Linear => byte as f32 * (1.0 / 255.0),
+        }
     }
 
     /// The linear value at `uv` (origin top left, one repeat per unit), bilinearly filtered.
@@ -228,20 +285,32 @@ impl Texture {
         self.filtered(uv, |x, y| self.texel(x, y))
     }
 
-    /// Bilinear filtering of the values `texel(x, y)` around `uv`, with the wrap modes.
+    /// The texels a bilinear lookup at `uv` blends, with the wrap modes;
+    /// `None` where `uv` is not finite.
     #[inline(always)]
-    fn filtered<T: Copy + Mul<f32, Output = T> + Add<Output = T>>(&self, uv: Vec2, texel: impl Fn(u32, u32) -> T) -> T {
+    fn footprint(&self, uv: Vec2) -> Option<Footprint> {
         if !uv.is_finite() {
-            return texel(0, 0);
+            return None;
         }
         // Texel centres sit at half-integer positions.
         let x = uv.x * self.width as f32 - 0.5;
         let y = uv.y * self.height as f32 - 0.5;
         let (x0, y0) = (x.floor(), y.floor());
-        let (fx, fy) = (x - x0, y - y0);
         let [wrap_u, wrap_v] = self.wrap;
-        let (xa, xb) = (wrap_u.apply(x0 as i64, self.width), wrap_u.apply(x0 as i64 + 1, self.width));
-        let (ya, yb) = (wrap_v.apply(y0 as i64, self.height), wrap_v.apply(y0 as i64 + 1, self.height));
+        Some(Footprint {
+            columns: [wrap_u.apply(x0 as i64, self.width), wrap_u.apply(x0 as i64 + 1, self.width)],
+            rows: [wrap_v.apply(y0 as i64, self.height), wrap_v.apply(y0 as i64 + 1, self.height)],
+            fx: x - x0,
+            fy: y - y0,
+        })
+    }
+
+    /// Bilinear filtering of the values `texel(x, y)` around `uv`, with the wrap modes.
+    #[inline(always)]
+    fn filtered<T: Copy + Mul<f32, Output = T> + Add<Output = T>>(&self, uv: Vec2, texel: impl Fn(u32, u32) -> T) -> T {
+        let Some(Footprint { columns: [xa, xb], rows: [ya, yb], fx, fy }) = self.footprint(uv) else {
+            return texel(0, 0);
+        };
         let top = texel(xa, ya) * (1.0 - fx) + texel(xb, ya) * fx;
         let bottom = texel(xa, yb) * (1.0 - fx) + texel(xb, yb) * fx;
         top * (1.0 - fy) + bottom * fy
@@ -317,5 +386,50 @@ mod tests {
                 }
             }
         }
+    }
+
+    #[test]
+    fn channel_bounds_hold_every_lookup_and_are_tight_where_texels_agree() {
+        // Alpha: a clear block, an opaque block and noise between; red noise.
+        let (width, height) = (13u32, 9u32);
+        let texels: Vec<[u8; 4]> = (0..width * height)
+            .map(|i| {
+                let x = i % width;
+                let alpha = if x < 4 {
+                    0
+                } else if x > 8 {
+                    255
+                } else {
+                    (i * 97 % 256) as u8
+                };
+                [(i * 37 % 256) as u8, 0, 0, alpha]
+            })
+            .collect();
+        let wraps = [Wrap::Repeat, Wrap::ClampToEdge, Wrap::MirroredRepeat];
+        let mut decided = [0, 0];
+        for encoding in [ColorEncoding::Srgb, ColorEncoding::Linear] {
+            for (u_wrap, v_wrap) in wraps.iter().flat_map(|u| wraps.iter().map(move |v| (*u, *v))) {
+                let t = Texture::from_rgba8("t", width, height, texels.clone(), encoding)
+                    .unwrap()
+                    .with_wrap(u_wrap, v_wrap);
+                for k in 0..3000 {
+                    let uv = Vec2::new(k as f32 * 0.0137 - 7.0, (k * 7 % 3000) as f32 * 0.0091 - 11.0);
+                    for channel in [0, 3] {
+                        let value = t.sample_channel(uv, channel);
+                        let (low, high) = t.channel_bounds(uv, channel).unwrap();
+                        assert!(low <= value && value <= high, "{encoding:?} {u_wrap:?} {v_wrap:?} {uv} {channel}");
+                        if channel == 3 && high == 0.0 {
+                            decided[0] += 1;
+                        }
+                        if channel == 3 && low > 0.99 {
+                            decided[1] += 1;
+                        }
+                    }
+                }
+            }
+        }
+        // The clear and the opaque blocks are decided from their bounds alone.
+        assert!(decided[0] > 3000 && decided[1] > 3000, "{decided:?}");
+        assert_eq!(two_by_one().channel_bounds(Vec2::new(f32::NAN, 0.5), 0), None);
     }
 }

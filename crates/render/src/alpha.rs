@@ -1,0 +1,214 @@
+//! Cut-outs: which hits on surfaces with alpha count.
+//!
+//! The test runs for every candidate hit on such a surface, inside the
+//! traversal, so its cost is that of the memory it reads. [`alpha_accepts`]
+//! reads the scene as it is: the triangle, its three vertices (in lines of
+//! their own, far apart in a large scene) and four texels of each texture.
+//! [`AlphaTest`] answers the same, bit for bit, from what it prepared: one
+//! 32-byte entry a triangle with its corners' texture coordinates and its
+//! material, and the textures' bounds around the hit
+//! ([`Texture::channel_bounds`]), which decide wherever the texels around
+//! it are all opaque or all clear; only at a hole's rim are texels filtered.
+
+use rtgi_math::Vec2;
+use rtgi_scene::{AlphaMode, Material, Scene, Texture};
+
+/// Whether any material of the scene has alpha that makes holes: masked
+/// or blended surfaces. Renders of scenes without skip the per-hit test.
+pub fn has_alpha(scene: &Scene) -> bool {
+    scene.materials.iter().any(|m| m.alpha_mode != AlphaMode::Opaque)
+}
+
+/// Whether a hit on `triangle` at `(beta, gamma)` counts: masked surfaces
+/// are holes where their alpha (base colour alpha times the texture's) is
+/// below the cutoff; blended surfaces are hit with probability alpha, decided
+/// by comparing it with the sample's uniform number `u` (stochastic
+/// transparency, which averages to the blend over samples).
+///
+/// For one test, or as the definition; tracing many rays, prepare an
+/// [`AlphaTest`], which answers the same with less memory traffic.
+pub fn alpha_accepts(scene: &Scene, triangle: u32, beta: f32, gamma: f32, u: f32) -> bool {
+    let triangle = &scene.triangles[triangle as usize];
+    let material = &scene.materials[triangle.material as usize];
+    decide(scene, material, u, || scene.interpolate(triangle, beta, gamma, |v| v.uv))
+}
+
+/// [`alpha_accepts`] prepared for a scene: the corners' texture
+/// coordinates and the material of every triangle, side by side.
+#[derive(Debug)]
+pub struct AlphaTest<'a> {
+    scene: &'a Scene,
+    /// A bit a triangle: whether its material has alpha. Most candidate
+    /// hits are on opaque surfaces, and these bits (a 64th of `triangles`)
+    /// stay in the cache.
+    with_alpha: Vec<u64>,
+    triangles: Vec<AlphaTriangle>,
+}
+
+/// What the alpha test reads of one triangle, in half a cache line.
+#[derive(Clone, Copy, Debug)]
+#[repr(C, align(32))]
+struct AlphaTriangle {
+    uv: [Vec2; 3],
+    material: u32,
+}
+
+impl<'a> AlphaTest<'a> {
+    /// The test for `scene`'s triangles as they are now.
+    pub fn new(scene: &'a Scene) -> Self {
+        let triangles = scene
+            .triangles
+            .iter()
+            .map(|t| AlphaTriangle { uv: t.vertices.map(|v| scene.vertices[v as usize].uv), material: t.material })
+            .collect();
+        let mut with_alpha = vec![0u64; scene.triangles.len().div_ceil(64)];
+        for (i, t) in scene.triangles.iter().enumerate() {
+            if scene.materials[t.material as usize].alpha_mode != AlphaMode::Opaque {
+                with_alpha[i / 64] |= 1 << (i % 64);
+            }
+        }
+        Self { scene, with_alpha, triangles }
+    }
+
+    /// [`alpha_accepts`]`(scene, triangle, beta, gamma, u)`, with the same answer.
+    #[inline]
+    pub fn accepts(&self, triangle: u32, beta: f32, gamma: f32, u: f32) -> bool {
+        let i = triangle as usize;
+        if self.with_alpha[i / 64] & (1 << (i % 64)) == 0 {
+            return true;
+        }
+        let AlphaTriangle { uv: [a, b, c], material } = self.triangles[triangle as usize];
+        let material = &self.scene.materials[material as usize];
+        // The arithmetic of `Scene::interpolate`, for the same bits.
+        decide(self.scene, material, u, || a * (1.0 - beta - gamma) + b * beta + c * gamma)
+    }
+}
+
+/// Whether `material` at the texture coordinates `uv()` counts as hit for
+/// the uniform number `u`.
+#[inline(always)]
+fn decide(scene: &Scene, material: &Material, u: f32, uv: impl FnOnce() -> Vec2) -> bool {
+    // Both modes accept from a threshold up, so bounds that fall on one
+    // side of it decide.
+    let accepts = |alpha: f32| match material.alpha_mode {
+        AlphaMode::Opaque => true,
+        AlphaMode::Mask { cutoff } => alpha >= cutoff,
+        AlphaMode::Blend => alpha > u,
+    };
+    if material.alpha_mode == AlphaMode::Opaque {
+        return true;
+    }
+    let (base, mask) = (material.base_color_texture, material.alpha_texture);
+    if base.is_none() && mask.is_none() {
+        return accepts(material.opacity);
+    }
+    // Interpolated once, and one channel read from each texture.
+    let uv = uv();
+    let base = base.map(|t| (&scene.textures[t.0 as usize], 3));
+    let mask = mask.map(|t| {
+        let mask = &scene.textures[t.0 as usize];
+        (mask, if mask.has_alpha() { 3 } else { 0 })
+    });
+    let bounds = |lookup: Option<(&Texture, usize)>| lookup.map_or(Some((1.0, 1.0)), |(t, c)| t.channel_bounds(uv, c));
+    if let (Some((base_low, base_high)), Some((mask_low, mask_high))) = (bounds(base), bounds(mask))
+        && (0.0..=f32::MAX).contains(&material.opacity)
+    {
+        // The value's two products below round by at most an ulp each.
+        let low = material.opacity * base_low * mask_low * (1.0 - 4.0 * f32::EPSILON);
+        let high = material.opacity * base_high * mask_high * (1.0 + 4.0 * f32::EPSILON);
+        let (low_accepted, high_accepted) = (accepts(low), accepts(high));
+        if low_accepted == high_accepted {
+            return low_accepted;
+        }
+    }
+    let value = |lookup: Option<(&Texture, usize)>| lookup.map_or(1.0, |(t, c)| t.sample_channel(uv, c));
+    accepts(material.opacity * value(base) * value(mask))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use rtgi_math::{Vec3, Vec4};
+    use rtgi_scene::{ColorEncoding, TextureId, Triangle, Vertex, Wrap};
+
+    /// The filtered value's test, as it was before bounds decided: the definition.
+    fn filtered(scene: &Scene, triangle: u32, beta: f32, gamma: f32, u: f32) -> bool {
+        let triangle = &scene.triangles[triangle as usize];
+        let material = &scene.materials[triangle.material as usize];
+        let uv = scene.interpolate(triangle, beta, gamma, |v| v.uv);
+        let texture = material.base_color_texture.map_or(1.0, |t| scene.textures[t.0 as usize].sample_channel(uv, 3));
+        let mask = material.alpha_texture.map_or(1.0, |t| {
+            let mask = &scene.textures[t.0 as usize];
+            mask.sample_channel(uv, if mask.has_alpha() { 3 } else { 0 })
+        });
+        let alpha = material.opacity * texture * mask;
+        match material.alpha_mode {
+            AlphaMode::Opaque => true,
+            AlphaMode::Mask { cutoff } => alpha >= cutoff,
+            AlphaMode::Blend => alpha > u,
+        }
+    }
+
+    #[test]
+    fn bounds_and_the_prepared_test_answer_as_the_filtered_value() {
+        // A texture of clear and opaque blocks with rims of every value,
+        // and a grey mask without alpha; cutoffs and opacities at and
+        // between texel values, where rounding decides.
+        let (width, height) = (16u32, 16u32);
+        let texels: Vec<[u8; 4]> = (0..width * height)
+            .map(|i| {
+                let (x, y) = (i % width, i / width);
+                let alpha = match (x / 4 + y / 4) % 3 {
+                    0 => 0,
+                    1 => 255,
+                    _ => (i * 61 % 256) as u8,
+                };
+                [(i * 29 % 256) as u8, 0, 0, alpha]
+            })
+            .collect();
+        let mut scene = Scene::default();
+        scene.textures.push(Texture::from_rgba8("alpha", width, height, texels.clone(), ColorEncoding::Srgb).unwrap());
+        let grey = texels.iter().map(|t| [t[0], t[0], t[0], 255]).collect();
+        scene.textures.push(
+            Texture::from_rgba8("mask", width, height, grey, ColorEncoding::Srgb)
+                .unwrap()
+                .with_wrap(Wrap::MirroredRepeat, Wrap::ClampToEdge),
+        );
+        let modes = [AlphaMode::Mask { cutoff: 0.5 }, AlphaMode::Mask { cutoff: 128.0 / 255.0 }, AlphaMode::Blend];
+        for alpha_mode in modes {
+            for (base, mask) in [(Some(0), None), (None, Some(1)), (Some(0), Some(1)), (None, None)] {
+                for opacity in [1.0, 0.5, 1.0 / 3.0, 0.0] {
+                    scene.materials.push(Material {
+                        alpha_mode,
+                        opacity,
+                        base_color_texture: base.map(TextureId),
+                        alpha_texture: mask.map(TextureId),
+                        ..Material::default()
+                    });
+                }
+            }
+        }
+        // One triangle per material, spanning a few repeats of the textures.
+        for (m, _) in scene.materials.iter().enumerate() {
+            let first = scene.vertices.len() as u32;
+            for uv in [Vec2::new(-1.3, -0.7), Vec2::new(2.1, -0.2), Vec2::new(0.4, 1.9)] {
+                scene.vertices.push(Vertex { position: Vec3::ZERO, normal: Vec3::Z, uv, tangent: Vec4::X });
+            }
+            scene.triangles.push(Triangle { vertices: [first, first + 1, first + 2], material: m as u32 });
+        }
+        let prepared = AlphaTest::new(&scene);
+        let mut counts = [0usize; 2];
+        for triangle in 0..scene.triangles.len() as u32 {
+            for k in 0..4000u32 {
+                let beta = (k % 61) as f32 / 61.0 * 0.97;
+                let gamma = (k / 61) as f32 / 66.0 * (1.0 - beta);
+                let u = (k * 7919 % 4001) as f32 / 4001.0;
+                let expected = filtered(&scene, triangle, beta, gamma, u);
+                assert_eq!(alpha_accepts(&scene, triangle, beta, gamma, u), expected, "{triangle} {beta} {gamma} {u}");
+                assert_eq!(prepared.accepts(triangle, beta, gamma, u), expected, "{triangle} {beta} {gamma} {u}");
+                counts[expected as usize] += 1;
+            }
+        }
+        assert!(counts[0] > 10_000 && counts[1] > 10_000, "{counts:?}");
+    }
+}
