@@ -248,3 +248,31 @@ fn of_two_file_cameras_the_one_that_sees_the_model_is_used_at_its_aspect_ratio()
     assert!(run.success && !run.stderr.contains("note: the view is"), "{run:?}");
     assert_eq!(image::image_dimensions(&out).unwrap(), (64, 512));
 }
+
+#[test]
+fn the_automatic_view_says_which_view_it_took_and_a_given_one_does_not() {
+    let dir = scratch_dir("automatic-view");
+    // A model without a camera: a cube of one material, alike from every side.
+    let model = dir.join("cube.obj");
+    let cube = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 0 1\nv 1 0 1\nv 1 1 1\nv 0 1 1\n\
+                f 1 4 3 2\nf 5 6 7 8\nf 1 2 6 5\nf 4 8 7 3\nf 1 5 8 4\nf 2 3 7 6\n";
+    std::fs::write(&model, cube).unwrap();
+    let render = |extra: &[&str]| {
+        let out = dir.join("cube.png");
+        let mut args = vec!["render", path_str(&model), "-o", path_str(&out), "--width", "24", "--height", "24"];
+        args.extend(["--spp", "1"]);
+        args.extend(extra);
+        rtgi(&args)
+    };
+    let run = render(&[]);
+    assert!(run.success, "{run:?}");
+    let note = "note: the automatic view is a three-quarter shot of the model's front, from +Z and above; --at (and \
+                --look) choose another";
+    assert!(run.stderr.contains(note), "{run:?}");
+    // A field of view keeps the automatic view; a position or a target replaces it.
+    assert!(render(&["--fov", "30"]).stderr.contains(note));
+    for given in [&["--at", "2,2,2"][..], &["--look", "0,0.2,0"][..]] {
+        let run = render(given);
+        assert!(run.success && !run.stderr.contains("automatic view"), "{given:?}: {run:?}");
+    }
+}

@@ -146,6 +146,9 @@ pub(crate) fn report_camera(chosen: &ChosenCamera, phrasing: Phrasing) {
     if let Some(choice) = &chosen.file_choice {
         eprintln!("note: the view is {choice}");
     }
+    if let Some(view) = &chosen.automatic_view {
+        eprintln!("note: the automatic view is {view}; {} choose another", phrasing.move_camera());
+    }
     if let Some(share) = chosen.up.base_share {
         eprintln!(
             "note: {} is up: the model stands on a flat base facing {} ({:.1}% of its surface) and has none across \

@@ -110,10 +110,22 @@ pub fn frame_scene<A: Accel + ?Sized>(scene: &Scene, accel: &A, vertical_fov: f3
 /// every "above", "side" and "front" of the views turns with it, +Z up
 /// putting the front at −Y ([`crate::up_axis::turned_up`]).
 pub fn frame_scene_up<A: Accel + ?Sized>(scene: &Scene, accel: &A, vertical_fov: f32, aspect: f32, up: Vec3) -> Camera {
+    frame_scene_explained(scene, accel, vertical_fov, aspect, up).0
+}
+
+/// [`frame_scene_up`], and which of its views it took and why (what `rtgi
+/// render` says of an automatic view).
+pub fn frame_scene_explained<A: Accel + ?Sized>(
+    scene: &Scene,
+    accel: &A,
+    vertical_fov: f32,
+    aspect: f32,
+    up: Vec3,
+) -> (Camera, AutomaticView) {
     let axes = Axes::new(up);
     let bounds = scene.bounds();
-    if let Some(view) = flat_view(scene, accel, &bounds, vertical_fov, aspect) {
-        return view;
+    if let Some((view, from)) = flat_view(scene, accel, &bounds, vertical_fov, aspect) {
+        return (view, AutomaticView::Flat { from });
     }
     let framing = Camera::framing(&bounds, vertical_fov, aspect);
     let centre = framing.position + framing.direction;
@@ -140,24 +152,177 @@ pub fn frame_scene_up<A: Accel + ?Sized>(scene: &Scene, accel: &A, vertical_fov:
         &three_quarter_view_from(&bounds, vertical_fov, aspect, 0, &axes, long_side_first),
         aspect,
     );
-    let product = best_side(scene, accel, product, vertical_fov, aspect, &axes);
+    let (product, side, reason) = best_side(scene, accel, product, vertical_fov, aspect, &axes);
+    let product_from = side_facing(&bounds, side.quarter(), &axes, long_side_first);
     // A room closed on all sides is seen from a corner; an open courtyard
     // keeps the views that show its sky.
     let enclosed = crate::sky_visibility(accel, centre) < crate::ENCLOSED;
     let corners = if enclosed { room_corner_views(&bounds, vertical_fov, &axes).to_vec() } else { Vec::new() };
 
-    let mut best: Option<(Camera, usize)> = None;
-    for candidate in [product, front, above, inside].into_iter().chain(corners) {
+    let product_view = AutomaticView::Product { from: product_from, side, reason };
+    let candidates = [
+        (product, product_view),
+        (front, AutomaticView::StraightOn { from: axes.front }),
+        (above, AutomaticView::FromAbove { from: axes.front }),
+        (inside, AutomaticView::Inside { along: along_room }),
+    ];
+    let corners = corners.into_iter().map(|corner| (corner, AutomaticView::RoomCorner));
+    let mut best: Option<(Camera, AutomaticView, usize)> = None;
+    for (candidate, view) in candidates.into_iter().chain(corners) {
         if camera_blocked(scene, accel, &candidate, aspect).is_some() {
             continue;
         }
         let shown = materials_shown(scene, accel, &candidate, aspect);
-        if best.is_none_or(|(_, most)| shown > most) {
-            best = Some((candidate, shown));
+        if best.is_none_or(|(_, _, most)| shown > most) {
+            best = Some((candidate, view, shown));
         }
     }
     // Every view blocked (a scene that is one solid): the product shot, from outside the bounds.
-    best.map_or(product, |(camera, _)| camera)
+    best.map_or((product, product_view), |(camera, view, _)| (camera, view))
+}
+
+/// Which of [`frame_scene`]'s views was taken, and why; its `Display`
+/// is the sentence `rtgi render` prints.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum AutomaticView {
+    /// A flat model seen straight on, from `from` (a unit axis).
+    Flat {
+        /// Where the camera is, from the model: a unit axis.
+        from: Vec3,
+    },
+    /// The three-quarter product shot.
+    Product {
+        /// The horizontal direction from the model towards the side it is shot from.
+        from: Vec3,
+        /// Which side of the model that is.
+        side: ModelSide,
+        /// Why that side.
+        reason: SideReason,
+    },
+    /// The bounds seen straight on from the front (into a box).
+    StraightOn {
+        /// The direction from the model towards the camera.
+        from: Vec3,
+    },
+    /// From the front and 35 degrees above (into a courtyard).
+    FromAbove {
+        /// The horizontal direction from the model towards the camera.
+        from: Vec3,
+    },
+    /// From the middle of the bounds (a closed room), looking along `along`.
+    Inside {
+        /// The direction the camera looks in.
+        along: Vec3,
+    },
+    /// From an upper corner of a closed room, across its floor.
+    RoomCorner,
+}
+
+/// A side of a model, turned from its front (+Z for a +Y-up model, or its
+/// long side for a long model of several materials) about its up.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ModelSide {
+    /// The front.
+    Front,
+    /// A quarter turn from the front: its side towards +X for a +Y-up model.
+    Side,
+    /// The back.
+    Back,
+    /// Three quarter turns from the front: its other side.
+    OtherSide,
+}
+
+impl ModelSide {
+    const ALL: [ModelSide; 4] = [ModelSide::Front, ModelSide::Side, ModelSide::Back, ModelSide::OtherSide];
+
+    /// Quarter turns from the front.
+    fn quarter(self) -> u32 {
+        ModelSide::ALL.iter().position(|s| *s == self).unwrap_or(0) as u32
+    }
+}
+
+/// Why the product shot is taken from the side it is.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum SideReason {
+    /// The front: no other side shows more.
+    Front,
+    /// That side shows more of the model's materials than the front.
+    Materials {
+        /// Materials that side shows.
+        shown: usize,
+        /// Materials the front shows.
+        front: usize,
+    },
+    /// A model of one material: that side shows `ratio` times the front's
+    /// surface detail (at least [`SIDE_DETAIL_MARGIN`]).
+    Detail {
+        /// That side's detail over the front's.
+        ratio: f32,
+    },
+}
+
+impl std::fmt::Display for AutomaticView {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        const MOST: &str = "which shows the most of the scene's materials";
+        match *self {
+            AutomaticView::Flat { from } => write!(
+                f,
+                "straight on from {}: the model is flat (a cut-out or a drawing)",
+                crate::up_axis::axis_name(from)
+            ),
+            AutomaticView::Product { from, side, reason } => {
+                write!(
+                    f,
+                    "a three-quarter shot of the model's {}, from {} and above",
+                    side.name(),
+                    direction_name(from)
+                )?;
+                match reason {
+                    SideReason::Front => Ok(()),
+                    SideReason::Materials { shown, front } => {
+                        write!(f, ": it shows {shown} of the model's materials, its front {front}")
+                    }
+                    SideReason::Detail { ratio } => {
+                        // A plain front (flat faces square to the view) shows next to no detail.
+                        if ratio < 100.0 {
+                            write!(f, ": it shows {ratio:.2} times the surface detail of its front")?;
+                        } else {
+                            write!(f, ": it shows surface detail where its front shows almost none")?;
+                        }
+                        write!(f, " (a model of one material is shown from its most detailed side)")
+                    }
+                }
+            }
+            AutomaticView::StraightOn { from } => {
+                write!(f, "straight into the bounds from {}, {MOST}", direction_name(from))
+            }
+            AutomaticView::FromAbove { from } => {
+                write!(f, "from {} and 35 degrees above, {MOST}", direction_name(from))
+            }
+            AutomaticView::Inside { along } => {
+                write!(f, "from the middle of the scene, looking along {}, {MOST}", direction_name(along))
+            }
+            AutomaticView::RoomCorner => write!(f, "from an upper corner of the closed room, looking across its floor"),
+        }
+    }
+}
+
+impl ModelSide {
+    fn name(self) -> &'static str {
+        match self {
+            ModelSide::Front => "front",
+            ModelSide::Back => "back",
+            ModelSide::Side | ModelSide::OtherSide => "side",
+        }
+    }
+}
+
+/// An axis's name (`+X`), or the nearest axis's for a direction off the axes.
+fn direction_name(direction: Vec3) -> String {
+    let axis = (0..3).max_by(|&a, &b| direction[a].abs().total_cmp(&direction[b].abs())).unwrap_or(2);
+    let mut nearest = Vec3::ZERO;
+    nearest[axis] = direction[axis].signum();
+    crate::up_axis::axis_name(nearest)
 }
 
 /// A flat model (a cut-out, a drawing: its bounds at most
@@ -171,7 +336,7 @@ fn flat_view<A: Accel + ?Sized>(
     bounds: &Aabb,
     vertical_fov: f32,
     aspect: f32,
-) -> Option<Camera> {
+) -> Option<(Camera, Vec3)> {
     if bounds.is_empty() {
         return None;
     }
@@ -187,7 +352,7 @@ fn flat_view<A: Accel + ?Sized>(
     let centre = bounds.centroid();
     let straight = Camera::look_at(centre + towards_camera * distance, centre, up, vertical_fov);
     let view = framed_tightly(scene, &straight, aspect);
-    camera_blocked(scene, accel, &view, aspect).is_none().then_some(view)
+    camera_blocked(scene, accel, &view, aspect).is_none().then_some((view, towards_camera))
 }
 
 /// Views from inside the four upper corners of `bounds`, each looking
@@ -255,36 +420,61 @@ fn best_side<A: Accel + ?Sized>(
     vertical_fov: f32,
     aspect: f32,
     axes: &Axes,
-) -> Camera {
+) -> (Camera, ModelSide, SideReason) {
     let bounds = scene.bounds();
-    let others: Vec<Camera> = [2, 1, 3]
+    let others: Vec<(Camera, ModelSide)> = [ModelSide::Back, ModelSide::Side, ModelSide::OtherSide]
         .into_iter()
-        .map(|quarter| {
-            let view = three_quarter_view_from(&bounds, vertical_fov, aspect, quarter, axes, scene.materials.len() > 1);
-            framed_tightly(scene, &view, aspect)
+        .map(|side| {
+            let view =
+                three_quarter_view_from(&bounds, vertical_fov, aspect, side.quarter(), axes, scene.materials.len() > 1);
+            (framed_tightly(scene, &view, aspect), side)
         })
-        .filter(|view| camera_blocked(scene, accel, view, aspect).is_none())
+        .filter(|(view, _)| camera_blocked(scene, accel, view, aspect).is_none())
         .collect();
     let front_materials = materials_shown(scene, accel, &front, aspect);
-    let materials: Vec<usize> = others.iter().map(|view| materials_shown(scene, accel, view, aspect)).collect();
+    let materials: Vec<usize> = others.iter().map(|(view, _)| materials_shown(scene, accel, view, aspect)).collect();
     if scene.materials.len() > 1 || materials.iter().any(|&m| m != front_materials) {
-        let mut best = (front, front_materials);
-        for (view, shown) in others.into_iter().zip(materials) {
-            if shown > best.1 {
-                best = (view, shown);
+        let mut best = (front, ModelSide::Front, front_materials);
+        for ((view, side), shown) in others.into_iter().zip(materials) {
+            if shown > best.2 {
+                best = (view, side, shown);
             }
         }
-        return best.0;
+        let (view, side, shown) = best;
+        let reason = if side == ModelSide::Front {
+            SideReason::Front
+        } else {
+            SideReason::Materials { shown, front: front_materials }
+        };
+        return (view, side, reason);
     }
     let front_detail = detail_shown(scene, accel, &front, aspect);
-    let mut best = (front, SIDE_DETAIL_MARGIN * front_detail);
-    for view in others {
+    let mut best = (front, ModelSide::Front, SIDE_DETAIL_MARGIN * front_detail);
+    for (view, side) in others {
         let detail = detail_shown(scene, accel, &view, aspect);
-        if detail > best.1 {
-            best = (view, detail);
+        if detail > best.2 {
+            best = (view, side, detail);
         }
     }
-    best.0
+    let (view, side, detail) = best;
+    let reason =
+        if side == ModelSide::Front { SideReason::Front } else { SideReason::Detail { ratio: detail / front_detail } };
+    (view, side, reason)
+}
+
+/// The horizontal direction from the model towards its side turned
+/// `quarter` quarter turns from its front (see [`three_quarter_view_from`]).
+fn side_facing(bounds: &Aabb, quarter: u32, axes: &Axes, long_side_first: bool) -> Vec3 {
+    // Long from front to back: its side is its face (a vehicle).
+    let along = axes.extent(bounds);
+    let facing = if long_side_first && along.z > 1.5 * along.x { axes.side } else { axes.front };
+    let turned = axes.up.cross(facing);
+    match quarter % 4 {
+        0 => facing,
+        1 => turned,
+        2 => -facing,
+        _ => -turned,
+    }
 }
 
 /// [`three_quarter_view`] from the model's front turned `quarter` quarter
@@ -303,16 +493,7 @@ fn three_quarter_view_from(
         (bounds.centroid(), bounds.extent().max(Vec3::splat(1e-6)))
     };
     let (azimuth, elevation) = (THREE_QUARTER_AZIMUTH.to_radians(), THREE_QUARTER_ELEVATION.to_radians());
-    // Long from front to back: its side is its face (a vehicle).
-    let along = axes.extent(bounds);
-    let facing = if long_side_first && along.z > 1.5 * along.x { axes.side } else { axes.front };
-    let turned = axes.up.cross(facing);
-    let front = match quarter % 4 {
-        0 => facing,
-        1 => turned,
-        2 => -facing,
-        _ => -turned,
-    };
+    let front = side_facing(bounds, quarter, axes, long_side_first);
     let side = axes.up.cross(front);
     let horizontal = front * azimuth.cos() + side * azimuth.sin();
     let towards_camera = horizontal * elevation.cos() + axes.up * elevation.sin();
@@ -641,9 +822,11 @@ mod tests {
                 }
             }
             let accel = AccelKind::Sah.build(&scene.triangle_positions(), &BuildParams::default());
-            let camera = frame_scene(&scene, accel.as_ref(), 40f32.to_radians(), 1.0);
+            let (camera, view) = frame_scene_explained(&scene, accel.as_ref(), 40f32.to_radians(), 1.0, Vec3::Y);
             let from = (camera.position - scene.bounds().centroid()).normalize();
             assert!(from.dot(towards) > 0.999, "lying {lying}: seen from {from}");
+            assert_eq!(view, AutomaticView::Flat { from: towards });
+            assert!(view.to_string().contains("the model is flat"), "{view}");
         }
     }
 
@@ -672,13 +855,26 @@ mod tests {
             let scene = statue(detailed);
             assert_eq!(scene.materials.len(), 1);
             let accel = AccelKind::Sah.build(&scene.triangle_positions(), &BuildParams::default());
-            let camera = frame_scene(&scene, accel.as_ref(), 40f32.to_radians(), 1.0);
+            let (camera, view) = frame_scene_explained(&scene, accel.as_ref(), 40f32.to_radians(), 1.0, Vec3::Y);
             let offset = camera.position - scene.bounds().centroid();
             assert!(offset.y > 0.0 && offset.x.abs() > 0.1, "a three-quarter view from above: {offset}");
+            // What `rtgi render` says of the view names the side and why.
+            let said = view.to_string();
             if detailed {
                 assert!(offset.z < 0.0, "the detailed front faces -Z, the camera is at {offset}");
+                let AutomaticView::Product { from, side: ModelSide::Back, reason: SideReason::Detail { ratio } } = view
+                else {
+                    panic!("{view:?}")
+                };
+                assert!(from == Vec3::NEG_Z && ratio >= SIDE_DETAIL_MARGIN, "{view:?}");
+                assert!(said.starts_with("a three-quarter shot of the model's back, from -Z"), "{said}");
+                assert!(said.contains(&format!("{ratio:.2} times the surface detail of its front")), "{said}");
             } else {
                 assert!(offset.z > 0.0, "a plain block is seen from +Z, the camera is at {offset}");
+                let expected =
+                    AutomaticView::Product { from: Vec3::Z, side: ModelSide::Front, reason: SideReason::Front };
+                assert_eq!(view, expected);
+                assert_eq!(said, "a three-quarter shot of the model's front, from +Z and above");
             }
         }
         // Turned so that its detail faces +X: seen from that side (deeper than

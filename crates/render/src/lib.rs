@@ -69,8 +69,8 @@ pub use distribution::Distribution1D;
 pub use effect_set::EffectSet;
 pub use effects::{Effect, EffectOverrides, EffectPlan, PlannedEffect, Reversal};
 pub use framing::{
-    DEFAULT_VERTICAL_FOV_DEGREES, camera_blocked, default_camera, frame_scene, frame_scene_up, framed_tightly,
-    three_quarter_view,
+    AutomaticView, DEFAULT_VERTICAL_FOV_DEGREES, ModelSide, SideReason, camera_blocked, default_camera, frame_scene,
+    frame_scene_explained, frame_scene_up, framed_tightly, three_quarter_view,
 };
 pub use identity::{Difference, RenderIdentity, scene_fingerprint};
 pub use integrator::{DirectStrategy, Integrator, ROULETTE_START};

@@ -17,9 +17,9 @@ use crate::effects::{materials_in_use, reflects_surroundings};
 use crate::up_axis::{UpAxis, detect_up};
 use crate::view_lighting::{REFLECTED_SHARE, UNLIT_VIEW, view_light};
 use crate::{
-    BounceSampling, DEFAULT_VERTICAL_FOV_DEGREES, DefaultLighting, DirectStrategy, ENCLOSED, EffectOverrides,
-    EffectPlan, EnvironmentSpec, Integrator, PixelSampler, RenderSettings, camera_blocked, frame_scene_up, room_light,
-    sky_visibility,
+    AutomaticView, BounceSampling, DEFAULT_VERTICAL_FOV_DEGREES, DefaultLighting, DirectStrategy, ENCLOSED,
+    EffectOverrides, EffectPlan, EnvironmentSpec, Integrator, PixelSampler, RenderSettings, camera_blocked,
+    frame_scene_explained, room_light, sky_visibility,
 };
 
 /// Why a render cannot be prepared; the messages name the option.
@@ -123,6 +123,9 @@ pub struct ChosenCamera {
     /// options' `up`, else for the automatic view the model's, judged by
     /// its base ([`crate::up_axis::detect_up`]), else +Y.
     pub up: UpAxis,
+    /// Which automatic view was taken and why, where the camera is one
+    /// (neither the file's nor placed by the options).
+    pub automatic_view: Option<AutomaticView>,
 }
 
 /// The scene's camera as `choice` says, for images of `aspect` (width / height).
@@ -149,9 +152,14 @@ pub fn choose_camera(
             let points = surface_points(scene);
             let (best, score) = best_file_camera(scene, accel, aspect, &points).expect("the scene has cameras");
             let automatic = (!score.sees_it_whole()).then(|| {
-                let view =
-                    frame_scene_up(scene, accel, DEFAULT_VERTICAL_FOV_DEGREES.to_radians(), aspect, model_up().up);
-                let seen = score_view(accel, &view, aspect, &points);
+                let view = frame_scene_explained(
+                    scene,
+                    accel,
+                    DEFAULT_VERTICAL_FOV_DEGREES.to_radians(),
+                    aspect,
+                    model_up().up,
+                );
+                let seen = score_view(accel, &view.0, aspect, &points);
                 (view, seen)
             });
             match automatic {
@@ -174,22 +182,30 @@ pub fn choose_camera(
         None => chosen.map_or(DEFAULT_VERTICAL_FOV_DEGREES.to_radians(), |c| c.vertical_fov),
     };
     let automatic = chosen.is_none() && choice.at.is_none();
-    let mut camera = match chosen {
-        Some(camera) => *camera,
+    let (mut camera, view) = match chosen {
+        Some(camera) => (*camera, None),
         // No camera in the file, or none worth taking: the automatic view
         // (already framed, at the default field of view, when it was
         // compared with the file's).
-        None => automatic_view.filter(|_| choice.fov_degrees.is_none()).unwrap_or_else(|| {
-            // A position given replaces everything the automatic view would
-            // choose but its up (+Y): its probe rays would cost seconds
-            // through a slow structure (the linear scan) for nothing.
-            if choice.at.is_some() {
-                Camera::framing(&scene.bounds(), fov, aspect)
-            } else {
-                frame_scene_up(scene, accel, fov, aspect, model_up().up)
-            }
-        }),
+        None => {
+            let framed =
+                automatic_view.filter(|_| choice.fov_degrees.is_none()).map(|(camera, view)| (camera, Some(view)));
+            let (camera, view) = framed.unwrap_or_else(|| {
+                // A position given replaces everything the automatic view would
+                // choose but its up (+Y): its probe rays would cost seconds
+                // through a slow structure (the linear scan) for nothing.
+                if choice.at.is_some() {
+                    (Camera::framing(&scene.bounds(), fov, aspect), None)
+                } else {
+                    let (camera, view) = frame_scene_explained(scene, accel, fov, aspect, model_up().up);
+                    (camera, Some(view))
+                }
+            });
+            (camera, view)
+        }
     };
+    // The view is the automatic one unless the options aim it elsewhere.
+    let automatic_view = view.filter(|_| choice.look.is_none());
     camera.vertical_fov = fov;
     if let Some(up) = choice.up {
         camera.up = up;
@@ -208,7 +224,7 @@ pub fn choose_camera(
     }
     let blocked = if automatic { None } else { camera_blocked(scene, accel, &camera, aspect) };
     let up = if chosen.is_none() { model_up() } else { given_up.unwrap_or(UpAxis::Y) };
-    Ok(ChosenCamera { camera, file_choice, blocked, up })
+    Ok(ChosenCamera { camera, file_choice, blocked, up, automatic_view })
 }
 
 /// The lighting options: lights added to the scene, the integrator and its
