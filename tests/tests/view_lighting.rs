@@ -135,3 +135,48 @@ fn info_prints_the_plan_the_render_follows() {
         assert!(plan(&info.stdout).contains("the scene's own lights give the surfaces in view"), "{info:?}");
     }
 }
+
+#[test]
+fn a_flat_cut_out_seen_straight_on_is_lit_from_the_view_s_upper_right() {
+    use rtgi_math::Vec3;
+    // A gingerbread-like flat outline facing +Z (woody's shape, coarsely),
+    // and the same stood up facing +X: seen straight on, each is lit from
+    // the camera's upper right, and brighter than the model's default sun
+    // (placed for a product shot) would light it.
+    let outline = "v -1 0 0\nv 1 0 0\nv 1 2 0\nv -1 2 0\nv -0.4 2 0\nv 0.4 2 0\nv 0 2.8 0\nf 1 2 3 4\nf 5 6 7\n";
+    for facing in [Vec3::Z, Vec3::X] {
+        let text = if facing == Vec3::X {
+            outline.lines().map(|l| swap_x_and_z(l) + "\n").collect::<String>()
+        } else {
+            outline.to_owned()
+        };
+        let mut scene = rtgi_scene::obj::load_from_text(&text, "", "flat.obj").unwrap();
+        let mut settings = RenderSettings::default();
+        let plan = prepared(&mut scene, &mut settings);
+        assert!(plan.default_environment, "{plan}");
+        let towards = settings.sun_towards.expect("the flat view places the sun");
+        // 30 degrees above the view and 25 to its right: 0.78 on the face.
+        assert!((towards.dot(facing) - 0.785).abs() < 0.01 && towards.y > 0.4, "{facing}: {towards}");
+        let default = rtgi_render::default_sun(Vec3::Y).direction;
+        assert!(towards.dot(facing) > 1.5 * (-default).dot(facing), "{facing}: {towards} against {default}");
+    }
+    // A model with depth keeps the sun placed for the product shot.
+    let mut cube = rtgi_scene::obj::load_from_text(
+        "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 0 1\nv 1 0 1\nv 1 1 1\nv 0 1 1\n\
+         f 1 4 3 2\nf 5 6 7 8\nf 1 2 6 5\nf 4 8 7 3\nf 1 5 8 4\nf 2 3 7 6\n",
+        "",
+        "cube.obj",
+    )
+    .unwrap();
+    let mut settings = RenderSettings::default();
+    prepared(&mut cube, &mut settings);
+    assert_eq!(settings.sun_towards, None);
+}
+
+/// An OBJ `v` line with its x and z swapped (other lines as they are).
+fn swap_x_and_z(line: &str) -> String {
+    match line.split_whitespace().collect::<Vec<_>>()[..] {
+        ["v", x, y, z] => format!("v {z} {y} {x}"),
+        _ => line.to_owned(),
+    }
+}

@@ -134,7 +134,7 @@ pub(crate) fn describe(settings: &RenderSettings) -> String {
             rtgi_render::Environment::Map(_) => format!("map of mean {:?}", e.mean_radiance()),
         }),
         settings.effects
-    )
+    ) + &settings.sun_towards.map_or(String::new(), |towards| format!(" sun towards {towards:?}"))
 }
 
 /// The estimator's settings, in words.

@@ -35,6 +35,11 @@ const SUN_AZIMUTH_DEGREES: f32 = 35.0;
 const SUN_IRRADIANCE: f32 = 2.0;
 const SUN_COLOUR: Vec3 = Vec3::new(1.0, 0.95, 0.86);
 
+/// The sun of a flat model seen straight on ([`flat_view_sun`]): this far
+/// above the view and to its right, in degrees.
+const FLAT_SUN_ELEVATION_DEGREES: f32 = 30.0;
+const FLAT_SUN_AZIMUTH_DEGREES: f32 = 25.0;
+
 static SKY: LazyLock<Environment> = LazyLock::new(|| {
     let mut image = HdrImage::new(SKY_WIDTH, SKY_HEIGHT);
     for y in 0..SKY_HEIGHT {
@@ -73,6 +78,31 @@ pub fn default_sun(up: Vec3) -> Light {
     let (elevation, azimuth) = (SUN_ELEVATION_DEGREES.to_radians(), SUN_AZIMUTH_DEGREES.to_radians());
     let towards_sun =
         turned_up(up) * Vec3::new(azimuth.sin() * elevation.cos(), elevation.sin(), azimuth.cos() * elevation.cos());
+    sun_towards(towards_sun)
+}
+
+/// The sun for a flat model seen straight on from `from` (a unit vector
+/// from the model towards the camera) with the camera's `up`: from the
+/// view's upper right, 30 degrees above and 25 to the right of the
+/// camera, so that it strikes the face at 0.78 where the default sun,
+/// placed for a product shot, struck a cut-out facing +Z at 0.47 (one
+/// facing +X at 0.33) and left it as grey as the sky behind it.
+pub fn flat_view_sun(from: Vec3, up: Vec3) -> Vec3 {
+    let right = up.cross(from).normalize_or_zero();
+    let up = from.cross(right);
+    let (elevation, azimuth) = (FLAT_SUN_ELEVATION_DEGREES.to_radians(), FLAT_SUN_AZIMUTH_DEGREES.to_radians());
+    (from * (elevation.cos() * azimuth.cos()) + right * (elevation.cos() * azimuth.sin()) + up * elevation.sin())
+        .normalize_or(from)
+}
+
+/// The sun of a render: towards `settings.sun_towards` where the view set
+/// it, else [`default_sun`].
+pub(crate) fn render_sun(settings: &crate::RenderSettings) -> Light {
+    settings.sun_towards.map_or_else(|| default_sun(settings.up), sun_towards)
+}
+
+/// The sun's light, shining from `towards_sun`.
+fn sun_towards(towards_sun: Vec3) -> Light {
     Light {
         name: "default sun".into(),
         kind: LightKind::Directional,

@@ -56,6 +56,7 @@ impl RenderIdentity {
             effects,
             default_lighting,
             up,
+            sun_towards,
             // Adaptive renders are never accumulated ([`crate::render_pass`] refuses them).
             adaptive: _,
         } = settings;
@@ -85,6 +86,8 @@ impl RenderIdentity {
             ("up", format!("{up:?}")),
             ("default lighting", format!("{default_lighting:?}")),
         ];
+        // Only where a view set it, so that other renders keep their identity.
+        let sun = sun_towards.map(|towards| ("sun towards".to_owned(), format!("{towards:?}")));
         Self {
             width: *width,
             height: *height,
@@ -92,7 +95,7 @@ impl RenderIdentity {
             seed: *seed,
             scene: format!("{:016x}", scene_fingerprint(scene)),
             camera: format!("{camera:?}"),
-            settings: settings.into_iter().map(|(k, v)| (k.to_owned(), v)).collect(),
+            settings: settings.into_iter().map(|(k, v)| (k.to_owned(), v)).chain(sun).collect(),
             version: env!("CARGO_PKG_VERSION").to_owned(),
         }
     }

@@ -237,7 +237,7 @@ impl<'a, A: Accel + ?Sized> Transport<'a, A> {
             // The default sun comes with the default sky.
             lights: LightSet::new(
                 scene,
-                plan.default_environment.then(|| crate::default_lighting::default_sun(settings.up)).as_slice(),
+                plan.default_environment.then(|| crate::default_lighting::render_sun(settings)).as_slice(),
                 plan.has(Effect::Emission),
                 environment,
             ),

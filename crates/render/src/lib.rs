@@ -32,6 +32,7 @@ mod accumulation;
 mod accumulation_file;
 pub mod adaptive;
 mod alpha;
+mod automatic_view;
 mod bounce_sampling;
 pub mod bsdf;
 mod camera;
@@ -59,9 +60,10 @@ pub use accumulation::{Accumulation, FIXED_POINT_BITS, MergeError, PartSpan, Pix
 pub use accumulation_file::{AccumulationFileError, MergeFilesError};
 pub use adaptive::{AdaptiveSampling, render_adaptive};
 pub use alpha::{AlphaTest, alpha_accepts, has_alpha};
+pub use automatic_view::{AutomaticView, ModelSide, SideReason};
 pub use bounce_sampling::BounceSampling;
 pub use camera::CameraRays;
-pub use default_lighting::{ENCLOSED, default_sky, default_sun, room_light, sky_visibility};
+pub use default_lighting::{ENCLOSED, default_sky, default_sun, flat_view_sun, room_light, sky_visibility};
 pub use denoise::{
     DenoiseError, DenoiseSettings, FIREFLY_FROM_SAMPLES, GUIDE_SAMPLES, Guides, denoise, render_denoised,
 };
@@ -69,8 +71,8 @@ pub use distribution::Distribution1D;
 pub use effect_set::EffectSet;
 pub use effects::{Effect, EffectOverrides, EffectPlan, PlannedEffect, Reversal};
 pub use framing::{
-    AutomaticView, DEFAULT_VERTICAL_FOV_DEGREES, ModelSide, SideReason, camera_blocked, default_camera, frame_scene,
-    frame_scene_explained, frame_scene_up, framed_tightly, three_quarter_view,
+    DEFAULT_VERTICAL_FOV_DEGREES, camera_blocked, default_camera, frame_scene, frame_scene_explained, frame_scene_up,
+    framed_tightly, three_quarter_view,
 };
 pub use identity::{Difference, RenderIdentity, scene_fingerprint};
 pub use integrator::{DirectStrategy, Integrator, ROULETTE_START};
@@ -154,6 +156,11 @@ pub struct RenderSettings {
     /// side the default sun shines from ([`up_axis`]; +Y by default, +Z
     /// for a model found standing on a base across Z).
     pub up: Vec3,
+    /// The direction towards the default sun (a unit vector), where the
+    /// view asks for its own ([`default_lighting::flat_view_sun`]: a flat
+    /// model seen straight on); `None` puts it at the upper front right of
+    /// the model, by `up`.
+    pub sun_towards: Option<Vec3>,
     /// Adaptive sampling: `samples_per_pixel` is then the most a pixel
     /// takes, in rounds, each pixel stopping at the noise target or all at
     /// the time bound ([`adaptive`]); `None` renders every pixel's samples.
@@ -202,6 +209,7 @@ impl Default for RenderSettings {
             effects: EffectOverrides::default(),
             default_lighting: DefaultLighting::Auto,
             up: Vec3::Y,
+            sun_towards: None,
             adaptive: None,
         }
     }
@@ -379,7 +387,8 @@ pub(crate) fn render_sums_of<A: Accel + ?Sized>(
     // The views of the closest hit follow the plan for alpha and textures too.
     let plan = EffectPlan::new(scene, settings);
     let (alpha, textures) = (plan.has(Effect::Alpha), plan.has(Effect::Textures));
-    let cut_outs = alpha.then(|| AlphaTest::new(scene));
+    // The light-transport integrators prepare their own.
+    let cut_outs = (alpha && !settings.integrator.simulates_light()).then(|| AlphaTest::new(scene));
     // Camera rays are traced together, a 4×4 block of pixels at a time,
     // unless alpha masks need the filtered query.
     let batch = |rays: &[Ray], hits: &mut [Option<Hit>]| accel.intersect_batch(rays, hits);

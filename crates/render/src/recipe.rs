@@ -367,6 +367,10 @@ pub fn prepare(
     let aspect = settings.width as f32 / settings.height.max(1) as f32;
     let camera = choose_camera(scene, accel, choice, aspect)?;
     settings.up = camera.up.up;
+    // A flat model seen straight on is lit from the view's upper right.
+    if let Some(AutomaticView::Flat { from }) = camera.automatic_view {
+        settings.sun_towards = Some(crate::flat_view_sun(from, camera.camera.up));
+    }
     judge_view_lighting(scene, accel, &camera.camera, aspect, settings);
     let room_light = light_enclosed_camera(scene, accel, &camera.camera, settings);
     Ok(Prepared { camera, room_light })
