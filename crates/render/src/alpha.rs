@@ -39,8 +39,8 @@ pub fn alpha_accepts(scene: &Scene, triangle: u32, beta: f32, gamma: f32, u: f32
 pub struct AlphaTest<'a> {
     scene: &'a Scene,
     /// A bit a triangle: whether its material has alpha. Most candidate
-    /// hits are on opaque surfaces, and these bits (a 64th of `triangles`)
-    /// stay in the cache.
+    /// hits are on opaque surfaces, and these bits (a 256th of the memory
+    /// of `triangles`) stay in the cache.
     with_alpha: Vec<u64>,
     triangles: Vec<AlphaTriangle>,
 }
@@ -56,16 +56,14 @@ struct AlphaTriangle {
 impl<'a> AlphaTest<'a> {
     /// The test for `scene`'s triangles as they are now.
     pub fn new(scene: &'a Scene) -> Self {
-        let triangles = scene
-            .triangles
-            .iter()
-            .map(|t| AlphaTriangle { uv: t.vertices.map(|v| scene.vertices[v as usize].uv), material: t.material })
-            .collect();
         let mut with_alpha = vec![0u64; scene.triangles.len().div_ceil(64)];
+        let mut triangles = Vec::with_capacity(scene.triangles.len());
         for (i, t) in scene.triangles.iter().enumerate() {
             if scene.materials[t.material as usize].alpha_mode != AlphaMode::Opaque {
                 with_alpha[i / 64] |= 1 << (i % 64);
             }
+            triangles
+                .push(AlphaTriangle { uv: t.vertices.map(|v| scene.vertices[v as usize].uv), material: t.material });
         }
         Self { scene, with_alpha, triangles }
     }
@@ -77,7 +75,7 @@ impl<'a> AlphaTest<'a> {
         if self.with_alpha[i / 64] & (1 << (i % 64)) == 0 {
             return true;
         }
-        let AlphaTriangle { uv: [a, b, c], material } = self.triangles[triangle as usize];
+        let AlphaTriangle { uv: [a, b, c], material } = self.triangles[i];
         let material = &self.scene.materials[material as usize];
         // The arithmetic of `Scene::interpolate`, for the same bits.
         decide(self.scene, material, u, || a * (1.0 - beta - gamma) + b * beta + c * gamma)
