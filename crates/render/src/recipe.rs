@@ -190,7 +190,7 @@ pub fn choose_camera(
         None => {
             let framed =
                 automatic_view.filter(|_| choice.fov_degrees.is_none()).map(|(camera, view)| (camera, Some(view)));
-            let (camera, view) = framed.unwrap_or_else(|| {
+            framed.unwrap_or_else(|| {
                 // A position given replaces everything the automatic view would
                 // choose but its up (+Y): its probe rays would cost seconds
                 // through a slow structure (the linear scan) for nothing.
@@ -200,8 +200,7 @@ pub fn choose_camera(
                     let (camera, view) = frame_scene_explained(scene, accel, fov, aspect, model_up().up);
                     (camera, Some(view))
                 }
-            });
-            (camera, view)
+            })
         }
     };
     // The view is the automatic one unless the options aim it elsewhere.
