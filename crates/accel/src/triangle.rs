@@ -1,9 +1,10 @@
 //! Ray/triangle intersection tests.
 
-use rtgi_math::Vec3A;
+use rtgi_math::{Ray, Vec3A};
 
 use crate::exact;
 use crate::simd::arith;
+use crate::simd::packet_triangles::WatertightPacket;
 use crate::simd::triangles::{self, BlockHits, TriangleBlock};
 
 /// Where a ray hits a triangle: distance and barycentric coordinates of
@@ -97,6 +98,15 @@ pub(crate) trait TriangleTest {
     /// triangle, and lanes in [`BlockHits::rescan`] must be decided by
     /// `intersect` itself (the watertight test's double-precision cases).
     fn intersect_block(ray: &Self::Ray, t_min: f32, t_max: f32, block: &TriangleBlock) -> BlockHits;
+
+    /// The rays of a packet (1 to 16 valid rays) prepared to be tested
+    /// against one triangle at a time ([`crate::simd::packet_triangles`]),
+    /// or `None` where the test has no such kernel or these rays cannot
+    /// share one: they are then tested ray by ray.
+    #[inline(always)]
+    fn packet(_rays: &[Ray]) -> Option<WatertightPacket> {
+        None
+    }
 }
 
 /// Evaluates `$body` with `$test` naming the [`TriangleTest`] that the
@@ -238,6 +248,12 @@ impl TriangleTest for Watertight {
     #[inline(always)]
     fn intersect_block(ray: &Self::Ray, t_min: f32, t_max: f32, block: &TriangleBlock) -> BlockHits {
         triangles::watertight_block(ray.origin.to_array(), ray.axes, ray.shear, t_min, t_max, block)
+    }
+
+    /// Packets whose rays share the permutation of axes.
+    #[inline(always)]
+    fn packet(rays: &[Ray]) -> Option<WatertightPacket> {
+        WatertightPacket::new(rays)
     }
 }
 

@@ -20,6 +20,7 @@ use std::sync::atomic::{AtomicU8, Ordering};
 
 use super::boxes::{FAR_OF_NEAR, PlaneRay, WideBoxes};
 use super::packet::{Lanes, PACKET, PacketRays};
+use super::packet_triangles::{PacketHits, WatertightPacket};
 use crate::slab::{ROBUST_FAR_SCALE, ROBUST_FAR_SHRINK};
 
 /// The instruction sets the kernels are compiled for, narrowest first.
@@ -172,6 +173,15 @@ pub(crate) trait Isa: Copy {
         t_max: &Lanes,
         active: u32,
     ) -> (u32, f32);
+
+    /// Whether packets test each triangle against all their rays at once
+    /// ([`Isa::watertight_packet`]) rather than ray by ray: only where one
+    /// instruction covers the sixteen rays.
+    const PACKET_TRIANGLES: bool;
+
+    /// [`WatertightPacket::intersect_portable`]: one triangle against a
+    /// packet's rays.
+    fn watertight_packet(self, packet: &WatertightPacket, t_max: &Lanes, corners: [[f32; 3]; 3]) -> PacketHits;
 }
 
 /// Asks the CPU to start loading the `bytes` bytes at `data` into its
@@ -215,6 +225,13 @@ impl Isa for Portable {
     ) -> (u32, f32) {
         rays.enter_box(near, far, t_max, active)
     }
+
+    const PACKET_TRIANGLES: bool = false;
+
+    #[inline(always)]
+    fn watertight_packet(self, packet: &WatertightPacket, t_max: &Lanes, corners: [[f32; 3]; 3]) -> PacketHits {
+        packet.intersect_portable(t_max, corners)
+    }
 }
 
 /// Proof that the CPU runs AVX2 and FMA: made only by `run_avx2`, which
@@ -254,6 +271,14 @@ impl Isa for Avx2 {
         // SAFETY: as above, the CPU runs AVX2.
         unsafe { enter_box_packet_avx2(near, far, rays, t_max, active) }
     }
+
+    /// Sixteen rays take two 256-bit registers a value: left ray by ray.
+    const PACKET_TRIANGLES: bool = false;
+
+    #[inline(always)]
+    fn watertight_packet(self, packet: &WatertightPacket, t_max: &Lanes, corners: [[f32; 3]; 3]) -> PacketHits {
+        packet.intersect_portable(t_max, corners)
+    }
 }
 
 #[cfg(target_arch = "x86_64")]
@@ -276,6 +301,101 @@ impl Isa for Avx512 {
     ) -> (u32, f32) {
         // SAFETY: an `Avx512` exists only where the CPU was seen to run AVX-512 F.
         unsafe { enter_box_packet_avx512(near, far, rays, t_max, active) }
+    }
+
+    const PACKET_TRIANGLES: bool = true;
+
+    #[inline(always)]
+    fn watertight_packet(self, packet: &WatertightPacket, t_max: &Lanes, corners: [[f32; 3]; 3]) -> PacketHits {
+        // SAFETY: an `Avx512` exists only where the CPU was seen to run AVX-512 F.
+        unsafe { watertight_packet_avx512(packet, t_max, corners) }
+    }
+}
+
+/// [`WatertightPacket::intersect_portable`] on all sixteen rays in 512-bit
+/// registers: the same operations on the same operands in the same order,
+/// lane by lane (products commute exactly, and `max_ps(a, b)` is
+/// `a > b ? a : b`, as `arith`'s `max`).
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx512f")]
+#[inline]
+fn watertight_packet_avx512(packet: &WatertightPacket, t_max: &Lanes, corners: [[f32; 3]; 3]) -> PacketHits {
+    use std::arch::x86_64::*;
+    // SAFETY: each argument is a reference to sixteen `f32`s, valid for a
+    // 64-byte load, and `Lanes` is 64-byte aligned.
+    let load = |values: &Lanes| unsafe { _mm512_load_ps(values.0.as_ptr()) };
+    let store = |value: __m512| {
+        let mut lanes = Lanes([0.0; PACKET]);
+        // SAFETY: `lanes` is sixteen `f32`s, 64-byte aligned, valid for a 64-byte store.
+        unsafe { _mm512_store_ps(lanes.0.as_mut_ptr(), value) };
+        lanes
+    };
+    let splat = |value: f32| _mm512_set1_ps(value);
+    let add = |a, b| _mm512_add_ps(a, b);
+    let sub = |a, b| _mm512_sub_ps(a, b);
+    let mul = |a, b| _mm512_mul_ps(a, b);
+    let abs = |a| _mm512_abs_ps(a);
+    let max = |a, b| _mm512_max_ps(a, b);
+    let origin = [load(&packet.origin[0]), load(&packet.origin[1]), load(&packet.origin[2])];
+    let shear = [load(&packet.shear[0]), load(&packet.shear[1]), load(&packet.shear[2])];
+    let [kx, ky, kz] = packet.axes;
+    // `arith::watertight_shear` of the corners relative to each origin
+    // (written out: array maps of closures were left as calls).
+    let mut xs = [_mm512_setzero_ps(); 3];
+    let mut ys = xs;
+    let mut zs = xs;
+    let mut heights = xs;
+    for c in 0..3 {
+        let corner = corners[c];
+        let (rx, ry, rz) =
+            (sub(splat(corner[kx]), origin[0]), sub(splat(corner[ky]), origin[1]), sub(splat(corner[kz]), origin[2]));
+        xs[c] = sub(rx, mul(shear[0], rz));
+        ys[c] = sub(ry, mul(shear[1], rz));
+        zs[c] = mul(rz, shear[2]);
+        heights[c] = rz;
+    }
+    // `arith::watertight_edges`.
+    let uvw = [
+        sub(mul(xs[2], ys[1]), mul(ys[2], xs[1])),
+        sub(mul(xs[0], ys[2]), mul(ys[0], xs[2])),
+        sub(mul(xs[1], ys[0]), mul(ys[1], xs[0])),
+    ];
+    // `arith::watertight_edge_bound`.
+    let largest = |v: [__m512; 3]| max(max(abs(v[0]), abs(v[1])), abs(v[2]));
+    let (x, y, z) = (largest(xs), largest(ys), largest(heights));
+    let spread = mul(z, add(mul(x, abs(shear[1])), mul(y, abs(shear[0]))));
+    let bound = add(mul(splat(32.0 * f32::EPSILON / 2.0), add(mul(x, y), spread)), splat(f32::from_bits(1 << 4)));
+    let zero = _mm512_setzero_ps();
+    let near_edge = _mm512_cmp_ps_mask::<_CMP_LE_OQ>(abs(uvw[0]), bound)
+        | _mm512_cmp_ps_mask::<_CMP_LE_OQ>(abs(uvw[1]), bound)
+        | _mm512_cmp_ps_mask::<_CMP_LE_OQ>(abs(uvw[2]), bound);
+    let negative = _mm512_cmp_ps_mask::<_CMP_LT_OQ>(uvw[0], zero)
+        | _mm512_cmp_ps_mask::<_CMP_LT_OQ>(uvw[1], zero)
+        | _mm512_cmp_ps_mask::<_CMP_LT_OQ>(uvw[2], zero);
+    let positive = _mm512_cmp_ps_mask::<_CMP_GT_OQ>(uvw[0], zero)
+        | _mm512_cmp_ps_mask::<_CMP_GT_OQ>(uvw[1], zero)
+        | _mm512_cmp_ps_mask::<_CMP_GT_OQ>(uvw[2], zero);
+    let one_sided = !(negative & positive);
+    // `arith::watertight_det_and_scaled_t` and `arith::watertight_t_bound`.
+    let det = add(add(uvw[0], uvw[1]), uvw[2]);
+    let t_scaled = add(add(mul(uvw[0], zs[0]), mul(uvw[1], zs[1])), mul(uvw[2], zs[2]));
+    let t_bound = mul(add(mul(splat(8.0 * f32::EPSILON / 2.0), abs(det)), mul(splat(3.0), bound)), largest(zs));
+    let cancels = one_sided & _mm512_cmp_ps_mask::<_CMP_LE_OQ>(abs(t_scaled), t_bound);
+    let t = _mm512_div_ps(t_scaled, det);
+    let infinity = splat(f32::INFINITY);
+    let finite = |v: __m512| _mm512_cmp_ps_mask::<_CMP_LT_OQ>(abs(v), infinity);
+    let in_range = _mm512_cmp_ps_mask::<_CMP_GE_OQ>(t, load(&packet.t_min))
+        & _mm512_cmp_ps_mask::<_CMP_LE_OQ>(t, load(t_max))
+        & finite(t);
+    let hit = one_sided & _mm512_cmp_ps_mask::<_CMP_NEQ_UQ>(det, zero) & finite(det) & in_range;
+    let rescan = near_edge | cancels;
+    PacketHits {
+        exact: (hit & !rescan) as u32,
+        rescan: rescan as u32,
+        t: store(t),
+        beta_scaled: store(uvw[1]),
+        gamma_scaled: store(uvw[2]),
+        scale: store(det),
     }
 }
 

@@ -7,7 +7,8 @@
 //! arithmetic lane by lane, and `packet.rs` sixteen rays against one box
 //! and, through the interval ray that bounds them, against a node's boxes;
 //! `triangles.rs` tests one ray against a block of
-//! four triangles, stored structure-of-arrays; `arith.rs` holds the
+//! four triangles, stored structure-of-arrays, and `packet_triangles.rs`
+//! one triangle against a packet's sixteen rays; `arith.rs` holds the
 //! ray/triangle arithmetic written once, generic over one lane (`f32`) or
 //! four (`Vec4`), so that the scalar tests and the block tests compute the
 //! same values, bit for bit; `dispatch.rs` (with the Embree binding, one of
@@ -18,6 +19,7 @@ pub(crate) mod arith;
 pub(crate) mod boxes;
 mod dispatch;
 pub(crate) mod packet;
+pub(crate) mod packet_triangles;
 pub(crate) mod triangles;
 
 pub(crate) use dispatch::{Isa, Kernel, dispatch, prefetch};

@@ -46,11 +46,17 @@ impl TriangleBlock {
         Self { corners: corners.map(|corner| corner.map(Vec4::from_array)), ids: lane_ids }
     }
 
+    /// The corners of the triangle in `lane`, as arrays.
+    #[inline(always)]
+    pub(crate) fn corners(&self, lane: usize) -> [[f32; 3]; 3] {
+        let c = &self.corners;
+        [0, 1, 2].map(|k| [c[k][0][lane], c[k][1][lane], c[k][2][lane]])
+    }
+
     /// The corners of the triangle in `lane`.
     #[inline(always)]
     pub(crate) fn triangle(&self, lane: usize) -> [Vec3A; 3] {
-        let c = &self.corners;
-        [0, 1, 2].map(|k| Vec3A::new(c[k][0][lane], c[k][1][lane], c[k][2][lane]))
+        self.corners(lane).map(Vec3A::from_array)
     }
 
     /// Lanes that hold a triangle.
@@ -59,21 +65,36 @@ impl TriangleBlock {
     }
 }
 
-/// What a block test found: bit `i` of `exact` says that lane `i` was hit,
-/// at `t[i]` with barycentrics `beta[i]`, `gamma[i]` ([`BlockHits::hit`]);
+/// What a test of several lanes found (one ray against a block's four
+/// triangles, [`BlockHits`], or one triangle against a packet's sixteen
+/// rays, [`PacketHits`]): bit `i` of `exact` says that lane `i` was hit,
+/// at `t[i]` with barycentrics `beta[i]`, `gamma[i]` ([`LaneHits::hit`]);
 /// bit `i` of `rescan` that the scalar test must decide lane `i`.
 #[derive(Clone, Copy, Debug)]
-pub(crate) struct BlockHits {
+pub(crate) struct LaneHits<L> {
     pub(crate) exact: u32,
     pub(crate) rescan: u32,
-    pub(crate) t: Vec4,
+    pub(crate) t: L,
     /// The barycentrics are `beta_scaled / scale` and `gamma_scaled /
     /// scale`, divided only for the lanes that are hit (the watertight
     /// test's scaled barycentrics and determinant; Möller-Trumbore's
     /// barycentrics over 1, which divides exactly).
-    beta_scaled: Vec4,
-    gamma_scaled: Vec4,
-    scale: Vec4,
+    pub(crate) beta_scaled: L,
+    pub(crate) gamma_scaled: L,
+    pub(crate) scale: L,
+}
+
+/// One ray against the four triangles of a block.
+pub(crate) type BlockHits = LaneHits<Vec4>;
+
+impl<L: std::ops::Index<usize, Output = f32>> LaneHits<L> {
+    /// The hit in lane `lane` of [`LaneHits::exact`]: the bits the scalar
+    /// test computes for that lane's ray and triangle.
+    #[inline(always)]
+    pub(crate) fn hit(&self, lane: usize) -> TriangleHit {
+        let scale = self.scale[lane];
+        TriangleHit { t: self.t[lane], beta: self.beta_scaled[lane] / scale, gamma: self.gamma_scaled[lane] / scale }
+    }
 }
 
 impl BlockHits {
@@ -95,14 +116,6 @@ impl BlockHits {
             gamma_scaled: Vec4::ZERO,
             scale: Vec4::ONE,
         }
-    }
-
-    /// The hit in lane `lane` of [`BlockHits::exact`]: the bits the scalar
-    /// test computes for that lane's triangle.
-    #[inline(always)]
-    pub(crate) fn hit(&self, lane: usize) -> TriangleHit {
-        let scale = self.scale[lane];
-        TriangleHit { t: self.t[lane], beta: self.beta_scaled[lane] / scale, gamma: self.gamma_scaled[lane] / scale }
     }
 }
 

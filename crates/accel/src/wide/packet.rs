@@ -2,9 +2,12 @@
 //! say) walk a wide BVH together. An inner node's children are tested
 //! once for the whole packet, by the interval ray that bounds its rays
 //! ([`IntervalRay`]: eight boxes in one test, as for a single ray); a leaf
-//! it may enter is then tested against each of the sixteen rays, and each
-//! ray that enters it tests its triangles on its own, with the same block
-//! tests as single rays.
+//! it may enter is then tested against each of the sixteen rays. The rays
+//! that enter it take its triangles together, each triangle against all
+//! of them in one test ([`crate::simd::packet_triangles`]), where the CPU
+//! has AVX-512 and the watertight test's rays share their permutation of
+//! axes; elsewhere each ray takes them on its own, with the block tests of
+//! single rays.
 //!
 //! The answers are those of single-ray traversal, bit for bit: every ray
 //! is tested against every leaf its own traversal would test (the interval
@@ -19,7 +22,9 @@
 //! Measured on the bunny's and the conference room's camera rays (one
 //! thread), the interval test of inner nodes, with the packet's set-up
 //! vectorised and its buffers kept across packets, made packets 1.74× as
-//! fast as testing every child against all sixteen rays.
+//! fast as testing every child against all sixteen rays. Testing leaves
+//! triangle against packet made them 1.13× as fast again on the bunny
+//! (AVX-512, one thread, 1024² camera rays: 23.4 → 26.4 Mrays/s).
 
 use std::marker::PhantomData;
 
@@ -28,9 +33,11 @@ use rtgi_math::Ray;
 use super::node::ChildRef;
 use super::traverse::TraversalStack;
 use super::{WideBvh, insert_far_to_near};
-use crate::contract::{Best, HitFilter, PreparedRay, QueryKind};
+use crate::contract::{Best, HitFilter, PreparedRay, QueryKind, box_rule, hit_triangle};
 use crate::simd::boxes::FAR_OF_NEAR;
 use crate::simd::packet::{IntervalRay, Lanes, PACKET, PacketRays};
+use crate::simd::packet_triangles::WatertightPacket;
+use crate::simd::triangles::TriangleBlock;
 use crate::simd::{Isa, Kernel, dispatch};
 use crate::triangle::{TriangleTest, with_triangle_test};
 use crate::{Hit, NoCounter};
@@ -85,8 +92,11 @@ impl<const W: usize> WideBvh<W> {
     ) {
         let mut best: [Best; PACKET] = std::array::from_fn(|lane| Best::new(rays.get(lane).unwrap_or(&rays[0])));
         let mut t_max = Lanes(std::array::from_fn(|lane| best[lane].t_max));
-        // Rays are prepared for the triangle tests when they reach their first leaf.
+        // Rays are prepared for the triangle tests when they reach their
+        // first leaf; the packet, for testing triangles against all its
+        // rays at once, when its first leaf is reached.
         let mut prepared = 0u32;
+        let mut packet_tests: Option<Option<WatertightPacket>> = None;
         let PacketScratch { prepared: prepared_rays, stack } = scratch;
         stack.clear();
         let all = if rays.len() == PACKET { u32::MAX >> (32 - PACKET) } else { (1 << rays.len()) - 1 };
@@ -98,31 +108,31 @@ impl<const W: usize> WideBvh<W> {
         let mut current = PacketEntry { child: ChildRef::node(0), rays: all, enter: 0.0 };
         loop {
             if current.child.is_leaf() {
-                let mut lanes = current.rays & !done;
-                while lanes != 0 {
-                    let lane = lanes.trailing_zeros() as usize;
-                    lanes &= lanes - 1;
-                    if prepared & 1 << lane == 0 {
-                        prepared_rays[lane] = PreparedRay::new(&rays[lane]);
-                        prepared |= 1 << lane;
-                    }
-                    let answered = self.visit_leaf::<Q, NoCounter, T, F>(
+                let packet_tests =
+                    packet_tests.get_or_insert_with(|| if I::PACKET_TRIANGLES { T::packet(rays) } else { None });
+                let (rays_in, prepared) = (current.rays & !done, (&mut *prepared_rays, &mut prepared));
+                done |= match packet_tests {
+                    Some(packet_tests) => self.visit_leaf_packet::<Q, T, F, I>(
+                        isa,
                         current.child,
-                        &prepared_rays[lane],
-                        &mut best[lane],
-                        &mut NoCounter,
+                        (rays, rays_in, packet_tests),
+                        prepared,
+                        (&mut best, &mut t_max),
                         filter,
-                    );
-                    t_max.0[lane] = best[lane].t_max;
-                    if answered {
-                        done |= 1 << lane;
-                    }
-                }
+                    ),
+                    None => self.visit_leaf_ray_by_ray::<Q, T, F>(
+                        current.child,
+                        (rays, rays_in),
+                        prepared,
+                        (&mut best, &mut t_max),
+                        filter,
+                    ),
+                };
                 latest = t_max.latest(all & !done);
             } else {
                 // Inner nodes are tested once, by the interval ray; a leaf
-                // the interval ray enters is then tested ray by ray, so
-                // that only the rays that enter it test its triangles.
+                // the interval ray enters is then tested against each ray,
+                // so that only the rays that enter it take its triangles.
                 let node = &self.nodes[current.child.node_index()];
                 let active = all & !done;
                 let (maybe, enter) = interval.enter_boxes(&node.boxes, latest);
@@ -135,8 +145,9 @@ impl<const W: usize> WideBvh<W> {
                     let child = node.children[lane];
                     let entry = if child.is_leaf() {
                         let planes = &node.boxes.planes;
-                        let near = [0, 1, 2].map(|axis| planes[packet.near[axis]][lane]);
-                        let far = [0, 1, 2].map(|axis| planes[packet.near[axis] ^ FAR_OF_NEAR[axis]][lane]);
+                        let plane = |axis: usize, flip: usize| planes[packet.near[axis] ^ flip][lane];
+                        let near = [plane(0, 0), plane(1, 0), plane(2, 0)];
+                        let far = [plane(0, FAR_OF_NEAR[0]), plane(1, FAR_OF_NEAR[1]), plane(2, FAR_OF_NEAR[2])];
                         let (rays_in, enter) = isa.enter_box_packet(near, far, packet, &t_max, active);
                         if rays_in == 0 {
                             continue;
@@ -169,6 +180,96 @@ impl<const W: usize> WideBvh<W> {
                 }
             }
         }
+    }
+}
+
+impl<const W: usize> WideBvh<W> {
+    /// Tests `leaf` ray by ray, for each ray of `rays_in` with the block
+    /// tests of single rays; offers each ray's hits to its `best`,
+    /// keeping `t_max` in step. Returns the rays whose query is answered
+    /// (any-hit queries that found a hit).
+    #[inline(always)]
+    fn visit_leaf_ray_by_ray<Q: QueryKind, T: TriangleTest, F: HitFilter>(
+        &self,
+        leaf: ChildRef,
+        (rays, rays_in): (&[Ray], u32),
+        (prepared_rays, prepared): (&mut [PreparedRay<T>; PACKET], &mut u32),
+        (best, t_max): (&mut [Best; PACKET], &mut Lanes),
+        filter: &F,
+    ) -> u32 {
+        let mut answered = 0;
+        let mut lanes = rays_in;
+        while lanes != 0 {
+            let lane = lanes.trailing_zeros() as usize;
+            lanes &= lanes - 1;
+            if *prepared & 1 << lane == 0 {
+                prepared_rays[lane] = PreparedRay::new(&rays[lane]);
+                *prepared |= 1 << lane;
+            }
+            if self.visit_leaf::<Q, NoCounter, T, F>(
+                leaf,
+                &prepared_rays[lane],
+                &mut best[lane],
+                &mut NoCounter,
+                filter,
+            ) {
+                answered |= 1 << lane;
+            }
+            t_max.0[lane] = best[lane].t_max;
+        }
+        answered
+    }
+
+    /// Tests each triangle of `leaf` against the rays `rays_in` of the
+    /// packet at once ([`Isa::watertight_packet`]), and offers each ray's
+    /// hits to its `best`, keeping `t_max` in step; the scalar test
+    /// decides the lanes the packet test hands back. Returns the rays
+    /// whose query is answered.
+    #[inline(always)]
+    fn visit_leaf_packet<Q: QueryKind, T: TriangleTest, F: HitFilter, I: Isa>(
+        &self,
+        isa: I,
+        leaf: ChildRef,
+        (rays, mut rays_in, packet): (&[Ray], u32, &WatertightPacket),
+        (prepared_rays, prepared): (&mut [PreparedRay<T>; PACKET], &mut u32),
+        (best, t_max): (&mut [Best; PACKET], &mut Lanes),
+        filter: &F,
+    ) -> u32 {
+        let mut answered = 0;
+        for block in &self.blocks[leaf.blocks()] {
+            for (triangle_lane, &id) in block.ids.iter().enumerate() {
+                if id == TriangleBlock::NO_TRIANGLE || rays_in == 0 {
+                    continue;
+                }
+                let hits = isa.watertight_packet(packet, t_max, block.corners(triangle_lane));
+                let mut lanes = (hits.exact | hits.rescan) & rays_in;
+                while lanes != 0 {
+                    let lane = lanes.trailing_zeros() as usize;
+                    lanes &= lanes - 1;
+                    if *prepared & 1 << lane == 0 {
+                        prepared_rays[lane] = PreparedRay::new(&rays[lane]);
+                        *prepared |= 1 << lane;
+                    }
+                    let ray = &prepared_rays[lane];
+                    let triangle = block.triangle(triangle_lane);
+                    let hit = if hits.rescan & 1 << lane != 0 {
+                        hit_triangle(ray, &triangle, best[lane].t_max)
+                    } else {
+                        box_rule(&ray.boxes, &triangle, hits.hit(lane), best[lane].t_max)
+                    };
+                    if let Some(hit) = hit
+                        && best[lane].offer(id, hit, filter)
+                    {
+                        t_max.0[lane] = best[lane].t_max;
+                        if Q::STOP_AT_FIRST_HIT {
+                            answered |= 1 << lane;
+                            rays_in &= !(1 << lane);
+                        }
+                    }
+                }
+            }
+        }
+        answered
     }
 }
 
