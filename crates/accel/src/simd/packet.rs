@@ -102,21 +102,15 @@ impl PacketRays {
         let mut coherent = true;
         for chunk in 0..PACKET / 4 {
             // Lanes past the end repeat the first ray; their answers are dropped.
+            // (Written out: array maps of closures were left as calls.)
             let ray = |lane: usize| rays.get(chunk * 4 + lane).unwrap_or(first);
-            let [ox, oy, oz, dx] = Mat4::from_cols_array_2d(&[0, 1, 2, 3].map(|lane| {
-                let ray = ray(lane);
-                [ray.origin.x, ray.origin.y, ray.origin.z, ray.direction.x]
-            }))
-            .transpose()
-            .to_cols_array_2d()
-            .map(Vec4::from);
-            let [dy, dz, t_min, t_max] = Mat4::from_cols_array_2d(&[0, 1, 2, 3].map(|lane| {
-                let ray = ray(lane);
-                [ray.direction.y, ray.direction.z, ray.t_min, ray.t_max]
-            }))
-            .transpose()
-            .to_cols_array_2d()
-            .map(Vec4::from);
+            let (r0, r1, r2, r3) = (ray(0), ray(1), ray(2), ray(3));
+            let first_half = |r: &Ray| Vec4::new(r.origin.x, r.origin.y, r.origin.z, r.direction.x);
+            let second_half = |r: &Ray| Vec4::new(r.direction.y, r.direction.z, r.t_min, r.t_max);
+            let a = Mat4::from_cols(first_half(r0), first_half(r1), first_half(r2), first_half(r3)).transpose();
+            let b = Mat4::from_cols(second_half(r0), second_half(r1), second_half(r2), second_half(r3)).transpose();
+            let (ox, oy, oz, dx) = (a.x_axis, a.y_axis, a.z_axis, a.w_axis);
+            let (dy, dz, t_min, t_max) = (b.x_axis, b.y_axis, b.z_axis, b.w_axis);
             let finite = |v: Vec4| v.abs().cmplt(Vec4::INFINITY);
             let along = dx * axis.x + dy * axis.y + dz * axis.z;
             let length2 = dx * dx + dy * dy + dz * dz;

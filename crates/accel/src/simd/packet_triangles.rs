@@ -15,12 +15,12 @@
 //! [`WatertightPacket::intersect_portable`] is its twin in plain Rust, lane
 //! by lane, which the tests hold it to.
 
-use rtgi_math::{Ray, Vec3A};
+use rtgi_math::{Ray, Vec3A, Vec4};
 
 use super::arith;
 use super::packet::{Lanes, PACKET};
 use super::triangles::LaneHits;
-use crate::triangle::{TriangleTest, Watertight};
+use crate::triangle::Watertight;
 
 /// What one triangle against a packet's sixteen rays found.
 pub(crate) type PacketHits = LaneHits<Lanes>;
@@ -40,30 +40,40 @@ pub(crate) struct WatertightPacket {
 
 impl WatertightPacket {
     /// The packet of `rays` (1 to [`PACKET`] valid rays), or `None` when
-    /// their permutations of axes differ.
+    /// their permutations of axes differ. The shears are divided four
+    /// lanes at a time, as [`Watertight::prepare`] divides them one by one.
     #[inline(always)]
     pub(crate) fn new(rays: &[Ray]) -> Option<Self> {
         debug_assert!(!rays.is_empty() && rays.len() <= PACKET);
+        let axes = Watertight::axes(Vec3A::from(rays[0].direction));
         let mut packet = WatertightPacket {
-            axes: [0; 3],
+            axes,
             origin: [Lanes([0.0; PACKET]); 3],
             shear: [Lanes([0.0; PACKET]); 3],
             t_min: Lanes([0.0; PACKET]),
         };
+        // The permuted directions, until they become shears.
+        let mut direction = [Lanes([0.0; PACKET]); 3];
         for lane in 0..PACKET {
             let ray = rays.get(lane).unwrap_or(&rays[0]);
-            let prepared = Watertight::prepare(Vec3A::from(ray.origin), Vec3A::from(ray.direction));
-            let [kx, ky, kz] = prepared.axes;
-            if lane == 0 {
-                packet.axes = prepared.axes;
-            } else if kx != packet.axes[0] || ky != packet.axes[1] || kz != packet.axes[2] {
+            let [kx, ky, kz] = Watertight::axes(Vec3A::from(ray.direction));
+            if kx != axes[0] || ky != axes[1] || kz != axes[2] {
                 return None;
             }
             for k in 0..3 {
-                packet.origin[k].0[lane] = prepared.origin[packet.axes[k]];
-                packet.shear[k].0[lane] = prepared.shear[k];
+                packet.origin[k].0[lane] = ray.origin[axes[k]];
+                direction[k].0[lane] = ray.direction[axes[k]];
             }
             packet.t_min.0[lane] = ray.t_min;
+        }
+        for chunk in 0..PACKET / 4 {
+            let lanes = chunk * 4..chunk * 4 + 4;
+            let dx = Vec4::from_slice(&direction[0].0[lanes.clone()]);
+            let dy = Vec4::from_slice(&direction[1].0[lanes.clone()]);
+            let dz = Vec4::from_slice(&direction[2].0[lanes.clone()]);
+            (dx / dz).write_to_slice(&mut packet.shear[0].0[lanes.clone()]);
+            (dy / dz).write_to_slice(&mut packet.shear[1].0[lanes.clone()]);
+            (Vec4::ONE / dz).write_to_slice(&mut packet.shear[2].0[lanes]);
         }
         Some(packet)
     }
@@ -110,6 +120,7 @@ impl WatertightPacket {
 mod tests {
     use super::*;
     use crate::simd::{Isa, Kernel, SimdLevel, dispatch, limit_simd_level};
+    use crate::triangle::TriangleTest;
     use rtgi_math::{Rng, Vec3};
 
     /// One triangle against a packet at the active level.

@@ -49,14 +49,20 @@ impl TriangleBlock {
     /// The corners of the triangle in `lane`, as arrays.
     #[inline(always)]
     pub(crate) fn corners(&self, lane: usize) -> [[f32; 3]; 3] {
-        let c = &self.corners;
-        [0, 1, 2].map(|k| [c[k][0][lane], c[k][1][lane], c[k][2][lane]])
+        // Written out: an array map of a closure was left as a call (with
+        // its register spills) in the packet traversal's inner loop.
+        let corner = |k: usize| {
+            let c = &self.corners[k];
+            [c[0][lane], c[1][lane], c[2][lane]]
+        };
+        [corner(0), corner(1), corner(2)]
     }
 
     /// The corners of the triangle in `lane`.
     #[inline(always)]
     pub(crate) fn triangle(&self, lane: usize) -> [Vec3A; 3] {
-        self.corners(lane).map(Vec3A::from_array)
+        let [a, b, c] = self.corners(lane);
+        [Vec3A::from_array(a), Vec3A::from_array(b), Vec3A::from_array(c)]
     }
 
     /// Lanes that hold a triangle.

@@ -90,8 +90,12 @@ impl<const W: usize> WideBvh<W> {
         answer: &mut dyn FnMut(usize, Option<Hit>),
         filter: &F,
     ) {
-        let mut best: [Best; PACKET] = std::array::from_fn(|lane| Best::new(rays.get(lane).unwrap_or(&rays[0])));
-        let mut t_max = Lanes(std::array::from_fn(|lane| best[lane].t_max));
+        let mut best = [Best::new(&rays[0]); PACKET];
+        let mut t_max = Lanes([rays[0].t_max; PACKET]);
+        for (lane, ray) in rays.iter().enumerate().skip(1) {
+            best[lane] = Best::new(ray);
+            t_max.0[lane] = ray.t_max;
+        }
         // Rays are prepared for the triangle tests when they reach their
         // first leaf; the packet, for testing triangles against all its
         // rays at once, when its first leaf is reached.
