@@ -140,7 +140,13 @@ pub(crate) fn watertight_block(
     t_max: f32,
     block: &TriangleBlock,
 ) -> BlockHits {
-    let relative = block.corners.map(|corner| axes.map(|axis| corner[axis] - Vec4::splat(origin[axis])));
+    // Written out: nested array maps of closures were left as calls (3.6%
+    // of incoherent rays' time in perf).
+    let [kx, ky, kz] = axes;
+    let (ox, oy, oz) = (Vec4::splat(origin[kx]), Vec4::splat(origin[ky]), Vec4::splat(origin[kz]));
+    let relative_to_origin = |corner: &[Vec4; 3]| [corner[kx] - ox, corner[ky] - oy, corner[kz] - oz];
+    let [a, b, c] = &block.corners;
+    let relative = [relative_to_origin(a), relative_to_origin(b), relative_to_origin(c)];
     let [xs, ys, zs] = arith::watertight_shear(relative, shear);
     let uvw = arith::watertight_edges(xs, ys);
     let zero = Vec4::ZERO;
