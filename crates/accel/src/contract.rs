@@ -32,6 +32,7 @@
 
 use rtgi_math::{Ray, Vec3, Vec3A};
 
+use crate::simd::triangles::LaneHits;
 use crate::slab::{BoxRay, RobustSlabs, SlabTest};
 use crate::triangle::{TriangleHit, TriangleTest, with_triangle_test};
 use crate::{Accel, BuildStats, Counter, Hit, Intersector, NoCounter, TraversalCounters};
@@ -115,6 +116,25 @@ pub(crate) fn box_rule(ray: &BoxRay, triangle: &[Vec3A; 3], hit: TriangleHit, t_
     let enter = RobustSlabs::enter(ray, a.min(b).min(c), a.max(b).max(c), t_max);
     // `enter` is +∞ when the box is missed; otherwise it lies in [t_min, t_max].
     (enter != f32::INFINITY).then_some(TriangleHit { t: hit.t.max(enter), ..hit })
+}
+
+/// The hit rule for one ray and `triangle`, held in lane `lane` of a lane
+/// test's `hits` (a block test's triangle lane, or a packet test's ray
+/// lane): a lane the test handed back is decided by the scalar test, and
+/// a lane it hit passes the box rule.
+#[inline(always)]
+pub(crate) fn lane_hit<T: TriangleTest, L: std::ops::Index<usize, Output = f32>>(
+    ray: &PreparedRay<T>,
+    triangle: &[Vec3A; 3],
+    hits: &LaneHits<L>,
+    lane: usize,
+    t_max: f32,
+) -> Option<TriangleHit> {
+    if hits.rescan & 1 << lane != 0 {
+        hit_triangle(ray, triangle, t_max)
+    } else {
+        box_rule(&ray.boxes, triangle, hits.hit(lane), t_max)
+    }
 }
 
 /// Tests `triangles` (whose input indices are `ids`) in order, offering

@@ -55,13 +55,6 @@ pub enum ModelSide {
     OtherSide,
 }
 
-impl ModelSide {
-    /// Quarter turns from the front.
-    pub(crate) fn quarter(self) -> u32 {
-        self as u32
-    }
-}
-
 /// Why the product shot is taken from the side it is.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum SideReason {
@@ -129,6 +122,11 @@ impl std::fmt::Display for AutomaticView {
 }
 
 impl ModelSide {
+    /// Quarter turns from the front.
+    pub(crate) fn quarter(self) -> u32 {
+        self as u32
+    }
+
     fn name(self) -> &'static str {
         match self {
             ModelSide::Front => "front",

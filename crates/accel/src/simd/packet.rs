@@ -32,8 +32,7 @@ pub(crate) struct PacketRays {
 pub(crate) struct Lanes(pub(crate) [f32; PACKET]);
 
 impl Lanes {
-    /// Lanes `4 chunk .. 4 chunk + 4`. (An iterator over the chunks was
-    /// left as a call in the traversal, a twentieth of its time.)
+    /// Lanes `4 chunk .. 4 chunk + 4`.
     #[inline(always)]
     fn chunk(&self, chunk: usize) -> Vec4 {
         Vec4::from_slice(&self.0[chunk * 4..chunk * 4 + 4])

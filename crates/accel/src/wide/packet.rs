@@ -33,7 +33,7 @@ use rtgi_math::Ray;
 use super::node::ChildRef;
 use super::traverse::TraversalStack;
 use super::{WideBvh, insert_far_to_near};
-use crate::contract::{Best, HitFilter, PreparedRay, QueryKind, box_rule, hit_triangle};
+use crate::contract::{Best, HitFilter, PreparedRay, QueryKind, lane_hit};
 use crate::simd::boxes::FAR_OF_NEAR;
 use crate::simd::packet::{IntervalRay, Lanes, PACKET, PacketRays};
 use crate::simd::packet_triangles::WatertightPacket;
@@ -60,6 +60,26 @@ struct PacketScratch<T: TriangleTest> {
     /// the packet's `prepared` mask.
     prepared: [PreparedRay<T>; PACKET],
     stack: Vec<PacketEntry>,
+}
+
+/// The rays of a packet prepared for the triangle tests, each when it
+/// is first needed (most camera rays of a framed object reach no leaf).
+struct PreparedRays<'a, T: TriangleTest> {
+    rays: &'a mut [PreparedRay<T>; PACKET],
+    /// Bit `i` set once `rays[i]` is prepared.
+    ready: u32,
+}
+
+impl<T: TriangleTest> PreparedRays<'_, T> {
+    /// Ray `lane` of the packet `rays`, prepared.
+    #[inline(always)]
+    fn get(&mut self, rays: &[Ray], lane: usize) -> &PreparedRay<T> {
+        if self.ready & 1 << lane == 0 {
+            self.rays[lane] = PreparedRay::new(&rays[lane]);
+            self.ready |= 1 << lane;
+        }
+        &self.rays[lane]
+    }
 }
 
 impl<const W: usize> WideBvh<W> {
@@ -99,9 +119,9 @@ impl<const W: usize> WideBvh<W> {
         // Rays are prepared for the triangle tests when they reach their
         // first leaf; the packet, for testing triangles against all its
         // rays at once, when its first leaf is reached.
-        let mut prepared = 0u32;
         let mut packet_tests: Option<Option<WatertightPacket>> = None;
         let PacketScratch { prepared: prepared_rays, stack } = scratch;
+        let mut prepared = PreparedRays { rays: prepared_rays, ready: 0 };
         stack.clear();
         let all = if rays.len() == PACKET { u32::MAX >> (32 - PACKET) } else { (1 << rays.len()) - 1 };
         let interval = IntervalRay::new(packet);
@@ -114,20 +134,20 @@ impl<const W: usize> WideBvh<W> {
             if current.child.is_leaf() {
                 let packet_tests =
                     packet_tests.get_or_insert_with(|| if I::PACKET_TRIANGLES { T::packet(rays) } else { None });
-                let (rays_in, prepared) = (current.rays & !done, (&mut *prepared_rays, &mut prepared));
+                let rays_in = current.rays & !done;
                 done |= match packet_tests {
                     Some(packet_tests) => self.visit_leaf_packet::<Q, T, F, I>(
                         isa,
                         current.child,
                         (rays, rays_in, packet_tests),
-                        prepared,
+                        &mut prepared,
                         (&mut best, &mut t_max),
                         filter,
                     ),
                     None => self.visit_leaf_ray_by_ray::<Q, T, F>(
                         current.child,
                         (rays, rays_in),
-                        prepared,
+                        &mut prepared,
                         (&mut best, &mut t_max),
                         filter,
                     ),
@@ -197,7 +217,7 @@ impl<const W: usize> WideBvh<W> {
         &self,
         leaf: ChildRef,
         (rays, rays_in): (&[Ray], u32),
-        (prepared_rays, prepared): (&mut [PreparedRay<T>; PACKET], &mut u32),
+        prepared: &mut PreparedRays<T>,
         (best, t_max): (&mut [Best; PACKET], &mut Lanes),
         filter: &F,
     ) -> u32 {
@@ -206,13 +226,9 @@ impl<const W: usize> WideBvh<W> {
         while lanes != 0 {
             let lane = lanes.trailing_zeros() as usize;
             lanes &= lanes - 1;
-            if *prepared & 1 << lane == 0 {
-                prepared_rays[lane] = PreparedRay::new(&rays[lane]);
-                *prepared |= 1 << lane;
-            }
             if self.visit_leaf::<Q, NoCounter, T, F>(
                 leaf,
-                &prepared_rays[lane],
+                prepared.get(rays, lane),
                 &mut best[lane],
                 &mut NoCounter,
                 filter,
@@ -235,14 +251,17 @@ impl<const W: usize> WideBvh<W> {
         isa: I,
         leaf: ChildRef,
         (rays, mut rays_in, packet): (&[Ray], u32, &WatertightPacket),
-        (prepared_rays, prepared): (&mut [PreparedRay<T>; PACKET], &mut u32),
+        prepared: &mut PreparedRays<T>,
         (best, t_max): (&mut [Best; PACKET], &mut Lanes),
         filter: &F,
     ) -> u32 {
         let mut answered = 0;
         for block in &self.blocks[leaf.blocks()] {
             for (triangle_lane, &id) in block.ids.iter().enumerate() {
-                if id == TriangleBlock::NO_TRIANGLE || rays_in == 0 {
+                if rays_in == 0 {
+                    return answered;
+                }
+                if id == TriangleBlock::NO_TRIANGLE {
                     continue;
                 }
                 let hits = isa.watertight_packet(packet, t_max, block.corners(triangle_lane));
@@ -250,18 +269,8 @@ impl<const W: usize> WideBvh<W> {
                 while lanes != 0 {
                     let lane = lanes.trailing_zeros() as usize;
                     lanes &= lanes - 1;
-                    if *prepared & 1 << lane == 0 {
-                        prepared_rays[lane] = PreparedRay::new(&rays[lane]);
-                        *prepared |= 1 << lane;
-                    }
-                    let ray = &prepared_rays[lane];
-                    let triangle = block.triangle(triangle_lane);
-                    let hit = if hits.rescan & 1 << lane != 0 {
-                        hit_triangle(ray, &triangle, best[lane].t_max)
-                    } else {
-                        box_rule(&ray.boxes, &triangle, hits.hit(lane), best[lane].t_max)
-                    };
-                    if let Some(hit) = hit
+                    let ray = prepared.get(rays, lane);
+                    if let Some(hit) = lane_hit(ray, &block.triangle(triangle_lane), &hits, lane, best[lane].t_max)
                         && best[lane].offer(id, hit, filter)
                     {
                         t_max.0[lane] = best[lane].t_max;

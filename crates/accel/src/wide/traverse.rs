@@ -9,7 +9,7 @@ use rtgi_math::Ray;
 
 use super::node::{ChildRef, WideNode};
 use super::{WideBvh, insert_far_to_near};
-use crate::contract::{Best, HitFilter, PreparedRay, QueryKind, box_rule, hit_triangle};
+use crate::contract::{Best, HitFilter, PreparedRay, QueryKind, lane_hit};
 use crate::simd::boxes::PlaneRay;
 use crate::simd::triangles::TriangleBlock;
 use crate::simd::{Isa, Kernel, dispatch, prefetch};
@@ -207,13 +207,7 @@ impl<const W: usize> WideBvh<W> {
             while lanes != 0 {
                 let lane = lanes.trailing_zeros() as usize;
                 lanes &= lanes - 1;
-                let triangle = block.triangle(lane);
-                let hit = if hits.rescan & (1 << lane) != 0 {
-                    hit_triangle(ray, &triangle, best.t_max)
-                } else {
-                    box_rule(&ray.boxes, &triangle, hits.hit(lane), best.t_max)
-                };
-                if let Some(hit) = hit
+                if let Some(hit) = lane_hit(ray, &block.triangle(lane), &hits, lane, best.t_max)
                     && best.offer(block.ids[lane], hit, filter)
                     && Q::STOP_AT_FIRST_HIT
                 {
