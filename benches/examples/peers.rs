@@ -73,9 +73,10 @@ fn main() {
     let incoherent = box_rays(&scene, 1_000_000, 1);
     println!("{}: {} triangles; medians of {RUNS} alternating runs", path.display(), triangles.len());
 
-    let ours: Vec<(AccelKind, Box<dyn Accel>)> = [AccelKind::Sah, AccelKind::Bvh4, AccelKind::Bvh8, AccelKind::Sbvh8]
-        .map(|kind| (kind, kind.build(&triangles, &kind.default_params())))
-        .into();
+    let ours: Vec<(AccelKind, Box<dyn Accel>)> =
+        [AccelKind::Sah, AccelKind::Bvh4, AccelKind::Bvh8, AccelKind::Bvh8q, AccelKind::Sbvh8]
+            .map(|kind| (kind, kind.build(&triangles, &kind.default_params())))
+            .into();
     let peer_triangles: Vec<obvhs::triangle::Triangle> = triangles
         .iter()
         .map(|t| obvhs::triangle::Triangle { v0: Vec3A::from(t[0]), v1: Vec3A::from(t[1]), v2: Vec3A::from(t[2]) })
@@ -103,6 +104,7 @@ fn main() {
         let names: [&'static str; 2] = match kind {
             AccelKind::Bvh4 => ["rtgi bvh4", "rtgi bvh4 16"],
             AccelKind::Bvh8 => ["rtgi bvh8", "rtgi bvh8 16"],
+            AccelKind::Bvh8q => ["rtgi bvh8q", "rtgi bvh8q 16"],
             AccelKind::Sbvh8 => ["rtgi sbvh8", "rtgi sbvh8 16"],
             _ => ["rtgi sah", ""],
         };

@@ -1,4 +1,4 @@
-use crate::{Accel, Bvh, Bvh4, Bvh8, Intersector, LinearScan, SplitMethod, Traversal, TriangleSource};
+use crate::{Accel, Bvh, Bvh4, Bvh8, Bvh8Quantised, Intersector, LinearScan, SplitMethod, Traversal, TriangleSource};
 
 /// The acceleration structures this crate offers, selectable by name.
 ///
@@ -22,6 +22,8 @@ pub enum AccelKind {
     Bvh4,
     /// Binned SAH BVH collapsed to eight children a node, traversed with SIMD.
     Bvh8,
+    /// bvh8 with child boxes quantised to one byte a plane: half the node memory.
+    Bvh8q,
     /// BVH split by the binned SAH with spatial splits (SBVH): triangles
     /// that straddle a cut are referenced on both sides, so that nodes of
     /// interiors with long walls overlap less.
@@ -99,6 +101,7 @@ impl AccelKind {
         AccelKind::SahSweep,
         AccelKind::Bvh4,
         AccelKind::Bvh8,
+        AccelKind::Bvh8q,
         AccelKind::Sbvh,
         AccelKind::Sbvh8,
     ];
@@ -125,6 +128,7 @@ impl AccelKind {
             AccelKind::Linear => "linear",
             AccelKind::Bvh4 => "bvh4",
             AccelKind::Bvh8 => "bvh8",
+            AccelKind::Bvh8q => "bvh8q",
             AccelKind::Sbvh8 => "sbvh8",
             #[cfg(feature = "embree")]
             AccelKind::Embree => "embree",
@@ -138,7 +142,7 @@ impl AccelKind {
         match self {
             AccelKind::Linear => None,
             AccelKind::Bvh4 => Some(4),
-            AccelKind::Bvh8 | AccelKind::Sbvh8 => Some(8),
+            AccelKind::Bvh8 | AccelKind::Bvh8q | AccelKind::Sbvh8 => Some(8),
             #[cfg(feature = "embree")]
             AccelKind::Embree => None,
             _ => Some(2),
@@ -167,7 +171,7 @@ impl AccelKind {
             AccelKind::SpatialMedian => Some(SplitMethod::SpatialMedian),
             AccelKind::Sah => Some(SplitMethod::BinnedSah),
             AccelKind::SahSweep => Some(SplitMethod::SweepSah),
-            AccelKind::Bvh4 | AccelKind::Bvh8 => Some(SplitMethod::BinnedSah),
+            AccelKind::Bvh4 | AccelKind::Bvh8 | AccelKind::Bvh8q => Some(SplitMethod::BinnedSah),
             AccelKind::Sbvh | AccelKind::Sbvh8 => Some(SplitMethod::SpatialSah),
             #[cfg(feature = "embree")]
             AccelKind::Embree => None,
@@ -204,6 +208,7 @@ impl AccelKind {
         Ok(match (self, self.split_method()) {
             (AccelKind::Bvh4, Some(method)) => Box::new(Bvh4::new(triangles, method, params)),
             (AccelKind::Bvh8 | AccelKind::Sbvh8, Some(method)) => Box::new(Bvh8::new(triangles, method, params)),
+            (AccelKind::Bvh8q, Some(method)) => Box::new(Bvh8Quantised::new(triangles, method, params)),
             (_, Some(method)) => Box::new(Bvh::new(triangles, method, params)),
             (_, None) => Box::new(LinearScan::new(triangles, params.intersector)),
         })

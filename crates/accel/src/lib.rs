@@ -124,7 +124,7 @@ pub use linear::LinearScan;
 pub use primitive::{Primitive, PrimitiveHit, intersect_primitive};
 pub use triangle::{Intersector, TriangleHit};
 pub use triangle_source::TriangleSource;
-pub use wide::{Bvh4, Bvh8, WideBvh};
+pub use wide::{Bvh4, Bvh8, Bvh8Quantised, QuantisedNode, WideBvh, WideNode};
 
 /// The math types this crate takes and returns, re-exported so that a user
 /// needs one dependency and sees the same glam version as the crate.

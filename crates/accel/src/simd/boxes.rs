@@ -43,6 +43,13 @@ impl<const W: usize> WideBoxes<W> {
         }
     }
 
+    /// The box in lane `lane`, as its minimum and maximum.
+    #[inline(always)]
+    pub(crate) fn lane(&self, lane: usize) -> ([f32; 3], [f32; 3]) {
+        let p = &self.planes;
+        ([p[0][lane], p[1][lane], p[2][lane]], [p[3][lane], p[4][lane], p[5][lane]])
+    }
+
     /// The distance at which the ray enters each box within
     /// `[t_min, t_max]`, or +∞ for boxes it misses, and a mask of the
     /// boxes entered (bit `i` for lane `i`).
@@ -51,10 +58,7 @@ impl<const W: usize> WideBoxes<W> {
     /// EVEX-encoded when compiled for a wider level.
     #[inline(always)]
     pub(crate) fn enter(&self, ray: &PlaneRay, t_max: f32) -> (u32, [f32; W]) {
-        self.enter_with(ray.near, ray.t_min, t_max, |axis, near, far| {
-            let (origin, inv) = (Vec4::splat(ray.origin[axis]), Vec4::splat(ray.inv_direction[axis]));
-            ((near - origin) * inv, later_exit((far - origin) * inv, Vec4::max))
-        })
+        self.enter_with(ray.near, ray.t_min, t_max, |axis, near, far| single_ray_distances(ray, axis, near, far))
     }
 
     /// The slab test's combination of distances, four boxes at a time:
@@ -71,27 +75,49 @@ impl<const W: usize> WideBoxes<W> {
         t_max: f32,
         distances: impl Fn(usize, Vec4, Vec4) -> (Vec4, Vec4),
     ) -> (u32, [f32; W]) {
-        const { assert!(W.is_multiple_of(4), "wide nodes have a multiple of four lanes") };
-        let mut entries = [f32::INFINITY; W];
-        let mut mask = 0;
-        for chunk in 0..W / 4 {
-            let lanes = chunk * 4..chunk * 4 + 4;
-            let mut enter = Vec4::splat(t_min);
-            let mut exit = Vec4::splat(t_max);
-            for (axis, flip) in FAR_OF_NEAR.into_iter().enumerate() {
-                let near = Vec4::from_slice(&self.planes[near_planes[axis]][lanes.clone()]);
-                let far = Vec4::from_slice(&self.planes[near_planes[axis] ^ flip][lanes.clone()]);
-                let (t_near, t_far) = distances(axis, near, far);
-                // A NaN compares false and leaves the bound as it was.
-                enter = Vec4::select(t_near.cmpgt(enter), t_near, enter);
-                exit = Vec4::select(t_far.cmplt(exit), t_far, exit);
-            }
-            let entered = enter.cmple(exit) & enter.cmplt(Vec4::INFINITY);
-            Vec4::select(entered, enter, Vec4::INFINITY).write_to_slice(&mut entries[lanes]);
-            mask |= entered.bitmask() << (chunk * 4);
-        }
-        (mask, entries)
+        let plane = |k: usize, first: usize| Vec4::from_slice(&self.planes[k][first..first + 4]);
+        enter_planes(plane, near_planes, t_min, t_max, distances)
     }
+}
+
+/// [`WideBoxes::enter_with`] on `W` boxes whose planes `plane(k, first)`
+/// gives: row `k` of [`WideBoxes::planes`], lanes `first..first + 4`.
+#[inline(always)]
+pub(crate) fn enter_planes<const W: usize>(
+    plane: impl Fn(usize, usize) -> Vec4,
+    near_planes: [usize; 3],
+    t_min: f32,
+    t_max: f32,
+    distances: impl Fn(usize, Vec4, Vec4) -> (Vec4, Vec4),
+) -> (u32, [f32; W]) {
+    const { assert!(W.is_multiple_of(4), "wide nodes have a multiple of four lanes") };
+    let mut entries = [f32::INFINITY; W];
+    let mut mask = 0;
+    for chunk in 0..W / 4 {
+        let first = chunk * 4;
+        let mut enter = Vec4::splat(t_min);
+        let mut exit = Vec4::splat(t_max);
+        for (axis, flip) in FAR_OF_NEAR.into_iter().enumerate() {
+            let near = plane(near_planes[axis], first);
+            let far = plane(near_planes[axis] ^ flip, first);
+            let (t_near, t_far) = distances(axis, near, far);
+            // A NaN compares false and leaves the bound as it was.
+            enter = Vec4::select(t_near.cmpgt(enter), t_near, enter);
+            exit = Vec4::select(t_far.cmplt(exit), t_far, exit);
+        }
+        let entered = enter.cmple(exit) & enter.cmplt(Vec4::INFINITY);
+        Vec4::select(entered, enter, Vec4::INFINITY).write_to_slice(&mut entries[first..first + 4]);
+        mask |= entered.bitmask() << first;
+    }
+    (mask, entries)
+}
+
+/// The distances of [`WideBoxes::enter`] to four boxes' planes along
+/// `axis`: near, and far enlarged.
+#[inline(always)]
+pub(crate) fn single_ray_distances(ray: &PlaneRay, axis: usize, near: Vec4, far: Vec4) -> (Vec4, Vec4) {
+    let (origin, inv) = (Vec4::splat(ray.origin[axis]), Vec4::splat(ray.inv_direction[axis]));
+    ((near - origin) * inv, later_exit((far - origin) * inv, Vec4::max))
 }
 
 /// `near ^ FAR_OF_NEAR[axis]` turns the index of an axis's min plane into

@@ -22,6 +22,7 @@ use super::boxes::{FAR_OF_NEAR, PlaneRay, WideBoxes};
 use super::packet::{Lanes, PACKET, PacketRays};
 use super::packet_triangles::{PacketHits, WatertightPacket};
 use crate::slab::{ROBUST_FAR_SCALE, ROBUST_FAR_SHRINK};
+use crate::wide::QuantisedNode;
 
 /// The instruction sets the kernels are compiled for, narrowest first.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
@@ -164,6 +165,10 @@ pub(crate) trait Isa: Copy {
     /// [`WideBoxes::enter`]: where one ray enters each of `W` boxes.
     fn enter_boxes<const W: usize>(self, boxes: &WideBoxes<W>, ray: &PlaneRay, t_max: f32) -> (u32, [f32; W]);
 
+    /// [`QuantisedNode::enter_portable`]: where one ray enters each of the
+    /// `W` quantised boxes of a node.
+    fn enter_quantised<const W: usize>(self, node: &QuantisedNode<W>, ray: &PlaneRay, t_max: f32) -> (u32, [f32; W]);
+
     /// [`PacketRays::enter_box`]: which rays of a packet enter one box.
     fn enter_box_packet(
         self,
@@ -215,6 +220,11 @@ impl Isa for Portable {
     }
 
     #[inline(always)]
+    fn enter_quantised<const W: usize>(self, node: &QuantisedNode<W>, ray: &PlaneRay, t_max: f32) -> (u32, [f32; W]) {
+        node.enter_portable(ray, t_max)
+    }
+
+    #[inline(always)]
     fn enter_box_packet(
         self,
         near: [f32; 3],
@@ -260,6 +270,15 @@ impl Isa for Avx2 {
     }
 
     #[inline(always)]
+    fn enter_quantised<const W: usize>(self, node: &QuantisedNode<W>, ray: &PlaneRay, t_max: f32) -> (u32, [f32; W]) {
+        if !W.is_multiple_of(8) {
+            return node.enter_portable(ray, t_max);
+        }
+        // SAFETY: as above, the CPU runs AVX2.
+        unsafe { enter_quantised_avx2(node, ray, t_max) }
+    }
+
+    #[inline(always)]
     fn enter_box_packet(
         self,
         near: [f32; 3],
@@ -288,6 +307,11 @@ impl Isa for Avx512 {
     #[inline(always)]
     fn enter_boxes<const W: usize>(self, boxes: &WideBoxes<W>, ray: &PlaneRay, t_max: f32) -> (u32, [f32; W]) {
         Avx2(()).enter_boxes(boxes, ray, t_max)
+    }
+
+    #[inline(always)]
+    fn enter_quantised<const W: usize>(self, node: &QuantisedNode<W>, ray: &PlaneRay, t_max: f32) -> (u32, [f32; W]) {
+        Avx2(()).enter_quantised(node, ray, t_max)
     }
 
     #[inline(always)]
@@ -429,6 +453,42 @@ fn enter_boxes_avx2<const W: usize>(boxes: &WideBoxes<W>, ray: &PlaneRay, t_max:
         // in two unless it sees the alignment.)
         unsafe { _mm256_load_ps(lanes.as_ptr()) }
     };
+    enter_planes_avx2::<W>(load, ray, t_max)
+}
+
+/// [`QuantisedNode::enter_portable`] eight lanes at a time: each plane's
+/// steps widened to 32-bit integers, converted (exactly) and decoded with
+/// the same product and sum, then the slab test of [`enter_boxes_avx2`].
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+#[inline]
+fn enter_quantised_avx2<const W: usize>(node: &QuantisedNode<W>, ray: &PlaneRay, t_max: f32) -> (u32, [f32; W]) {
+    use std::arch::x86_64::*;
+    let (origin, scale) = (node.origin(), node.scale());
+    let load = |plane: usize, chunk: usize| {
+        let steps: &[u8; 8] = node.steps(plane)[chunk * 8..chunk * 8 + 8].try_into().expect("eight lanes");
+        // SAFETY: `steps` is a reference to eight bytes, valid for the
+        // 8-byte load, which has no alignment requirement.
+        let bytes = unsafe { _mm_loadl_epi64(steps.as_ptr().cast()) };
+        let steps = _mm256_cvtepi32_ps(_mm256_cvtepu8_epi32(bytes));
+        let axis = plane % 3;
+        _mm256_add_ps(_mm256_set1_ps(origin[axis]), _mm256_mul_ps(steps, _mm256_set1_ps(scale[axis])))
+    };
+    enter_planes_avx2::<W>(load, ray, t_max)
+}
+
+/// The slab test of [`WideBoxes::enter`] on eight lanes at a time, whose
+/// planes `load(plane, chunk)` gives: row `plane` of
+/// [`WideBoxes::planes`], lanes `8 · chunk` to `8 · chunk + 7`.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+#[inline]
+fn enter_planes_avx2<const W: usize>(
+    load: impl Fn(usize, usize) -> std::arch::x86_64::__m256,
+    ray: &PlaneRay,
+    t_max: f32,
+) -> (u32, [f32; W]) {
+    use std::arch::x86_64::*;
     let mut distances = [f32::INFINITY; W];
     let mut mask = 0;
     for chunk in 0..W / 8 {
@@ -540,16 +600,23 @@ mod tests {
         packet: &'a PacketRays,
         t_max: f32,
         packet_t_max: &'a Lanes,
+        quantised: &'a QuantisedNode<8>,
     }
 
+    type Entered = (u32, [f32; 8]);
+
     impl Kernel for Compare<'_> {
-        type Output = ((u32, [f32; 8]), (u32, [f32; 8]), Vec<((u32, f32), (u32, f32))>);
+        type Output = ((Entered, Entered), (Entered, Entered), Vec<((u32, f32), (u32, f32))>);
 
         #[inline(always)]
         fn run<I: Isa>(self, isa: I) -> Self::Output {
             let node = (
                 isa.enter_boxes(self.boxes, self.ray, self.t_max),
                 Portable.enter_boxes(self.boxes, self.ray, self.t_max),
+            );
+            let quantised = (
+                isa.enter_quantised(self.quantised, self.ray, self.t_max),
+                Portable.enter_quantised(self.quantised, self.ray, self.t_max),
             );
             let packets = (0..8)
                 .map(|lane| {
@@ -562,7 +629,7 @@ mod tests {
                     )
                 })
                 .collect();
-            (node.0, node.1, packets)
+            (node, quantised, packets)
         }
     }
 
@@ -589,6 +656,7 @@ mod tests {
                     Vec3::from(a).max(Vec3::from(b)).to_array(),
                 );
             }
+            let quantised = QuantisedNode::of_boxes(&boxes, 7);
             let direction = Vec3::from([0; 3].map(|_| coordinate(&mut rng)));
             let direction = if direction == Vec3::ZERO { Vec3::new(-0.0, 0.5, 1.0) } else { direction };
             let rays: Vec<Ray> =
@@ -599,10 +667,19 @@ mod tests {
             let packet_t_max = Lanes(std::array::from_fn(|_| rng.next_f32() * 8.0));
             for &level in SimdLevel::ALL.iter().filter(|&&level| level <= detected) {
                 limit_simd_level(level);
-                let (node, portable_node, packets) =
-                    dispatch(Compare { boxes: &boxes, ray: &ray, packet: &packet, t_max, packet_t_max: &packet_t_max });
-                assert_eq!(node.0, portable_node.0, "{level}");
-                assert_eq!(node.1.map(f32::to_bits), portable_node.1.map(f32::to_bits), "{level}");
+                let compare = Compare {
+                    boxes: &boxes,
+                    ray: &ray,
+                    packet: &packet,
+                    t_max,
+                    packet_t_max: &packet_t_max,
+                    quantised: &quantised,
+                };
+                let (node, node_quantised, packets) = dispatch(compare);
+                for (ours, portable) in [node, node_quantised] {
+                    assert_eq!(ours.0, portable.0, "{level}");
+                    assert_eq!(ours.1.map(f32::to_bits), portable.1.map(f32::to_bits), "{level}");
+                }
                 for (ours, portable) in packets {
                     assert_eq!(ours.0, portable.0, "{level}");
                     assert_eq!(ours.1.to_bits(), portable.1.to_bits(), "{level}");

@@ -8,7 +8,7 @@
 use rtgi_math::glam::BVec4A;
 use rtgi_math::{Mat4, Ray, Vec4};
 
-use super::boxes::WideBoxes;
+use super::boxes::{WideBoxes, enter_planes};
 use crate::slab::later_exit;
 
 /// Rays in a packet.
@@ -251,15 +251,31 @@ impl IntervalRay {
     /// as it does for the ray that has it.
     #[inline(always)]
     pub(crate) fn enter_boxes<const W: usize>(&self, boxes: &WideBoxes<W>, t_max: f32) -> (u32, [f32; W]) {
-        boxes.enter_with(self.near, self.t_min, t_max, |axis, near, far| {
-            let (small, big, sign) =
-                (Vec4::splat(self.inv_small[axis]), Vec4::splat(self.inv_big[axis]), Vec4::splat(self.sign[axis]));
-            let to_near = near - Vec4::splat(self.origin_ahead[axis]);
-            let to_far = far - Vec4::splat(self.origin_behind[axis]);
-            let t_near = to_near * Vec4::select((to_near * sign).cmpgt(Vec4::ZERO), small, big);
-            let t_far = to_far * Vec4::select((to_far * sign).cmplt(Vec4::ZERO), small, big);
-            (t_near, later_exit(t_far, Vec4::max))
-        })
+        boxes.enter_with(self.near, self.t_min, t_max, |axis, near, far| self.distances(axis, near, far))
+    }
+
+    /// [`IntervalRay::enter_boxes`] on `W` boxes whose planes
+    /// `plane(k, first)` gives (see [`enter_planes`]).
+    #[inline(always)]
+    pub(crate) fn enter_planes<const W: usize>(
+        &self,
+        plane: impl Fn(usize, usize) -> Vec4,
+        t_max: f32,
+    ) -> (u32, [f32; W]) {
+        enter_planes(plane, self.near, self.t_min, t_max, |axis, near, far| self.distances(axis, near, far))
+    }
+
+    /// The least distance to four boxes' near planes along `axis`, and the
+    /// greatest (enlarged) to their far planes, over the packet's rays.
+    #[inline(always)]
+    fn distances(&self, axis: usize, near: Vec4, far: Vec4) -> (Vec4, Vec4) {
+        let (small, big, sign) =
+            (Vec4::splat(self.inv_small[axis]), Vec4::splat(self.inv_big[axis]), Vec4::splat(self.sign[axis]));
+        let to_near = near - Vec4::splat(self.origin_ahead[axis]);
+        let to_far = far - Vec4::splat(self.origin_behind[axis]);
+        let t_near = to_near * Vec4::select((to_near * sign).cmpgt(Vec4::ZERO), small, big);
+        let t_far = to_far * Vec4::select((to_far * sign).cmplt(Vec4::ZERO), small, big);
+        (t_near, later_exit(t_far, Vec4::max))
     }
 }
 

@@ -1,18 +1,80 @@
-//! The node of a wide BVH and the references to its children.
+//! The node of a wide BVH, the references to its children, and what
+//! traversal asks of a node however it stores its boxes ([`NodeLayout`]).
 
-use crate::simd::boxes::WideBoxes;
+use crate::simd::Isa;
+use crate::simd::boxes::{PlaneRay, WideBoxes};
+use crate::simd::packet::IntervalRay;
 
 /// A node with up to `W` children: their boxes structure-of-arrays, so
-/// that one ray tests all of them at once, and a [`ChildRef`] for each.
+/// that one ray tests all of them at once, and a reference to each child.
 #[derive(Clone, Copy, Debug)]
 #[repr(C, align(64))]
-pub(crate) struct WideNode<const W: usize> {
+pub struct WideNode<const W: usize> {
     pub(crate) boxes: WideBoxes<W>,
     pub(crate) children: [ChildRef; W],
 }
 
 impl<const W: usize> WideNode<W> {
     pub(crate) const EMPTY: Self = Self { boxes: WideBoxes::EMPTY, children: [ChildRef::NONE; W] };
+}
+
+/// How a wide BVH stores its nodes: as built ([`WideNode`], 32-bit
+/// planes) or compressed ([`super::quantised::QuantisedNode`]). Traversal
+/// asks a node only these questions, so that both layouts share it.
+///
+/// A layout's boxes may be larger than the built ones, never smaller:
+/// every box a layout answers for holds the built box of its child, so
+/// that the robust slab test, which is monotone in the planes, enters it
+/// wherever it enters the built box, no later. That keeps the answers
+/// exact (see the crate's exactness contract).
+pub(crate) trait NodeLayout<const W: usize>: Copy + std::fmt::Debug + Send + Sync + 'static {
+    /// The suffix of the variant's name in reports (`bvh8` + `q`).
+    const NAME_SUFFIX: &'static str;
+
+    /// The built nodes in this layout, in the same order.
+    fn from_built(nodes: Vec<WideNode<W>>) -> Vec<Self>;
+
+    /// The references to the node's children ([`ChildRef::NONE`] for
+    /// empty lanes).
+    fn children(&self) -> &[ChildRef; W];
+
+    /// [`Isa::enter_boxes`] on the node's boxes: where one ray enters each
+    /// child, and the mask of the children it enters.
+    fn enter<I: Isa>(&self, isa: I, ray: &PlaneRay, t_max: f32) -> (u32, [f32; W]);
+
+    /// [`IntervalRay::enter_boxes`] on the node's boxes.
+    fn enter_interval(&self, ray: &IntervalRay, t_max: f32) -> (u32, [f32; W]);
+
+    /// The box of the child in `lane`, as its minimum and maximum.
+    fn child_box(&self, lane: usize) -> ([f32; 3], [f32; 3]);
+}
+
+impl<const W: usize> NodeLayout<W> for WideNode<W> {
+    const NAME_SUFFIX: &'static str = "";
+
+    fn from_built(nodes: Vec<WideNode<W>>) -> Vec<Self> {
+        nodes
+    }
+
+    #[inline(always)]
+    fn children(&self) -> &[ChildRef; W] {
+        &self.children
+    }
+
+    #[inline(always)]
+    fn enter<I: Isa>(&self, isa: I, ray: &PlaneRay, t_max: f32) -> (u32, [f32; W]) {
+        isa.enter_boxes(&self.boxes, ray, t_max)
+    }
+
+    #[inline(always)]
+    fn enter_interval(&self, ray: &IntervalRay, t_max: f32) -> (u32, [f32; W]) {
+        ray.enter_boxes(&self.boxes, t_max)
+    }
+
+    #[inline(always)]
+    fn child_box(&self, lane: usize) -> ([f32; 3], [f32; 3]) {
+        self.boxes.lane(lane)
+    }
 }
 
 /// A child of a wide node, packed in 32 bits: another node (its index,

@@ -30,11 +30,10 @@ use std::marker::PhantomData;
 
 use rtgi_math::Ray;
 
-use super::node::ChildRef;
+use super::node::{ChildRef, NodeLayout};
 use super::traverse::TraversalStack;
 use super::{WideBvh, insert_far_to_near};
 use crate::contract::{Best, HitFilter, PreparedRay, QueryKind, lane_hit};
-use crate::simd::boxes::FAR_OF_NEAR;
 use crate::simd::packet::{IntervalRay, Lanes, PACKET, PacketRays};
 use crate::simd::packet_triangles::WatertightPacket;
 use crate::simd::triangles::TriangleBlock;
@@ -82,7 +81,7 @@ impl<T: TriangleTest> PreparedRays<'_, T> {
     }
 }
 
-impl<const W: usize> WideBvh<W> {
+impl<const W: usize, N: NodeLayout<W>> WideBvh<W, N> {
     /// Answers every ray of `rays`: packets where sixteen consecutive rays
     /// are coherent, single rays elsewhere.
     pub(super) fn query_batch_dispatched<Q: QueryKind, F: HitFilter>(
@@ -91,7 +90,7 @@ impl<const W: usize> WideBvh<W> {
         answer: &mut dyn FnMut(usize, Option<Hit>),
         filter: &F,
     ) {
-        with_triangle_test!(self.intersector, |T| dispatch(Batch::<W, Q, T, F> {
+        with_triangle_test!(self.intersector, |T| dispatch(Batch::<W, N, Q, T, F> {
             bvh: self,
             rays,
             answer,
@@ -159,19 +158,23 @@ impl<const W: usize> WideBvh<W> {
                 // so that only the rays that enter it take its triangles.
                 let node = &self.nodes[current.child.node_index()];
                 let active = all & !done;
-                let (maybe, enter) = interval.enter_boxes(&node.boxes, latest);
+                let (maybe, enter) = node.enter_interval(&interval, latest);
+                let children = node.children();
                 let mut entered = [PacketEntry { child: ChildRef::NONE, rays: 0, enter: 0.0 }; W];
                 let mut count = 0;
                 let mut lanes = maybe;
                 while lanes != 0 {
                     let lane = lanes.trailing_zeros() as usize;
                     lanes &= lanes - 1;
-                    let child = node.children[lane];
+                    let child = children[lane];
                     let entry = if child.is_leaf() {
-                        let planes = &node.boxes.planes;
-                        let plane = |axis: usize, flip: usize| planes[packet.near[axis] ^ flip][lane];
-                        let near = [plane(0, 0), plane(1, 0), plane(2, 0)];
-                        let far = [plane(0, FAR_OF_NEAR[0]), plane(1, FAR_OF_NEAR[1]), plane(2, FAR_OF_NEAR[2])];
+                        let (min, max) = node.child_box(lane);
+                        let planes = [min, max];
+                        // `packet.near[axis]` is `axis` (the minimum) or `axis + 3` (the maximum).
+                        let plane =
+                            |axis: usize, far: bool| planes[(packet.near[axis] >= 3) as usize ^ far as usize][axis];
+                        let near = [plane(0, false), plane(1, false), plane(2, false)];
+                        let far = [plane(0, true), plane(1, true), plane(2, true)];
                         let (rays_in, enter) = isa.enter_box_packet(near, far, packet, &t_max, active);
                         if rays_in == 0 {
                             continue;
@@ -207,7 +210,7 @@ impl<const W: usize> WideBvh<W> {
     }
 }
 
-impl<const W: usize> WideBvh<W> {
+impl<const W: usize, N: NodeLayout<W>> WideBvh<W, N> {
     /// Tests `leaf` ray by ray, for each ray of `rays_in` with the block
     /// tests of single rays; offers each ray's hits to its `best`,
     /// keeping `t_max` in step. Returns the rays whose query is answered
@@ -287,15 +290,17 @@ impl<const W: usize> WideBvh<W> {
 }
 
 /// A batch of queries as one [`Kernel`].
-struct Batch<'a, const W: usize, Q, T, F> {
-    bvh: &'a WideBvh<W>,
+struct Batch<'a, const W: usize, N, Q, T, F> {
+    bvh: &'a WideBvh<W, N>,
     rays: &'a [Ray],
     answer: &'a mut dyn FnMut(usize, Option<Hit>),
     filter: &'a F,
     kinds: PhantomData<(Q, T)>,
 }
 
-impl<const W: usize, Q: QueryKind, T: TriangleTest, F: HitFilter> Kernel for Batch<'_, W, Q, T, F> {
+impl<const W: usize, N: NodeLayout<W>, Q: QueryKind, T: TriangleTest, F: HitFilter> Kernel
+    for Batch<'_, W, N, Q, T, F>
+{
     type Output = ();
 
     #[inline(always)]

@@ -7,7 +7,7 @@ use std::marker::PhantomData;
 
 use rtgi_math::Ray;
 
-use super::node::{ChildRef, WideNode};
+use super::node::{ChildRef, NodeLayout};
 use super::{WideBvh, insert_far_to_near};
 use crate::contract::{Best, HitFilter, PreparedRay, QueryKind, lane_hit};
 use crate::simd::boxes::PlaneRay;
@@ -67,7 +67,7 @@ impl<const INLINE: usize> TraversalStack<INLINE> {
 /// Entries kept on the call stack: enough for every tree but degenerate ones.
 const INLINE_STACK: usize = 32;
 
-impl<const W: usize> WideBvh<W> {
+impl<const W: usize, N: NodeLayout<W>> WideBvh<W, N> {
     /// The query compiled for the intersector and run at the active SIMD level.
     pub(super) fn query_dispatched<Q: QueryKind, C: Counter, F: HitFilter>(
         &self,
@@ -75,7 +75,7 @@ impl<const W: usize> WideBvh<W> {
         counter: &mut C,
         filter: &F,
     ) -> Option<Hit> {
-        with_triangle_test!(self.intersector, |T| dispatch(SingleRay::<W, Q, C, T, F> {
+        with_triangle_test!(self.intersector, |T| dispatch(SingleRay::<W, N, Q, C, T, F> {
             bvh: self,
             ray,
             counter,
@@ -114,11 +114,12 @@ impl<const W: usize> WideBvh<W> {
             } else {
                 let node = &self.nodes[current.node_index()];
                 counter.node_visited();
-                let (entered, enter) = isa.enter_boxes(&node.boxes, &plane_ray, best.t_max);
+                let (entered, enter) = node.enter(isa, &plane_ray, best.t_max);
+                let children = node.children();
                 if entered != 0 {
                     let first = entered.trailing_zeros() as usize;
                     if entered & (entered - 1) == 0 {
-                        current = node.children[first];
+                        current = children[first];
                         continue;
                     }
                     if Q::STOP_AT_FIRST_HIT {
@@ -128,19 +129,19 @@ impl<const W: usize> WideBvh<W> {
                         while lanes != 0 {
                             let lane = lanes.trailing_zeros() as usize;
                             lanes &= lanes - 1;
-                            self.prefetch(node.children[lane]);
-                            stack.push((node.children[lane], enter[lane]));
+                            self.prefetch(children[lane]);
+                            stack.push((children[lane], enter[lane]));
                         }
-                        current = node.children[first];
+                        current = children[first];
                         continue;
                     }
                     let second = (entered & (entered - 1)).trailing_zeros() as usize;
                     if entered.count_ones() == 2 {
                         let (near, far) = if enter[second] < enter[first] { (second, first) } else { (first, second) };
-                        let far_entry = (node.children[far], enter[far]);
+                        let far_entry = (children[far], enter[far]);
                         self.prefetch(far_entry.0);
                         stack.push(far_entry);
-                        current = node.children[near];
+                        current = children[near];
                         continue;
                     }
                     // Children entered, sorted far to near: the nearest is
@@ -151,7 +152,7 @@ impl<const W: usize> WideBvh<W> {
                     while lanes != 0 {
                         let lane = lanes.trailing_zeros() as usize;
                         lanes &= lanes - 1;
-                        insert_far_to_near(&mut sorted, count, (node.children[lane], enter[lane]), |e| e.1);
+                        insert_far_to_near(&mut sorted, count, (children[lane], enter[lane]), |e| e.1);
                         count += 1;
                     }
                     for &entry in &sorted[..count - 1] {
@@ -185,7 +186,7 @@ impl<const W: usize> WideBvh<W> {
                 prefetch(first, blocks.len() * std::mem::size_of::<TriangleBlock>());
             }
         } else if let Some(node) = self.nodes.get(child.node_index()) {
-            prefetch(node, std::mem::size_of::<WideNode<W>>());
+            prefetch(node, std::mem::size_of::<N>());
         }
     }
 
@@ -220,15 +221,17 @@ impl<const W: usize> WideBvh<W> {
 }
 
 /// One query as a [`Kernel`], so that it runs compiled for the active SIMD level.
-struct SingleRay<'a, const W: usize, Q, C, T, F> {
-    bvh: &'a WideBvh<W>,
+struct SingleRay<'a, const W: usize, N, Q, C, T, F> {
+    bvh: &'a WideBvh<W, N>,
     ray: &'a Ray,
     counter: &'a mut C,
     filter: &'a F,
     test: PhantomData<(Q, T)>,
 }
 
-impl<const W: usize, Q: QueryKind, C: Counter, T: TriangleTest, F: HitFilter> Kernel for SingleRay<'_, W, Q, C, T, F> {
+impl<const W: usize, N: NodeLayout<W>, Q: QueryKind, C: Counter, T: TriangleTest, F: HitFilter> Kernel
+    for SingleRay<'_, W, N, Q, C, T, F>
+{
     type Output = Option<Hit>;
 
     #[inline(always)]
