@@ -198,6 +198,20 @@ impl AccelKind {
         triangles: &(impl TriangleSource + ?Sized),
         params: &BuildParams,
     ) -> Result<Box<dyn Accel>, BuildError> {
+        self.try_build_from_any(&triangles, params)
+    }
+
+    /// [`AccelKind::try_build`] for every source at once. Building a
+    /// `Box<dyn Accel>` generates code for every structure's queries, and a
+    /// generic builder did so again in every crate that built from a source
+    /// type of its own: two minutes of compiling per test binary. Builds
+    /// read each triangle once or twice, so the virtual call is lost in the
+    /// build's time.
+    fn try_build_from_any(
+        self,
+        triangles: &dyn TriangleSource,
+        params: &BuildParams,
+    ) -> Result<Box<dyn Accel>, BuildError> {
         #[cfg(feature = "embree")]
         if self == AccelKind::Embree {
             return match crate::EmbreeBackend::new(triangles) {

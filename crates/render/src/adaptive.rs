@@ -157,9 +157,9 @@ impl AdaptiveSampling {
 /// pixel, in rounds, each pixel stopping as `settings.adaptive` says (see
 /// the module's documentation; without it, [`AdaptiveError::NoTarget`]).
 /// `on_round` hears of each round as it ends.
-pub fn render_adaptive<A: Accel + ?Sized>(
+pub fn render_adaptive(
     scene: &Scene,
-    accel: &A,
+    accel: &dyn Accel,
     camera: &Camera,
     settings: &RenderSettings,
     on_round: &mut dyn FnMut(&Round),

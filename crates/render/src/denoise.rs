@@ -125,7 +125,7 @@ impl Guides {
     /// Renders the guides of the view that `settings` (size, seed, effects)
     /// and `camera` render: [`GUIDE_SAMPLES`] camera rays a pixel, spread
     /// over it in a 2 × 2 grid, each giving all four guides at once.
-    pub fn render<A: Accel + ?Sized>(scene: &Scene, accel: &A, camera: &Camera, settings: &RenderSettings) -> Guides {
+    pub fn render(scene: &Scene, accel: &dyn Accel, camera: &Camera, settings: &RenderSettings) -> Guides {
         let plan = EffectPlan::new(scene, settings);
         let (alpha, textures) = (plan.has(Effect::Alpha), plan.has(Effect::Textures));
         let cut_outs = alpha.then(|| AlphaTest::new(scene));
@@ -161,9 +161,9 @@ impl Guides {
 /// PNG output: the samples in two halves (the image is the same, bit for
 /// bit, as [`crate::render`]'s), the guides, then the filter. Returns the
 /// denoised image and the samples' mean.
-pub fn render_denoised<A: Accel + ?Sized>(
+pub fn render_denoised(
     scene: &Scene,
-    accel: &A,
+    accel: &dyn Accel,
     camera: &Camera,
     settings: &RenderSettings,
     denoise_settings: &DenoiseSettings,

@@ -255,6 +255,11 @@ fn tiles(width: u32, rows: Range<u32>) -> Vec<(u32, u32, u32, u32)> {
 /// `progress` is called from the worker threads with the number of pixels
 /// finished since its last call; it must be cheap.
 ///
+/// Any structure is passed as `&dyn Accel` (a `&Bvh8` coerces to it), as
+/// to every entry point of the renderer: it is compiled once, in this
+/// crate, rather than again in every crate that renders, and one virtual
+/// call a ray is nothing beside the ray's traversal.
+///
 /// The image has the same bits as any progressive or split render of the
 /// same settings ([`render_pass`], [`Accumulation::merge`]). With
 /// [`RenderSettings::adaptive`], pixels take samples in rounds until their
@@ -264,9 +269,9 @@ fn tiles(width: u32, rows: Range<u32>) -> Vec<(u32, u32, u32, u32)> {
 /// # Panics
 /// If `settings.adaptive` cannot run ([`AdaptiveSampling::check`]: a
 /// sampler laid out for a fixed count, or no target).
-pub fn render<A: Accel + ?Sized>(
+pub fn render(
     scene: &Scene,
-    accel: &A,
+    accel: &dyn Accel,
     camera: &Camera,
     settings: &RenderSettings,
     progress: &(dyn Fn(u64) + Sync),
@@ -327,9 +332,9 @@ pub struct Cancelled;
 /// If `accumulation` is of another size, seed or sample count than
 /// `settings`, `count` goes past the render's samples, or the settings are
 /// adaptive.
-pub fn render_pass<A: Accel + ?Sized>(
+pub fn render_pass(
     scene: &Scene,
-    accel: &A,
+    accel: &dyn Accel,
     camera: &Camera,
     settings: &RenderSettings,
     accumulation: &mut Accumulation,
@@ -576,8 +581,8 @@ fn render_samples(
 /// and ray/triangle tests (green channel) of the ray through the pixel's
 /// centre, and 1 in blue where it hit something. Parallel and
 /// deterministic like [`render`]; also returns the totals.
-pub fn render_traversal_cost<A: Accel + ?Sized>(
-    accel: &A,
+pub fn render_traversal_cost(
+    accel: &dyn Accel,
     camera: &Camera,
     width: u32,
     height: u32,

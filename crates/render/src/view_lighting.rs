@@ -48,13 +48,7 @@ impl ViewLight {
 
 /// The light on the surfaces `camera` sees ([`ViewLight`]); `None` when
 /// the view shows no surface.
-pub fn view_light<A: Accel + ?Sized>(
-    scene: &Scene,
-    accel: &A,
-    camera: &Camera,
-    aspect: f32,
-    up: Vec3,
-) -> Option<ViewLight> {
+pub fn view_light(scene: &Scene, accel: &dyn Accel, camera: &Camera, aspect: f32, up: Vec3) -> Option<ViewLight> {
     let own = LightSet::new(scene, &[], true, None);
     let sky_environment = default_sky(up);
     let sky = LightSet::new(scene, &[default_sun(up)], false, Some(&sky_environment));
