@@ -104,6 +104,41 @@ impl BvhNode {
     }
 }
 
+/// The tree over a source's hittable triangles, before their corners are
+/// copied anywhere: [`Bvh`] copies them into leaf order, the wide builds
+/// straight into their blocks.
+pub(crate) struct BinaryTree {
+    pub(crate) tree: build::Tree,
+    /// For each position of the leaf order, the triangle's index in the source.
+    pub(crate) triangle_ids: Vec<u32>,
+    /// Triangles left out because no ray can hit them ([`is_hittable`]).
+    pub(crate) excluded: usize,
+}
+
+impl BinaryTree {
+    pub(crate) fn new(triangles: &(impl TriangleSource + ?Sized), method: SplitMethod, params: &BuildParams) -> Self {
+        let count = triangles.len();
+        let all_hittable = (0..count).into_par_iter().all(|i| is_hittable(&triangles.corners(i)));
+        let (boxes, ids): (Vec<BoxA>, Vec<u32>) = if all_hittable {
+            (
+                (0..count).into_par_iter().map(|i| BoxA::from_triangle(&triangles.corners(i))).collect(),
+                (0..count as u32).collect(),
+            )
+        } else {
+            (0..count)
+                .into_par_iter()
+                .filter_map(|i| {
+                    let corners = triangles.corners(i);
+                    is_hittable(&corners).then(|| (BoxA::from_triangle(&corners), i as u32))
+                })
+                .unzip()
+        };
+        let tree = build::build(&boxes, method, params);
+        let triangle_ids = tree.order.par_iter().map(|&p| ids[p as usize]).collect();
+        BinaryTree { tree, triangle_ids, excluded: count - ids.len() }
+    }
+}
+
 /// A bounding volume hierarchy over triangles.
 #[derive(Debug)]
 pub struct Bvh {
@@ -129,26 +164,10 @@ impl Bvh {
     pub fn new(triangles: &(impl TriangleSource + ?Sized), method: SplitMethod, params: &BuildParams) -> Self {
         let start = Instant::now();
         let count = triangles.len();
-        let all_hittable = (0..count).into_par_iter().all(|i| is_hittable(&triangles.corners(i)));
-        let (boxes, ids): (Vec<BoxA>, Vec<u32>) = if all_hittable {
-            (
-                (0..count).into_par_iter().map(|i| BoxA::from_triangle(&triangles.corners(i))).collect(),
-                (0..count as u32).collect(),
-            )
-        } else {
-            (0..count)
-                .into_par_iter()
-                .filter_map(|i| {
-                    let corners = triangles.corners(i);
-                    is_hittable(&corners).then(|| (BoxA::from_triangle(&corners), i as u32))
-                })
-                .unzip()
-        };
-        let tree = build::build(&boxes, method, params);
-        let triangle_ids: Vec<u32> = tree.order.par_iter().map(|&p| ids[p as usize]).collect();
+        let BinaryTree { tree, triangle_ids, excluded } = BinaryTree::new(triangles, method, params);
         let leaf_triangles = triangle_ids.par_iter().map(|&i| triangles.corners(i as usize).map(Vec3A::from)).collect();
         let leaf_bytes = (std::mem::size_of::<[Vec3A; 3]>() + std::mem::size_of::<u32>()) * triangle_ids.len();
-        let stats = tree.stats(method.name().to_owned(), count, count - ids.len(), start, leaf_bytes);
+        let stats = tree.stats(method.name().to_owned(), count, excluded, start, leaf_bytes);
         Self {
             nodes: tree.nodes,
             triangles: leaf_triangles,
@@ -163,11 +182,6 @@ impl Bvh {
     /// The flattened nodes; the root is node 0 (absent for an empty tree).
     pub fn nodes(&self) -> &[BvhNode] {
         &self.nodes
-    }
-
-    /// Triangle corners in leaf order, and the input index of each.
-    pub(crate) fn leaf_order(&self) -> (&[[Vec3A; 3]], &[u32]) {
-        (&self.triangles, &self.triangle_ids)
     }
 
     /// The input indices of the triangles of a leaf.

@@ -4,13 +4,21 @@
 //! children or only leaves are left. Binary leaves become wide leaves whose
 //! triangles are copied, in order, into blocks of four. The top levels'
 //! subtrees are collapsed in parallel and appended in depth-first order.
+//!
+//! A leaf's blocks are placed before any node is made: the wide tree keeps
+//! the binary leaves' left-to-right order, so each leaf's first block is the
+//! count of blocks before it, and all blocks are filled at once, in
+//! parallel, straight from the source's corners. Collapsing the top levels
+//! in parallel used to grow a block array per subtree and copy it into the
+//! whole; the blocks are most of a wide tree's memory.
 
 use rayon::prelude::*;
 use rtgi_math::Vec3A;
 
 use super::node::{ChildRef, WideNode};
+use crate::TriangleSource;
 use crate::boxa::BoxA;
-use crate::bvh::{Bvh, BvhNode};
+use crate::bvh::{BinaryTree, BvhNode};
 use crate::simd::triangles::TriangleBlock;
 
 /// The wide tree: nodes (the root first), triangle blocks in leaf order,
@@ -30,43 +38,42 @@ pub(crate) struct WideTree<const W: usize> {
 const PARALLEL_DEPTH: usize = 2;
 
 impl<const W: usize> WideTree<W> {
-    fn empty(nodes: usize, blocks: usize) -> Self {
-        Self {
-            nodes: Vec::with_capacity(nodes),
-            blocks: Vec::with_capacity(blocks),
-            leaves: 0,
-            depth: 0,
-            sah_cost: 0.0,
-        }
+    fn empty(nodes: usize) -> Self {
+        Self { nodes: Vec::with_capacity(nodes), blocks: Vec::new(), leaves: 0, depth: 0, sah_cost: 0.0 }
     }
 
-    /// Appends `subtree` (its root at its index 0), moving its references
-    /// past this tree's nodes and blocks; returns its root's reference.
+    /// Appends the nodes of `subtree` (its root at its index 0), moving its
+    /// node references past this tree's nodes; returns its root's reference.
     fn append(&mut self, subtree: WideTree<W>) -> ChildRef {
-        let (node_offset, block_offset) = (self.nodes.len(), self.blocks.len());
+        let node_offset = self.nodes.len();
         self.nodes.extend(subtree.nodes.into_iter().map(|mut node| {
             for child in &mut node.children {
-                *child = child.relocated(node_offset, block_offset);
+                *child = child.relocated(node_offset);
             }
             node
         }));
-        self.blocks.extend(subtree.blocks);
         self.leaves += subtree.leaves;
         self.depth = self.depth.max(subtree.depth);
         ChildRef::node(node_offset)
     }
 }
 
-pub(crate) fn collapse<const W: usize>(binary: &Bvh, traversal_cost: f32) -> WideTree<W> {
+/// Collapses `binary`, built over `triangles`, into a `W`-wide tree.
+pub(crate) fn collapse<const W: usize>(
+    binary: &BinaryTree,
+    triangles: &(impl TriangleSource + ?Sized),
+    traversal_cost: f32,
+) -> WideTree<W> {
     const { assert!(W >= 2 && W <= 32) };
-    let (triangles, ids) = binary.leaf_order();
-    // Each wide node replaces at least one binary node; each block holds at least one triangle.
-    let mut tree = WideTree::empty(binary.nodes().len().div_ceil(2), triangles.len());
-    let Some(root) = binary.nodes().first() else {
+    let nodes = binary.tree.nodes.as_slice();
+    // Each wide node replaces at least one binary node.
+    let mut tree = WideTree::empty(nodes.len().div_ceil(2));
+    let Some(root) = nodes.first() else {
         return tree;
     };
-    let collapser =
-        Collapser { binary: binary.nodes(), triangles, ids, root_area: corners(root).half_area(), traversal_cost };
+    let BlockPlacement { first_blocks, spans } = place_blocks(nodes);
+    tree.blocks = fill_blocks(&spans, &binary.triangle_ids, triangles);
+    let collapser = Collapser { binary: nodes, first_blocks, root_area: corners(root).half_area(), traversal_cost };
     let mut cost = 0.0f64;
     if root.is_leaf() {
         // A wide root over the one leaf, so that traversal always starts at a node.
@@ -83,14 +90,54 @@ pub(crate) fn collapse<const W: usize>(binary: &Bvh, traversal_cost: f32) -> Wid
     tree
 }
 
+/// Where each binary leaf's blocks go.
+struct BlockPlacement {
+    /// Each leaf's first position in the leaf order and the index of its
+    /// first block, sorted.
+    first_blocks: Vec<(u32, u32)>,
+    /// Each block's range of the leaf order: its first position and its
+    /// number of triangles.
+    spans: Vec<(u32, u32)>,
+}
+
+fn place_blocks(nodes: &[BvhNode]) -> BlockPlacement {
+    let mut leaves: Vec<(u32, u32)> =
+        nodes.iter().filter(|node| node.is_leaf()).map(|leaf| (leaf.first(), leaf.count())).collect();
+    leaves.sort_unstable();
+    let lanes = TriangleBlock::LANES as u32;
+    let mut first_blocks = Vec::with_capacity(leaves.len());
+    let mut spans = Vec::with_capacity(leaves.iter().map(|&(_, count)| count.div_ceil(lanes) as usize).sum());
+    for (first, count) in leaves {
+        first_blocks.push((first, spans.len() as u32));
+        spans.extend((0..count).step_by(lanes as usize).map(|offset| (first + offset, (count - offset).min(lanes))));
+    }
+    BlockPlacement { first_blocks, spans }
+}
+
+/// The triangle blocks over the given spans of the leaf order, read from
+/// the source (`ids` maps positions to its indices).
+fn fill_blocks(spans: &[(u32, u32)], ids: &[u32], triangles: &(impl TriangleSource + ?Sized)) -> Vec<TriangleBlock> {
+    spans
+        .par_iter()
+        .map(|&(first, count)| {
+            let ids = &ids[first as usize..(first + count) as usize];
+            let mut corners = [[Vec3A::ZERO; 3]; TriangleBlock::LANES];
+            for (lane, &id) in ids.iter().enumerate() {
+                corners[lane] = triangles.corners(id as usize).map(Vec3A::from);
+            }
+            TriangleBlock::new(&corners[..ids.len()], ids)
+        })
+        .collect()
+}
+
 fn corners(node: &BvhNode) -> BoxA {
     BoxA { min: node.min().into(), max: node.max().into() }
 }
 
 struct Collapser<'a> {
     binary: &'a [BvhNode],
-    triangles: &'a [[Vec3A; 3]],
-    ids: &'a [u32],
+    /// Each binary leaf's first position in the leaf order, and its first block, sorted.
+    first_blocks: Vec<(u32, u32)>,
     root_area: f32,
     traversal_cost: f32,
 }
@@ -144,7 +191,7 @@ impl Collapser<'_> {
                 .par_iter()
                 .map(|&(child, _)| {
                     (!child.is_leaf()).then(|| {
-                        let (mut subtree, mut subtree_cost) = (WideTree::empty(0, 0), 0.0);
+                        let (mut subtree, mut subtree_cost) = (WideTree::empty(0), 0.0);
                         self.node(child, depth + 1, &mut subtree, &mut subtree_cost);
                         (subtree, subtree_cost)
                     })
@@ -174,18 +221,13 @@ impl Collapser<'_> {
         ChildRef::node(index)
     }
 
-    /// Copies the triangles of the binary leaf `leaf` into blocks.
+    /// The reference to the blocks of the binary leaf `leaf`, placed by [`place_blocks`].
     fn leaf<const W: usize>(&self, leaf: &BvhNode, tree: &mut WideTree<W>, cost: &mut f64) -> ChildRef {
-        let range = leaf.first() as usize..(leaf.first() + leaf.count()) as usize;
-        let first_block = tree.blocks.len();
-        for (triangles, ids) in self.triangles[range.clone()]
-            .chunks(TriangleBlock::LANES)
-            .zip(self.ids[range.clone()].chunks(TriangleBlock::LANES))
-        {
-            tree.blocks.push(TriangleBlock::new(triangles, ids));
-        }
+        let at = self.first_blocks.partition_point(|&(first, _)| first < leaf.first());
+        let (first, first_block) = self.first_blocks[at];
+        debug_assert_eq!(first, leaf.first());
         tree.leaves += 1;
-        *cost += self.relative_area(leaf) * range.len() as f64;
-        ChildRef::leaf(first_block, tree.blocks.len() - first_block)
+        *cost += self.relative_area(leaf) * leaf.count() as f64;
+        ChildRef::leaf(first_block as usize, leaf.count().div_ceil(TriangleBlock::LANES as u32) as usize)
     }
 }

@@ -24,9 +24,10 @@ use std::time::Instant;
 
 use rtgi_math::{Aabb, Vec3};
 
+use crate::bvh::BinaryTree;
 use crate::contract::{HitFilter, QueryKind, Structure};
 use crate::simd::triangles::TriangleBlock;
-use crate::{BuildParams, BuildStats, Bvh, Counter, Hit, Intersector, SplitMethod, TriangleSource};
+use crate::{BuildParams, BuildStats, Counter, Hit, Intersector, SplitMethod, TriangleSource};
 pub use node::WideNode;
 use node::{ChildRef, NodeLayout};
 pub use quantised::QuantisedNode;
@@ -61,15 +62,14 @@ impl<const W: usize, N: NodeLayout<W>> WideBvh<W, N> {
     pub fn new(triangles: &(impl TriangleSource + ?Sized), method: SplitMethod, params: &BuildParams) -> Self {
         let start = Instant::now();
         let params = BuildParams { max_leaf_size: params.max_leaf_size.min(Self::MAX_LEAF_SIZE), ..params.clone() };
-        let binary = Bvh::new(triangles, method, &params);
-        let tree = collapse::collapse::<W>(&binary, params.traversal_cost);
+        let binary = BinaryTree::new(triangles, method, &params);
+        let tree = collapse::collapse::<W>(&binary, triangles, params.traversal_cost);
         let (node_count, memory_bytes) = (
             tree.nodes.len(),
             tree.nodes.len() * std::mem::size_of::<N>() + std::mem::size_of_val(tree.blocks.as_slice()),
         );
         let nodes = N::from_built(tree.nodes);
         let build_ms = start.elapsed().as_secs_f64() * 1e3;
-        let binary_stats = Structure::stats(&binary);
         let stats = BuildStats {
             variant: match method {
                 SplitMethod::BinnedSah => format!("bvh{W}{}", N::NAME_SUFFIX),
@@ -77,12 +77,12 @@ impl<const W: usize, N: NodeLayout<W>> WideBvh<W, N> {
                 _ => format!("{}-bvh{W}{}", method.name(), N::NAME_SUFFIX),
             },
             triangles: triangles.len(),
-            excluded_triangles: binary_stats.excluded_triangles,
+            excluded_triangles: binary.excluded,
             build_ms,
             nodes: node_count,
             leaves: tree.leaves,
             depth: tree.depth,
-            leaf_size_histogram: binary_stats.leaf_size_histogram.clone(),
+            leaf_size_histogram: binary.tree.leaf_size_histogram,
             sah_cost: tree.sah_cost,
             memory_bytes,
         };

@@ -107,17 +107,10 @@ impl ChildRef {
         ChildRef(LEAF_BIT | (first_block as u32) << BLOCK_COUNT_BITS | (blocks as u32 - 1))
     }
 
-    /// This reference in a tree whose nodes and blocks were moved up by
-    /// `node_offset` and `block_offset`.
-    pub(crate) fn relocated(self, node_offset: usize, block_offset: usize) -> Self {
-        if self == ChildRef::NONE {
-            self
-        } else if self.is_leaf() {
-            let blocks = self.blocks();
-            ChildRef::leaf(blocks.start + block_offset, blocks.len())
-        } else {
-            ChildRef::node(self.node_index() + node_offset)
-        }
+    /// This reference in a tree whose nodes were moved up by `node_offset`
+    /// (blocks are placed once, for the whole tree).
+    pub(crate) fn relocated(self, node_offset: usize) -> Self {
+        if self == ChildRef::NONE || self.is_leaf() { self } else { ChildRef::node(self.node_index() + node_offset) }
     }
 
     #[inline(always)]
