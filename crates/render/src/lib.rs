@@ -256,9 +256,11 @@ fn tiles(width: u32, rows: Range<u32>) -> Vec<(u32, u32, u32, u32)> {
 /// finished since its last call; it must be cheap.
 ///
 /// Any structure is passed as `&dyn Accel` (a `&Bvh8` coerces to it), as
-/// to every entry point of the renderer: it is compiled once, in this
-/// crate, rather than again in every crate that renders, and one virtual
-/// call a ray is nothing beside the ray's traversal.
+/// to the other functions that trace a whole view ([`render_pass`],
+/// [`render_adaptive`], [`render_denoised`], [`Guides::render`],
+/// [`view_lighting::view_light`], [`render_traversal_cost`]): the renderer is compiled
+/// once, in this crate, rather than again in every crate that renders, and
+/// one virtual call a ray is nothing beside the ray's traversal.
 ///
 /// The image has the same bits as any progressive or split render of the
 /// same settings ([`render_pass`], [`Accumulation::merge`]). With
