@@ -229,25 +229,22 @@ fn binned_core<R: BuildRef>(
 const SMALL_RANGE: usize = 8;
 
 /// The best split of a range of `count` primitives, over the three axes:
-/// `sorted(axis)` gives the range sorted by centroid along `axis`, and
-/// `right_cost` is scratch space of `count` entries. Returns the summed
-/// `A · N` of both sides, the axis and the left count.
-fn best_sweep<'a, R: BuildRef>(
-    count: usize,
-    mut sorted: impl FnMut(usize) -> &'a [R],
-    right_cost: &mut [f32],
-) -> (f32, usize, usize) {
+/// `bounds(axis, k)` is the box of the `k`-th primitive of the range sorted
+/// by centroid along `axis`, and `right_cost` is scratch space of `count`
+/// entries. Returns the summed `A · N` of both sides, the axis and the
+/// left count.
+#[inline(always)]
+fn best_sweep(count: usize, bounds: impl Fn(usize, usize) -> BoxA, right_cost: &mut [f32]) -> (f32, usize, usize) {
     let mut best = (f32::INFINITY, 0, 0);
     for axis in 0..3 {
-        let order = sorted(axis);
         let mut acc = BoxA::EMPTY;
         for k in (1..count).rev() {
-            acc = acc.union(order[k].bounds());
+            acc = acc.union(bounds(axis, k));
             right_cost[k] = acc.half_area() * (count - k) as f32;
         }
         let mut acc = BoxA::EMPTY;
         for k in 0..count - 1 {
-            acc = acc.union(order[k].bounds());
+            acc = acc.union(bounds(axis, k));
             let cost = acc.half_area() * (k + 1) as f32 + right_cost[k + 1];
             // Equal costs (coincident boxes) go to the most even split, so
             // that such ranges halve instead of peeling one primitive a level.
@@ -260,24 +257,49 @@ fn best_sweep<'a, R: BuildRef>(
     best
 }
 
-/// The full sweep of [`sweep`] for at most [`SMALL_RANGE`] primitives,
-/// sorted on the stack. Most nodes of a tree are this small, so this keeps
-/// the per-node overhead of binning (bin arrays to clear, three axes to
-/// evaluate) off the bottom levels.
+/// A key whose unsigned order is [`by_centroid`]'s order along `axis`:
+/// the centroid's coordinate in [`f32::total_cmp`]'s order, then the index.
+#[inline(always)]
+fn centroid_key<R: BuildRef>(prim: &R, axis: usize) -> u64 {
+    let bits = prim.centroid2()[axis].to_bits();
+    // Negative floats order backwards as integers: flip their magnitude
+    // bits, then the sign bit, so that all of them order as unsigned.
+    let total_order = bits ^ ((((bits as i32) >> 31) as u32) >> 1) ^ 0x8000_0000;
+    (u64::from(total_order) << 32) | u64::from(prim.index())
+}
+
+/// The full sweep of [`sweep`] for at most [`SMALL_RANGE`] primitives.
+/// Most nodes of a tree are this small, so this keeps the per-node
+/// overhead of binning (bin arrays to clear, three axes to evaluate) off
+/// the bottom levels. Each axis's order is found by ranking integer keys,
+/// all pairs compared without branches, instead of sorting the 32-byte
+/// references three times with a comparison function.
 fn small<R: BuildRef>(ctx: &Context, prims: &mut [R], range: &RangeBounds) -> Option<Split> {
     let count = prims.len();
     debug_assert!(count <= SMALL_RANGE);
-    let mut sorted = [[prims[0]; SMALL_RANGE]; 3];
+    let mut sorted = [[0u8; SMALL_RANGE]; 3];
     for (axis, order) in sorted.iter_mut().enumerate() {
-        order[..count].copy_from_slice(prims);
-        order[..count].sort_unstable_by(by_centroid(axis));
+        let mut keys = [u64::MAX; SMALL_RANGE];
+        for (key, prim) in keys.iter_mut().zip(prims.iter()) {
+            *key = centroid_key(prim, axis);
+        }
+        for i in 0..count {
+            // Equal keys (a primitive referenced twice) rank by position,
+            // so that the ranks are a permutation.
+            let rank = (0..count).filter(|&j| keys[j] < keys[i] || (keys[j] == keys[i] && j < i)).count();
+            order[rank] = i as u8;
+        }
     }
-    let best = best_sweep(count, |axis| &sorted[axis][..count], &mut [0.0; SMALL_RANGE]);
+    let best = best_sweep(count, |axis, k| prims[sorted[axis][k] as usize].bounds(), &mut [0.0; SMALL_RANGE]);
     if !split_pays(ctx, count, range, best.0) {
         return None;
     }
     let (_, axis, left_count) = best;
-    prims.copy_from_slice(&sorted[axis][..count]);
+    let mut unsorted = [prims[0]; SMALL_RANGE];
+    unsorted[..count].copy_from_slice(prims);
+    for (prim, &i) in prims.iter_mut().zip(&sorted[axis][..count]) {
+        *prim = unsorted[i as usize];
+    }
     Some(Split::measured(prims, left_count))
 }
 
@@ -290,7 +312,7 @@ pub(crate) fn sweep<R: BuildRef>(ctx: &Context, prims: &mut [R], range: &RangeBo
     for (axis, order) in sorted.iter_mut().enumerate() {
         order.sort_unstable_by(by_centroid(axis));
     }
-    let best = best_sweep(count, |axis| &sorted[axis], &mut vec![0.0; count]);
+    let best = best_sweep(count, |axis, k| sorted[axis][k].bounds(), &mut vec![0.0; count]);
     if !split_pays(ctx, count, range, best.0) {
         return None;
     }
@@ -301,7 +323,40 @@ pub(crate) fn sweep<R: BuildRef>(ctx: &Context, prims: &mut [R], range: &RangeBo
 
 #[cfg(test)]
 mod tests {
-    use rtgi_math::Vec3;
+    use rtgi_math::{Vec3, Vec3A};
+
+    use super::centroid_key;
+    use crate::boxa::BoxA;
+    use crate::bvh::median::by_centroid;
+    use crate::bvh::split::PrimRef;
+
+    /// The small sweep ranks integer keys where every other sweep sorts by
+    /// [`by_centroid`]; both must give one order, or the trees would differ
+    /// with the range's length. Signed zeros, subnormals, infinities and
+    /// equal centroids with different indices are where a key goes wrong.
+    #[test]
+    fn centroid_keys_order_as_by_centroid() {
+        let values = [f32::NEG_INFINITY, -3e38, -1.0, -1e-40, -0.0, 0.0, 1e-40, 1.0, 3e38, f32::INFINITY];
+        let mut prims = Vec::new();
+        for (i, &x) in values.iter().enumerate() {
+            for index in [0, i as u32 + 1, (1 << 30) - 1] {
+                let corner = Vec3A::new(x, -x, x * 0.5);
+                prims.push(PrimRef::new(BoxA { min: corner, max: corner }, index));
+            }
+        }
+        for axis in 0..3 {
+            let order = by_centroid(axis);
+            for a in &prims {
+                for b in &prims {
+                    assert_eq!(
+                        centroid_key(a, axis).cmp(&centroid_key(b, axis)),
+                        order(a, b),
+                        "axis {axis}: {a:?} against {b:?}"
+                    );
+                }
+            }
+        }
+    }
 
     use crate::{BuildParams, Bvh, SahAxes, SplitMethod};
 
