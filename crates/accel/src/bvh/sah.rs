@@ -45,6 +45,21 @@ const STACK_BINS: usize = 32;
 /// Ranges at least this long are binned in parallel chunks.
 const PARALLEL_BINNING: usize = 32 * 1024;
 
+/// Ranges at least this long are binned into two sets of bins (see
+/// `binned_core`); shorter ones would spend more on clearing the second set.
+const PAIRED_BINNING: usize = 256;
+
+/// Adds the counts and boxes of `from`'s bins to `into`'s, axis by axis
+/// (as many bins as `into` has).
+fn merge_bins(into: &mut [&mut [Bin]; 3], from: &[impl AsRef<[Bin]>; 3]) {
+    for (into, from) in into.iter_mut().zip(from) {
+        for (bin, other) in into.iter_mut().zip(from.as_ref()) {
+            bin.bounds = bin.bounds.union(other.bounds);
+            bin.count += other.count;
+        }
+    }
+}
+
 /// Maps centroids to bins along each axis.
 #[derive(Clone, Copy)]
 struct Binning {
@@ -133,16 +148,34 @@ fn binned_core<R: BuildRef>(
     let scale = Vec3A::select(usable, Vec3A::splat(bins as f32 * (1.0 - 1e-6)) / extent, Vec3A::ZERO);
     let binning = Binning { origin, scale, last: bins as u32 - 1 };
 
-    let fill = |chunk: &[R], per_axis: &mut [&mut [Bin]; 3]| {
-        for prim in chunk {
-            let bounds = prim.bounds();
-            let slots = binning.bins(prim.centroid2());
-            for axis in 0..3 {
-                let bin = &mut per_axis[axis][slots[axis] as usize];
-                bin.bounds = bin.bounds.union(bounds);
-                bin.count += 1;
-            }
+    // Sorted primitives (every range below the root's) often fall in the
+    // bin of the one before, and then each bin update waits for the last
+    // one's store. Long ranges alternate between two sets of bins, merged
+    // after, so that two such chains run at once.
+    let add = |per_axis: &mut [&mut [Bin]; 3], prim: &R| {
+        let bounds = prim.bounds();
+        let slots = binning.bins(prim.centroid2());
+        for axis in 0..3 {
+            let bin = &mut per_axis[axis][slots[axis] as usize];
+            bin.bounds = bin.bounds.union(bounds);
+            bin.count += 1;
         }
+    };
+    let fill = |chunk: &[R], per_axis: &mut [&mut [Bin]; 3]| {
+        if chunk.len() < PAIRED_BINNING || bins > STACK_BINS {
+            chunk.iter().for_each(|prim| add(per_axis, prim));
+            return;
+        }
+        let mut odd_storage = [[Bin::EMPTY; STACK_BINS]; 3];
+        let [x, y, z] = &mut odd_storage;
+        let mut odd = [&mut x[..bins], &mut y[..bins], &mut z[..bins]];
+        let pairs = chunk.chunks_exact(2);
+        pairs.remainder().iter().for_each(|prim| add(per_axis, prim));
+        for pair in pairs {
+            add(per_axis, &pair[0]);
+            add(&mut odd, &pair[1]);
+        }
+        merge_bins(per_axis, &odd);
     };
     if count >= PARALLEL_BINNING && bins <= STACK_BINS {
         use rayon::prelude::*;
@@ -155,13 +188,8 @@ fn binned_core<R: BuildRef>(
                 local
             })
             .collect::<Vec<_>>();
-        for local in partial {
-            for axis in 0..3 {
-                for (bin, other) in per_axis[axis].iter_mut().zip(&local[axis]) {
-                    bin.bounds = bin.bounds.union(other.bounds);
-                    bin.count += other.count;
-                }
-            }
+        for local in &partial {
+            merge_bins(&mut per_axis, local);
         }
     } else {
         fill(prims, &mut per_axis);
