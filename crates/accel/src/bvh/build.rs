@@ -8,7 +8,10 @@
 //! owns `2n - 1` slots of a scratch array (enough for any subtree over them),
 //! so the two subtrees of a node get disjoint halves of its slots and are
 //! built in parallel without locks. A final pass lays the used slots out
-//! compactly with siblings side by side, and measures the tree.
+//! compactly with siblings side by side, and measures the tree. A subtree
+//! too small to split between threads is built on one thread with its
+//! nodes packed depth-first at the front of its slots, so that the layout
+//! pass reads them in order instead of one cache miss a node.
 
 use rtgi_math::{Vec3, Vec3A};
 
@@ -25,7 +28,8 @@ use crate::boxa::BoxA;
 /// `traverse::STACK_SIZE` entries.
 pub(crate) const HEURISTIC_DEPTH_LIMIT: usize = 64;
 
-/// Subtrees over at least this many primitives are built in parallel.
+/// Subtrees over at least this many primitives are built in parallel;
+/// smaller ones on one thread, their nodes side by side.
 const PARALLEL_THRESHOLD: usize = 2048;
 
 /// What [`build`] hands back: the flattened nodes and the primitive order.
@@ -128,6 +132,9 @@ fn build_over<R: BuildRef>(mut prims: Vec<R>, method: SplitMethod, params: &Buil
 
 /// Builds the subtree over `prims` (which start at position `first` of the
 /// final order) into `slots`, whose first element is at `slot_base`.
+/// Subtrees large enough to build in parallel split `slots` between their
+/// children; smaller ones are built by [`build_dense`] at the front of their
+/// share.
 fn build_node<R: BuildRef>(
     ctx: &Context,
     prims: &mut [R],
@@ -138,17 +145,73 @@ fn build_node<R: BuildRef>(
     range: RangeBounds,
 ) {
     let n = prims.len();
+    if n < PARALLEL_THRESHOLD {
+        build_dense(ctx, prims, first, slots, slot_base, &mut 0, depth, range);
+        return;
+    }
+    let split = choose_split(ctx, prims, depth, &range);
+    let (this, rest) = slots.split_first_mut().expect("a subtree over n primitives has 2n - 1 slots");
+    let Some(Split { left_count, left: left_range, right: right_range }) = split else {
+        *this = Slot::new(range.bounds, first, n as u32);
+        return;
+    };
+    let (left_slots, right_slots) = rest.split_at_mut(2 * left_count - 1);
+    let right_slot = slot_base + 2 * left_count as u32;
+    *this = Slot::new(range.bounds, right_slot, 0);
+    let (left_prims, right_prims) = prims.split_at_mut(left_count);
+    let right_first = first + left_count as u32;
+    rayon::join(
+        || build_node(ctx, left_prims, first, left_slots, slot_base + 1, depth + 1, left_range),
+        || build_node(ctx, right_prims, right_first, right_slots, right_slot, depth + 1, right_range),
+    );
+}
+
+/// Builds the subtree over `prims` on this thread into the slots from
+/// `*used` on (of `slots`, whose first element is at `slot_base`), in
+/// depth-first order with no gaps, and moves `*used` past them. Left
+/// sparse, the used slots of a large tree lie about one in five in an
+/// array too large for the caches, and the layout pass that reads them
+/// back waited on a cache miss for almost every node.
+#[allow(clippy::too_many_arguments)]
+fn build_dense<R: BuildRef>(
+    ctx: &Context,
+    prims: &mut [R],
+    first: u32,
+    slots: &mut [Slot],
+    slot_base: u32,
+    used: &mut usize,
+    depth: usize,
+    range: RangeBounds,
+) {
+    let n = prims.len();
+    let this = *used;
+    *used += 1;
+    let Some(Split { left_count, left: left_range, right: right_range }) = choose_split(ctx, prims, depth, &range)
+    else {
+        slots[this] = Slot::new(range.bounds, first, n as u32);
+        return;
+    };
+    let (left_prims, right_prims) = prims.split_at_mut(left_count);
+    build_dense(ctx, left_prims, first, slots, slot_base, used, depth + 1, left_range);
+    let right_slot = slot_base + *used as u32;
+    slots[this] = Slot::new(range.bounds, right_slot, 0);
+    build_dense(ctx, right_prims, first + left_count as u32, slots, slot_base, used, depth + 1, right_range);
+}
+
+/// The split of a node over `prims` at `depth`, or `None` for a leaf.
+fn choose_split<R: BuildRef>(ctx: &Context, prims: &mut [R], depth: usize, range: &RangeBounds) -> Option<Split> {
+    let n = prims.len();
     let split = if n <= 1 {
         None
     } else if depth >= HEURISTIC_DEPTH_LIMIT {
-        Some(median::object_median(prims, &range))
+        Some(median::object_median(prims, range))
     } else {
         match ctx.method {
-            SplitMethod::ObjectMedian => (n > ctx.max_leaf_size).then(|| median::object_median(prims, &range)),
-            SplitMethod::SpatialMedian => (n > ctx.max_leaf_size).then(|| median::spatial_median(prims, &range)),
+            SplitMethod::ObjectMedian => (n > ctx.max_leaf_size).then(|| median::object_median(prims, range)),
+            SplitMethod::SpatialMedian => (n > ctx.max_leaf_size).then(|| median::spatial_median(prims, range)),
             // User primitives are not split: their references stay whole.
-            SplitMethod::BinnedSah | SplitMethod::SpatialSah => sah::binned(ctx, prims, &range),
-            SplitMethod::SweepSah => sah::sweep(ctx, prims, &range),
+            SplitMethod::BinnedSah | SplitMethod::SpatialSah => sah::binned(ctx, prims, range),
+            SplitMethod::SweepSah => sah::sweep(ctx, prims, range),
         }
     };
     // A split method that puts every primitive on one side (found by
@@ -156,28 +219,11 @@ fn build_node<R: BuildRef>(
     // infinity) would index past the slots; the object median always
     // splits in two.
     let split = match split {
-        Some(s) if s.left_count == 0 || s.left_count >= n => Some(median::object_median(prims, &range)),
+        Some(s) if s.left_count == 0 || s.left_count >= n => Some(median::object_median(prims, range)),
         split => split,
     };
-    let (this, rest) = slots.split_first_mut().expect("a subtree over n primitives has 2n - 1 slots");
-    let Some(Split { left_count, left: left_range, right: right_range }) = split else {
-        *this = Slot::new(range.bounds, first, n as u32);
-        return;
-    };
-    debug_assert!(left_count > 0 && left_count < n);
-    let (left_slots, right_slots) = rest.split_at_mut(2 * left_count - 1);
-    let right_slot = slot_base + 2 * left_count as u32;
-    *this = Slot::new(range.bounds, right_slot, 0);
-    let (left_prims, right_prims) = prims.split_at_mut(left_count);
-    let right_first = first + left_count as u32;
-    let mut build_left = || build_node(ctx, left_prims, first, left_slots, slot_base + 1, depth + 1, left_range);
-    let mut build_right = || build_node(ctx, right_prims, right_first, right_slots, right_slot, depth + 1, right_range);
-    if n >= PARALLEL_THRESHOLD {
-        rayon::join(build_left, build_right);
-    } else {
-        build_left();
-        build_right();
-    }
+    debug_assert!(split.as_ref().is_none_or(|s| s.left_count > 0 && s.left_count < n));
+    split
 }
 
 /// Lays the used slots out depth-first with siblings adjacent, and measures
