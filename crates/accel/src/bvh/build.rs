@@ -40,13 +40,24 @@ pub(crate) struct Tree {
     pub(crate) leaves: usize,
     pub(crate) depth: usize,
     pub(crate) leaf_size_histogram: Vec<usize>,
+    /// Each leaf's first position in `order` and its count, left to right
+    /// (so in increasing order of position).
+    pub(crate) leaf_ranges: Vec<(u32, u32)>,
     pub(crate) sah_cost: f32,
 }
 
 impl Tree {
     /// The tree over no primitives.
     pub(crate) fn empty() -> Tree {
-        Tree { nodes: Vec::new(), order: Vec::new(), leaves: 0, depth: 0, leaf_size_histogram: vec![], sah_cost: 0.0 }
+        Tree {
+            nodes: Vec::new(),
+            order: Vec::new(),
+            leaves: 0,
+            depth: 0,
+            leaf_size_histogram: vec![],
+            leaf_ranges: vec![],
+            sah_cost: 0.0,
+        }
     }
 
     /// The statistics of a build that made this tree: `variant` names it,
@@ -238,6 +249,7 @@ pub(crate) fn layout(slots: &[Slot], order: Vec<u32>, traversal_cost: f32) -> Tr
     let mut leaves = 0;
     let mut depth = 0;
     let mut histogram = Vec::new();
+    let mut leaf_ranges = Vec::new();
     let mut cost = 0.0f64;
     let mut stack = Vec::with_capacity(2 * super::traverse::STACK_SIZE);
     stack.push((0u32, 0u32, 0usize));
@@ -252,6 +264,7 @@ pub(crate) fn layout(slots: &[Slot], order: Vec<u32>, traversal_cost: f32) -> Tr
                 histogram.resize(slot.count as usize + 1, 0);
             }
             histogram[slot.count as usize] += 1;
+            leaf_ranges.push((slot.link, slot.count));
             cost += relative_area * slot.count as f64;
             BvhNode::new(min, max, slot.link, slot.count)
         } else {
@@ -265,5 +278,5 @@ pub(crate) fn layout(slots: &[Slot], order: Vec<u32>, traversal_cost: f32) -> Tr
         };
         nodes[node_index as usize] = node;
     }
-    Tree { nodes, order, leaves, depth, leaf_size_histogram: histogram, sah_cost: cost as f32 }
+    Tree { nodes, order, leaves, depth, leaf_size_histogram: histogram, leaf_ranges, sah_cost: cost as f32 }
 }

@@ -71,7 +71,7 @@ pub(crate) fn collapse<const W: usize>(
     let Some(root) = nodes.first() else {
         return tree;
     };
-    let BlockPlacement { first_blocks, spans } = place_blocks(nodes);
+    let BlockPlacement { first_blocks, spans } = place_blocks(&binary.tree.leaf_ranges);
     tree.blocks = fill_blocks(&spans, &binary.triangle_ids, triangles);
     let collapser = Collapser { binary: nodes, first_blocks, root_area: corners(root).half_area(), traversal_cost };
     let mut cost = 0.0f64;
@@ -93,21 +93,21 @@ pub(crate) fn collapse<const W: usize>(
 /// Where each binary leaf's blocks go.
 struct BlockPlacement {
     /// Each leaf's first position in the leaf order and the index of its
-    /// first block, sorted.
+    /// first block, in increasing order.
     first_blocks: Vec<(u32, u32)>,
     /// Each block's range of the leaf order: its first position and its
     /// number of triangles.
     spans: Vec<(u32, u32)>,
 }
 
-fn place_blocks(nodes: &[BvhNode]) -> BlockPlacement {
-    let mut leaves: Vec<(u32, u32)> =
-        nodes.iter().filter(|node| node.is_leaf()).map(|leaf| (leaf.first(), leaf.count())).collect();
-    leaves.sort_unstable();
+/// Places the blocks of the leaves given by their ranges of the leaf order,
+/// left to right (as [`crate::bvh::BinaryTree`] lists them).
+fn place_blocks(leaves: &[(u32, u32)]) -> BlockPlacement {
+    debug_assert!(leaves.is_sorted());
     let lanes = TriangleBlock::LANES as u32;
     let mut first_blocks = Vec::with_capacity(leaves.len());
     let mut spans = Vec::with_capacity(leaves.iter().map(|&(_, count)| count.div_ceil(lanes) as usize).sum());
-    for (first, count) in leaves {
+    for &(first, count) in leaves {
         first_blocks.push((first, spans.len() as u32));
         spans.extend((0..count).step_by(lanes as usize).map(|offset| (first + offset, (count - offset).min(lanes))));
     }
