@@ -263,8 +263,18 @@ fn pixel_seed(shift: Vec2) -> u64 {
 /// `jitter ∈ [0, 1)` across it, inside the strip exactly despite rounding
 /// (for counts up to 2^24, where strips are still wider than an f32 step).
 fn in_strip(strip: u32, jitter: f32, count: u32) -> f32 {
+    let position = strip as f64 + jitter as f64;
+    // A power of two's reciprocal is exact, so multiplying by it gives the
+    // quotient's bits. The division's line had 5% of a Cornell box render's
+    // samples (perf), most of them waiting for its result; the render is
+    // about 1% faster without it.
+    let scaled = if count.is_power_of_two() {
+        position * f64::from_bits((1023 - u64::from(count.trailing_zeros())) << 52)
+    } else {
+        position / count as f64
+    };
     let (strip, count) = (strip as f64, count as f64);
-    let mut x = ((strip + jitter as f64) / count) as f32;
+    let mut x = scaled as f32;
     // x · count is exact in f64 (24 × 32 bits), so these tests are too.
     if x as f64 * count >= strip + 1.0 {
         x = next_float_down(x);
@@ -620,6 +630,26 @@ mod tests {
                     assert!(!seen[j], "permute(_, {len}, {seed}) repeats {j}");
                     seen[j] = true;
                 }
+            }
+        }
+    }
+
+    /// `in_strip` multiplies by the reciprocal of a power-of-two count;
+    /// the division it replaces is the definition.
+    #[test]
+    fn power_of_two_strips_are_the_quotients_bits() {
+        let mut rng = Rng::new(7, 0);
+        for count in (0..24).map(|k| 1u32 << k) {
+            for _ in 0..2000 {
+                let strip_index = rng.next_u32() % count;
+                let jitter = if rng.next_f32() < 0.1 { 1.0 - f32::EPSILON / 2.0 } else { rng.next_f32() };
+                let divided = ((strip_index as f64 + jitter as f64) / count as f64) as f32;
+                let x = in_strip(strip_index, jitter, count);
+                // Only the rounding correction may move it, and only inside the strip.
+                if strip(divided, count) == strip_index as usize {
+                    assert_eq!(x.to_bits(), divided.to_bits(), "strip {strip_index} of {count}, jitter {jitter}");
+                }
+                assert_eq!(strip(x, count), strip_index as usize, "strip {strip_index} of {count}, jitter {jitter}");
             }
         }
     }
