@@ -37,7 +37,6 @@ pub(crate) struct Tree {
     pub(crate) nodes: Vec<BvhNode>,
     /// Primitive indices (into the builder's input) in leaf order.
     pub(crate) order: Vec<u32>,
-    pub(crate) leaves: usize,
     pub(crate) depth: usize,
     pub(crate) leaf_size_histogram: Vec<usize>,
     /// Each leaf's first position in `order` and its count, left to right
@@ -52,7 +51,6 @@ impl Tree {
         Tree {
             nodes: Vec::new(),
             order: Vec::new(),
-            leaves: 0,
             depth: 0,
             leaf_size_histogram: vec![],
             leaf_ranges: vec![],
@@ -77,7 +75,7 @@ impl Tree {
             excluded_triangles: excluded,
             build_ms: start.elapsed().as_secs_f64() * 1e3,
             nodes: self.nodes.len(),
-            leaves: self.leaves,
+            leaves: self.leaf_ranges.len(),
             depth: self.depth,
             leaf_size_histogram: self.leaf_size_histogram.clone(),
             sah_cost: self.sah_cost,
@@ -246,7 +244,6 @@ pub(crate) fn layout(slots: &[Slot], order: Vec<u32>, traversal_cost: f32) -> Tr
     // space, and saves the copies of a growing vector.
     let mut nodes = Vec::with_capacity(slots.len());
     nodes.push(BvhNode::default());
-    let mut leaves = 0;
     let mut depth = 0;
     let mut histogram = Vec::new();
     let mut leaf_ranges = Vec::new();
@@ -259,7 +256,6 @@ pub(crate) fn layout(slots: &[Slot], order: Vec<u32>, traversal_cost: f32) -> Tr
         let relative_area = if root_area > 0.0 { (slot.bounds().half_area() / root_area) as f64 } else { 1.0 };
         let (min, max) = (slot.min, slot.max);
         let node = if slot.count > 0 {
-            leaves += 1;
             if histogram.len() <= slot.count as usize {
                 histogram.resize(slot.count as usize + 1, 0);
             }
@@ -278,5 +274,5 @@ pub(crate) fn layout(slots: &[Slot], order: Vec<u32>, traversal_cost: f32) -> Tr
         };
         nodes[node_index as usize] = node;
     }
-    Tree { nodes, order, leaves, depth, leaf_size_histogram: histogram, leaf_ranges, sah_cost: cost as f32 }
+    Tree { nodes, order, depth, leaf_size_histogram: histogram, leaf_ranges, sah_cost: cost as f32 }
 }

@@ -357,7 +357,7 @@ mod tests {
     use crate::boxa::BoxA;
     use crate::bvh::median::by_centroid;
     use crate::bvh::split::PrimRef;
-
+    use crate::{BuildParams, Bvh, SahAxes, SplitMethod};
     /// The small sweep ranks integer keys where every other sweep sorts by
     /// [`by_centroid`]; both must give one order, or the trees would differ
     /// with the range's length. Signed zeros, subnormals, infinities and
@@ -385,8 +385,6 @@ mod tests {
             }
         }
     }
-
-    use crate::{BuildParams, Bvh, SahAxes, SplitMethod};
 
     /// Two rows of small triangles, long along x and far apart along y:
     /// the SAH over all axes separates the rows (a split along y), the
