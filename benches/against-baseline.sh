@@ -57,10 +57,17 @@ new="target/release/rtgi"
 scratch="$(mktemp -d)"
 trap 'rm -rf "$scratch"' EXIT
 
-# The rate a render reports on its "rays" line: "rays  N (R Mrays/s)".
+# The rate a render reports on its "rays" line: "rays  N (R Mrays/s)"; a
+# render that fails or prints no rate stops the run with its last lines.
 rate() {
-    "$1" render "$2" -o "$scratch/image.exr" "${options[@]}" 2>&1 |
-        sed -n 's/^rays .*(\([0-9.]*\) Mrays\/s).*/\1/p'
+    local output value
+    output="$("$1" render "$2" -o "$scratch/image.exr" "${options[@]}" 2>&1)" &&
+        value="$(sed -n 's/^rays .*(\([0-9.]*\) Mrays\/s).*/\1/p' <<<"$output")" && [[ -n "$value" ]] || {
+        echo "against-baseline: '$1 render $2' gave no rate:" >&2
+        tail -n 5 <<<"$output" >&2
+        exit 1
+    }
+    echo "$value"
 }
 
 summary() { # median (min-max) of the numbers on standard input
@@ -74,12 +81,9 @@ for scene in "${scenes[@]}"; do
         rate "$old" "$scene" >>"$scratch/old"
         rate "$new" "$scene" >>"$scratch/new"
     done
-    if [[ $(wc -l <"$scratch/old") -ne $runs || $(wc -l <"$scratch/new") -ne $runs ]]; then
-        echo "against-baseline: a render of $scene printed no rate (run it by hand to see why)" >&2
-        exit 1
-    fi
-    old_median="$(summary <"$scratch/old" | cut -d' ' -f1)"
-    new_median="$(summary <"$scratch/new" | cut -d' ' -f1)"
-    printf '%-40s %-24s %-24s %s\n' "$(basename "$scene")" "$(summary <"$scratch/old")" \
-        "$(summary <"$scratch/new")" "$(awk -v n="$new_median" -v o="$old_median" 'BEGIN { printf "%.2fx", n / o }')"
+    old_summary="$(summary <"$scratch/old")"
+    new_summary="$(summary <"$scratch/new")"
+    # The medians are the summaries' first words.
+    ratio="$(awk -v n="${new_summary%% *}" -v o="${old_summary%% *}" 'BEGIN { printf "%.2fx", n / o }')"
+    printf '%-40s %-24s %-24s %s\n' "$(basename "$scene")" "$old_summary" "$new_summary" "$ratio"
 done
