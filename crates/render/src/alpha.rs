@@ -82,6 +82,19 @@ impl<'a> AlphaTest<'a> {
     }
 }
 
+/// The texture and channel of `material`'s alpha mask, if it has one that
+/// is not the base colour's alpha itself: an MTL `map_d` naming the RGBA
+/// file of `map_Kd` means that file's alpha, which the base colour already
+/// brings, and counted twice it would be squared (a rim texel of alpha 0.6
+/// would fall below a cutoff of one half).
+#[inline(always)]
+fn mask_lookup<'s>(scene: &'s Scene, material: &Material) -> Option<(&'s Texture, usize)> {
+    let id = material.alpha_texture?;
+    let mask = &scene.textures[id.0 as usize];
+    let channel = if mask.has_alpha() { 3 } else { 0 };
+    (material.base_color_texture != Some(id) || channel != 3).then_some((mask, channel))
+}
+
 /// Whether `material` at the texture coordinates `uv()` counts as hit for
 /// the uniform number `u`.
 #[inline(always)]
@@ -103,10 +116,7 @@ fn decide(scene: &Scene, material: &Material, u: f32, uv: impl FnOnce() -> Vec2)
     // Interpolated once, and one channel read from each texture.
     let uv = uv();
     let base = base.map(|t| (&scene.textures[t.0 as usize], 3));
-    let mask = mask.map(|t| {
-        let mask = &scene.textures[t.0 as usize];
-        (mask, if mask.has_alpha() { 3 } else { 0 })
-    });
+    let mask = mask_lookup(scene, material);
     let bounds = |lookup: Option<(&Texture, usize)>| lookup.map_or(Some((1.0, 1.0)), |(t, c)| t.channel_bounds(uv, c));
     if let (Some((base_low, base_high)), Some((mask_low, mask_high))) = (bounds(base), bounds(mask))
         && (0.0..=f32::MAX).contains(&material.opacity)
@@ -137,6 +147,9 @@ mod tests {
         let texture = material.base_color_texture.map_or(1.0, |t| scene.textures[t.0 as usize].sample_channel(uv, 3));
         let mask = material.alpha_texture.map_or(1.0, |t| {
             let mask = &scene.textures[t.0 as usize];
+            if material.base_color_texture == Some(t) && mask.has_alpha() {
+                return 1.0; // the base colour's own alpha, counted once
+            }
             mask.sample_channel(uv, if mask.has_alpha() { 3 } else { 0 })
         });
         let alpha = material.opacity * texture * mask;
@@ -174,7 +187,17 @@ mod tests {
         );
         let modes = [AlphaMode::Mask { cutoff: 0.5 }, AlphaMode::Mask { cutoff: 128.0 / 255.0 }, AlphaMode::Blend];
         for alpha_mode in modes {
-            for (base, mask) in [(Some(0), None), (None, Some(1)), (Some(0), Some(1)), (None, None)] {
+            // With the same texture as base and mask too: its alpha, or
+            // (without alpha) its red channel as the mask.
+            let pairs = [
+                (Some(0), None),
+                (None, Some(1)),
+                (Some(0), Some(1)),
+                (None, None),
+                (Some(0), Some(0)),
+                (Some(1), Some(1)),
+            ];
+            for (base, mask) in pairs {
                 for opacity in [1.0, 0.5, 1.0 / 3.0, 0.0] {
                     scene.materials.push(Material {
                         alpha_mode,
@@ -208,5 +231,34 @@ mod tests {
             }
         }
         assert!(counts[0] > 10_000 && counts[1] > 10_000, "{counts:?}");
+    }
+
+    #[test]
+    fn a_mask_naming_the_base_colour_texture_counts_its_alpha_once() {
+        // An MTL material with `map_Kd leaf.png` and `map_d leaf.png`: one
+        // texture, alpha 0.6 everywhere. Squared (0.36), it would be a hole
+        // under the cutoff of one half; counted once, it is solid.
+        let mut scene = Scene::default();
+        let texels = vec![[40, 120, 30, 153]; 4];
+        scene.textures.push(Texture::from_rgba8("leaf", 2, 2, texels, ColorEncoding::Srgb).unwrap());
+        for (base, mask) in [(Some(0), Some(0)), (None, Some(0)), (Some(0), None)] {
+            scene.materials.push(Material {
+                alpha_mode: AlphaMode::Mask { cutoff: 0.5 },
+                base_color_texture: base.map(TextureId),
+                alpha_texture: mask.map(TextureId),
+                ..Material::default()
+            });
+            let first = scene.vertices.len() as u32;
+            for uv in [Vec2::ZERO, Vec2::X, Vec2::Y] {
+                scene.vertices.push(Vertex { position: Vec3::ZERO, normal: Vec3::Z, uv, tangent: Vec4::X });
+            }
+            let material = scene.materials.len() as u32 - 1;
+            scene.triangles.push(Triangle { vertices: [first, first + 1, first + 2], material });
+        }
+        let prepared = AlphaTest::new(&scene);
+        for triangle in 0..3 {
+            assert!(alpha_accepts(&scene, triangle, 0.3, 0.3, 0.5), "material {triangle}");
+            assert!(prepared.accepts(triangle, 0.3, 0.3, 0.5), "material {triangle}");
+        }
     }
 }

@@ -58,7 +58,9 @@ pub struct Material {
     /// How the alpha of base colour and texture is used: ignored, a cutout mask, or blending.
     pub alpha_mode: AlphaMode,
     /// Multiplies alpha by its alpha channel, or by its red channel where it
-    /// has none (an MTL `map_d` mask, often greyscale).
+    /// has none (an MTL `map_d` mask, often greyscale). Where it is the base
+    /// colour texture and has alpha, that alpha is the base colour's, which
+    /// counts once.
     pub alpha_texture: Option<TextureId>,
     /// Whether the back side is lit as the front (glTF); OBJ surfaces are two-sided.
     pub double_sided: bool,
