@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Renders scenes with this checkout's `rtgi` and with an older commit's, in
 # one run, the two binaries taking turns, and prints the rays per second
-# each render reports: median (min-max) and the ratio new / old. This is
+# each render reports: median (min-max) and the ratio new / old, then
+# every run's rate ("runs SCENE old: R R R new: R R R"). This is
 # how an issue's "N times today's rate" is measured, since timings on a
 # shared machine drift between runs that are not interleaved.
 #
@@ -74,6 +75,7 @@ summary() { # median (min-max) of the numbers on standard input
     sort -g | awk '{ v[NR] = $1 } END { printf "%s (%s-%s)", v[int((NR + 1) / 2)], v[1], v[NR] }'
 }
 
+runs_lines=()
 printf '%-40s %-24s %-24s %s\n' "scene (Mrays/s, $runs runs)" "old $hash" "new $(git rev-parse --short HEAD)" "new / old"
 for scene in "${scenes[@]}"; do
     : >"$scratch/old" && : >"$scratch/new"
@@ -86,4 +88,6 @@ for scene in "${scenes[@]}"; do
     # The medians are the summaries' first words.
     ratio="$(awk -v n="${new_summary%% *}" -v o="${old_summary%% *}" 'BEGIN { printf "%.2fx", n / o }')"
     printf '%-40s %-24s %-24s %s\n' "$(basename "$scene")" "$old_summary" "$new_summary" "$ratio"
+    runs_lines+=("runs $(basename "$scene") old: $(tr '\n' ' ' <"$scratch/old")new: $(tr '\n' ' ' <"$scratch/new")")
 done
+printf '%s\n' "${runs_lines[@]}"

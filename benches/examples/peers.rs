@@ -159,6 +159,9 @@ fn main() {
     if names.iter().any(|n| n.starts_with("embree")) {
         println!("embree 1: rtcIntersect1 (Accel::intersect); embree 16: rtcIntersect16 packets");
     }
+    // The columns once more, unambiguous for scripts (benches/targets.sh):
+    // in the tables, names wider than a column push the rest along.
+    println!("columns: threads, {}", names.join(", "));
 
     let timed = |pool: &rayon::ThreadPool, work: &(dyn Fn() + Sync)| {
         let start = Instant::now();

@@ -2,6 +2,7 @@
 //! running the CLI, scratch folders.
 
 pub mod corpus;
+pub mod voxel_world;
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
