@@ -126,10 +126,23 @@ fi
 milliseconds() { # WORD OUTPUT
     sed -n "s/^$1 *\([0-9.]*\) ms.*/\1/p" <<<"$2" | head -n 1
 }
+# Runs rtgi with ARGS and prints its output (stderr included); a run that
+# fails stops the script with its last lines.
+run_rtgi() {
+    local output
+    output="$("$rtgi" "$@" 2>&1)" || {
+        echo "targets: 'rtgi $*' failed:" >&2
+        tail -n 5 <<<"$output" >&2
+        exit 1
+    }
+    echo "$output"
+}
 timed() { # WORD ARGS... : runs rtgi, prints the milliseconds of its WORD line
     local word="$1" output ms
     shift
-    output="$("$rtgi" "$@" 2>&1)" && ms="$(milliseconds "$word" "$output")" && [[ -n "$ms" ]] || {
+    output="$(run_rtgi "$@")" || exit 1
+    ms="$(milliseconds "$word" "$output")"
+    [[ -n "$ms" ]] || {
         echo "targets: 'rtgi $*' gave no '$word' time:" >&2
         tail -n 5 <<<"$output" >&2
         exit 1
@@ -140,10 +153,10 @@ timed() { # WORD ARGS... : runs rtgi, prints the milliseconds of its WORD line
 echo "cut-outs: the voxel world ..." >&2
 world="$(target/release/examples/voxel-world "$scratch/world" 48)"
 view=(--at -6,16,-6 --look 20,4,20)
-"$rtgi" rays "$world" "${view[@]}" --kind camera --width 1024 --height 768 -o "$scratch/camera.rays" >/dev/null 2>&1
-"$rtgi" rays "$world" "${view[@]}" --kind surface --count 1000000 -o "$scratch/surface.rays" >/dev/null 2>&1
+run_rtgi rays "$world" "${view[@]}" --kind camera --width 1024 --height 768 -o "$scratch/camera.rays" >/dev/null
+run_rtgi rays "$world" "${view[@]}" --kind surface --count 1000000 -o "$scratch/surface.rays" >/dev/null
 render=(render "$world" "${view[@]}" --width 320 --height 240 --spp 16 -t 2 -o "$scratch/world.exr")
-"$rtgi" "${render[@]}" >/dev/null 2>&1 # the first run reads the files into the cache
+run_rtgi "${render[@]}" >/dev/null # the first run reads the files into the cache
 with=() without=()
 for _ in $(seq "$runs"); do
     with+=("$(timed render "${render[@]}")")

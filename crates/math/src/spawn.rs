@@ -201,9 +201,8 @@ const SHADOW_T_MAX: f32 = 1.0 - 16.0 * f32::EPSILON;
 /// two of a caller's separately stored coordinates as one 8-byte word
 /// cannot be forwarded from the stores, so each call waited for them (a
 /// fifth of the samples of the function, which had 7.7% of a Cornell box
-/// render's). Inlined
-/// into the spawning functions, the render takes 5% less time, with the
-/// same bits.
+/// render's). Inlined into the spawning functions, the render takes 5% less
+/// time, with the same bits.
 #[inline(always)]
 pub fn offset_ray_origin(p: Vec3, error: Vec3, normal: Vec3, direction: Vec3) -> Vec3 {
     let side = if direction.dot(normal) < 0.0 { -normal } else { normal };
