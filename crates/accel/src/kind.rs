@@ -70,7 +70,9 @@ pub struct BuildParams {
     pub sah_bins: usize,
     /// Which axes the binned SAH build tries splits on.
     pub sah_axes: SahAxes,
-    /// Cost of a traversal step relative to one ray/triangle test, for the SAH.
+    /// Cost of a traversal step relative to one leaf test, for the SAH: one
+    /// ray/triangle test, or for the wide BVHs one test of a block of four
+    /// triangles, which they test at once.
     pub traversal_cost: f32,
     /// The ray/triangle test every query uses.
     pub intersector: Intersector,
@@ -150,15 +152,17 @@ impl AccelKind {
     }
 
     /// The build parameters this variant is tuned for. The binary BVHs
-    /// take [`BuildParams::default`]. The wide ones test a node's eight
-    /// boxes and a leaf's four triangles in about the time of one binary
-    /// node, so their binary tree is built with a traversal cost of 4 and
-    /// leaves of up to 8 triangles (two blocks): fewer, fuller leaves and
-    /// shallower trees. On the bunny this traces incoherent rays about 45%
-    /// faster than the binary defaults, camera rays as fast.
+    /// take [`BuildParams::default`]. The wide ones take leaves of up to 8
+    /// triangles (two blocks of four); their SAH prices a leaf by its
+    /// blocks, and a node's eight boxes cost about one block's test, so
+    /// their traversal cost stays 1. Priced by triangles with a traversal
+    /// cost of 4 (until 2026-11), the trees traced as fast but took a
+    /// tenth (bunny) to a sixth (conference room) more memory: leaves of
+    /// five were split four and one, and 23% of the conference room's
+    /// blocks held a single triangle.
     pub fn default_params(self) -> BuildParams {
         match self.node_width() {
-            Some(width) if width > 2 => BuildParams { max_leaf_size: 8, traversal_cost: 4.0, ..BuildParams::default() },
+            Some(width) if width > 2 => BuildParams { max_leaf_size: 8, ..BuildParams::default() },
             _ => BuildParams::default(),
         }
     }

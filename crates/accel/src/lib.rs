@@ -168,8 +168,10 @@ pub struct BuildStats {
     pub depth: usize,
     /// `leaf_size_histogram[k]` leaves hold `k` triangles.
     pub leaf_size_histogram: Vec<usize>,
-    /// The tree's SAH cost in units of one triangle test, with the build's
-    /// traversal cost: the quality number of a tree (lower is better).
+    /// The tree's SAH cost in units of one leaf test (one triangle, or for
+    /// the wide BVHs one block of four triangles tested at once), with the
+    /// build's traversal cost: the quality number of a tree (lower is
+    /// better; compare it between builds of one structure).
     pub sah_cost: f32,
     /// Bytes of nodes, triangles and index tables.
     pub memory_bytes: usize,

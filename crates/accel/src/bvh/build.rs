@@ -17,7 +17,7 @@ use rtgi_math::{Vec3, Vec3A};
 
 use rayon::prelude::*;
 
-use super::split::{BuildRef, CentredPrimRef, Context, PrimRef, RangeBounds, Split, SplitMethod};
+use super::split::{BuildRef, CentredPrimRef, Context, LeafTests, PrimRef, RangeBounds, Split, SplitMethod};
 use super::{BvhNode, median, sah, spatial};
 use crate::BuildParams;
 use crate::boxa::BoxA;
@@ -108,12 +108,13 @@ impl Slot {
 /// Builds a tree over primitives given by their boxes, each centred in its
 /// box (triangles). With spatial splits a primitive may be in several
 /// leaves ([`spatial`]).
-pub(crate) fn build(boxes: &[BoxA], method: SplitMethod, params: &BuildParams) -> Tree {
+pub(crate) fn build(boxes: &[BoxA], method: SplitMethod, params: &BuildParams, leaf_tests: LeafTests) -> Tree {
+    let ctx = Context::of(method, params, leaf_tests);
     if method == SplitMethod::SpatialSah {
-        return spatial::build(boxes, &Context::of(method, params));
+        return spatial::build(boxes, &ctx);
     }
     let prims = boxes.par_iter().enumerate().map(|(i, b)| PrimRef::new(*b, i as u32)).collect();
-    build_over(prims, method, params)
+    build_over(prims, &ctx)
 }
 
 /// Builds a tree over primitives given by their boxes and centroids.
@@ -123,20 +124,19 @@ pub(crate) fn build_with_centroids(primitives: &[(BoxA, Vec3A)], method: SplitMe
         .enumerate()
         .map(|(i, (bounds, centroid))| CentredPrimRef::new(*bounds, *centroid, i as u32))
         .collect();
-    build_over(prims, method, params)
+    build_over(prims, &Context::of(method, params, LeafTests::OneByOne))
 }
 
-fn build_over<R: BuildRef>(mut prims: Vec<R>, method: SplitMethod, params: &BuildParams) -> Tree {
+fn build_over<R: BuildRef>(mut prims: Vec<R>, ctx: &Context) -> Tree {
     let n = prims.len();
     if n == 0 {
         return Tree::empty();
     }
-    let ctx = Context::of(method, params);
     let mut slots = vec![Slot::default(); 2 * n - 1];
     let root = RangeBounds::of(&prims);
-    build_node(&ctx, &mut prims, 0, &mut slots, 0, 0, root);
+    build_node(ctx, &mut prims, 0, &mut slots, 0, 0, root);
     let order = prims.iter().map(BuildRef::index).collect();
-    layout(&slots, order, params.traversal_cost)
+    layout(&slots, order, ctx)
 }
 
 /// Builds the subtree over `prims` (which start at position `first` of the
@@ -236,9 +236,9 @@ fn choose_split<R: BuildRef>(ctx: &Context, prims: &mut [R], depth: usize, range
 }
 
 /// Lays the used slots out depth-first with siblings adjacent, and measures
-/// the tree: depth, leaves, leaf sizes and SAH cost (intersection cost 1,
-/// traversal cost as given, relative to the root's area).
-pub(crate) fn layout(slots: &[Slot], order: Vec<u32>, traversal_cost: f32) -> Tree {
+/// the tree: depth, leaves, leaf sizes and SAH cost (the build's leaf and
+/// traversal costs, relative to the root's area).
+pub(crate) fn layout(slots: &[Slot], order: Vec<u32>, ctx: &Context) -> Tree {
     let root_area = slots[0].bounds().half_area();
     // At most every slot is used; reserving that much only claims address
     // space, and saves the copies of a growing vector.
@@ -261,13 +261,13 @@ pub(crate) fn layout(slots: &[Slot], order: Vec<u32>, traversal_cost: f32) -> Tr
             }
             histogram[slot.count as usize] += 1;
             leaf_ranges.push((slot.link, slot.count));
-            cost += relative_area * slot.count as f64;
+            cost += relative_area * ctx.leaf_cost(slot.count as usize) as f64;
             BvhNode::new(min, max, slot.link, slot.count)
         } else {
             let children = nodes.len() as u32;
             nodes.push(BvhNode::default());
             nodes.push(BvhNode::default());
-            cost += relative_area * traversal_cost as f64;
+            cost += relative_area * ctx.traversal_cost as f64;
             stack.push((slot.link, children + 1, node_depth + 1));
             stack.push((slot_index + 1, children, node_depth + 1));
             BvhNode::new(min, max, children, 0)

@@ -17,6 +17,7 @@ mod traverse;
 mod validate;
 
 pub use primitives::PrimitiveBvh;
+pub(crate) use split::LeafTests;
 pub use split::SplitMethod;
 pub use traverse::Traversal;
 
@@ -116,7 +117,14 @@ pub(crate) struct BinaryTree {
 }
 
 impl BinaryTree {
-    pub(crate) fn new(triangles: &(impl TriangleSource + ?Sized), method: SplitMethod, params: &BuildParams) -> Self {
+    /// The tree over the hittable `triangles`, for a structure whose leaves
+    /// are tested as `leaf_tests` says.
+    pub(crate) fn new(
+        triangles: &(impl TriangleSource + ?Sized),
+        method: SplitMethod,
+        params: &BuildParams,
+        leaf_tests: LeafTests,
+    ) -> Self {
         let count = triangles.len();
         let all_hittable = (0..count).into_par_iter().all(|i| is_hittable(&triangles.corners(i)));
         let (boxes, ids): (Vec<BoxA>, Vec<u32>) = if all_hittable {
@@ -133,7 +141,7 @@ impl BinaryTree {
                 })
                 .unzip()
         };
-        let tree = build::build(&boxes, method, params);
+        let tree = build::build(&boxes, method, params, leaf_tests);
         let triangle_ids = tree.order.par_iter().map(|&p| ids[p as usize]).collect();
         BinaryTree { tree, triangle_ids, excluded: count - ids.len() }
     }
@@ -164,7 +172,8 @@ impl Bvh {
     pub fn new(triangles: &(impl TriangleSource + ?Sized), method: SplitMethod, params: &BuildParams) -> Self {
         let start = Instant::now();
         let count = triangles.len();
-        let BinaryTree { tree, triangle_ids, excluded } = BinaryTree::new(triangles, method, params);
+        let BinaryTree { tree, triangle_ids, excluded } =
+            BinaryTree::new(triangles, method, params, LeafTests::OneByOne);
         let leaf_triangles = triangle_ids.par_iter().map(|&i| triangles.corners(i as usize).map(Vec3A::from)).collect();
         let leaf_bytes = (std::mem::size_of::<[Vec3A; 3]>() + std::mem::size_of::<u32>()) * triangle_ids.len();
         let stats = tree.stats(method.name().to_owned(), count, excluded, start, leaf_bytes);

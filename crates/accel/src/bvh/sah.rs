@@ -1,11 +1,14 @@
 //! Splits by the surface area heuristic (Goldsmith and Salmon 1987;
 //! MacDonald and Booth 1990): the expected cost of a split is
 //! `C_trav + (A_L N_L + A_R N_R) / A` in units of one triangle test, where
-//! `A` are surface areas and `N` primitive counts; a leaf costs `N`.
+//! `A` are surface areas and `N` primitive counts; a leaf costs `N`, or
+//! for leaves tested in blocks the number of blocks ([`LeafTests`]).
 
 use rtgi_math::Vec3A;
 
 use super::median::{by_centroid, object_median};
+#[cfg(doc)]
+use super::split::LeafTests;
 use super::split::{BuildRef, Context, RangeBounds, Split};
 use crate::SahAxes;
 use crate::boxa::BoxA;
@@ -23,9 +26,9 @@ fn split_pays(ctx: &Context, count: usize, range: &RangeBounds, best_area_count:
     let split_cost = if node_area > 0.0 {
         ctx.traversal_cost + best_area_count / node_area
     } else {
-        ctx.traversal_cost + count as f32
+        ctx.traversal_cost + ctx.leaf_cost(count)
     };
-    must_split || split_cost < count as f32
+    must_split || split_cost < ctx.leaf_cost(count)
 }
 
 /// Bins a node's primitives fall into, per axis.
@@ -211,7 +214,7 @@ fn binned_core<R: BuildRef>(
         for k in (1..bins).rev() {
             acc = acc.union(axis_bins[k].bounds);
             n += axis_bins[k].count;
-            right_cost[k] = acc.half_area() * n as f32;
+            right_cost[k] = acc.half_area() * ctx.leaf_cost(n as usize);
         }
         let (mut acc, mut n) = (BoxA::EMPTY, 0u32);
         for k in 0..bins - 1 {
@@ -220,7 +223,7 @@ fn binned_core<R: BuildRef>(
             if n == 0 || n as usize == count {
                 continue;
             }
-            let cost = acc.half_area() * n as f32 + right_cost[k + 1];
+            let cost = acc.half_area() * ctx.leaf_cost(n as usize) + right_cost[k + 1];
             if cost < best.0 {
                 best = (cost, axis, k);
             }
@@ -259,21 +262,26 @@ const SMALL_RANGE: usize = 8;
 /// The best split of a range of `count` primitives, over the three axes:
 /// `bounds(axis, k)` is the box of the `k`-th primitive of the range sorted
 /// by centroid along `axis`, and `right_cost` is scratch space of `count`
-/// entries. Returns the summed `A · N` of both sides, the axis and the
-/// left count.
+/// entries. Returns the summed `A · N` of both sides (`N` priced by
+/// [`Context::leaf_cost`]), the axis and the left count.
 #[inline(always)]
-fn best_sweep(count: usize, bounds: impl Fn(usize, usize) -> BoxA, right_cost: &mut [f32]) -> (f32, usize, usize) {
+fn best_sweep(
+    ctx: &Context,
+    count: usize,
+    bounds: impl Fn(usize, usize) -> BoxA,
+    right_cost: &mut [f32],
+) -> (f32, usize, usize) {
     let mut best = (f32::INFINITY, 0, 0);
     for axis in 0..3 {
         let mut acc = BoxA::EMPTY;
         for k in (1..count).rev() {
             acc = acc.union(bounds(axis, k));
-            right_cost[k] = acc.half_area() * (count - k) as f32;
+            right_cost[k] = acc.half_area() * ctx.leaf_cost(count - k);
         }
         let mut acc = BoxA::EMPTY;
         for k in 0..count - 1 {
             acc = acc.union(bounds(axis, k));
-            let cost = acc.half_area() * (k + 1) as f32 + right_cost[k + 1];
+            let cost = acc.half_area() * ctx.leaf_cost(k + 1) + right_cost[k + 1];
             // Equal costs (coincident boxes) go to the most even split, so
             // that such ranges halve instead of peeling one primitive a level.
             let imbalance = |left: usize| left.abs_diff(count - left);
@@ -318,7 +326,7 @@ fn small<R: BuildRef>(ctx: &Context, prims: &mut [R], range: &RangeBounds) -> Op
             order[rank] = i as u8;
         }
     }
-    let best = best_sweep(count, |axis, k| prims[sorted[axis][k] as usize].bounds(), &mut [0.0; SMALL_RANGE]);
+    let best = best_sweep(ctx, count, |axis, k| prims[sorted[axis][k] as usize].bounds(), &mut [0.0; SMALL_RANGE]);
     if !split_pays(ctx, count, range, best.0) {
         return None;
     }
@@ -340,7 +348,7 @@ pub(crate) fn sweep<R: BuildRef>(ctx: &Context, prims: &mut [R], range: &RangeBo
     for (axis, order) in sorted.iter_mut().enumerate() {
         order.sort_unstable_by(by_centroid(axis));
     }
-    let best = best_sweep(count, |axis, k| sorted[axis][k].bounds(), &mut vec![0.0; count]);
+    let best = best_sweep(ctx, count, |axis, k| sorted[axis][k].bounds(), &mut vec![0.0; count]);
     if !split_pays(ctx, count, range, best.0) {
         return None;
     }
@@ -353,11 +361,47 @@ pub(crate) fn sweep<R: BuildRef>(ctx: &Context, prims: &mut [R], range: &RangeBo
 mod tests {
     use rtgi_math::{Vec3, Vec3A};
 
-    use super::centroid_key;
+    use super::{binned, centroid_key, small, sweep};
     use crate::boxa::BoxA;
     use crate::bvh::median::by_centroid;
-    use crate::bvh::split::PrimRef;
+    use crate::bvh::split::{Context, LeafTests, PrimRef, RangeBounds};
     use crate::{BuildParams, Bvh, SahAxes, SplitMethod};
+
+    /// Four unit squares' halves in a row, a tenth apart: priced one by
+    /// one, a leaf costs 4 and two leaves of two cost 1 + 2 · 2 · 2.1/4.3
+    /// ≈ 2.95, so every sweep splits them; priced in blocks of four, the
+    /// leaf costs one block and the split 1 + 2 · 2.1/4.3 ≈ 1.98, so every
+    /// sweep keeps them together. Five in a row still take two blocks
+    /// either way, and a split into four and one is what pays.
+    #[test]
+    fn leaves_priced_in_blocks_keep_a_block_of_four_together() {
+        let row = |count: u32| -> Vec<PrimRef> {
+            (0..count)
+                .map(|i| {
+                    let x = i as f32 * 1.1;
+                    PrimRef::new(BoxA { min: Vec3A::new(x, 0.0, 0.0), max: Vec3A::new(x + 1.0, 1.0, 0.0) }, i)
+                })
+                .collect()
+        };
+        let params = BuildParams { max_leaf_size: 8, ..BuildParams::default() };
+        let splits = |leaf_tests, count| {
+            let ctx = Context::of(SplitMethod::BinnedSah, &params, leaf_tests);
+            let mut prims = row(count);
+            let range = RangeBounds::of(&prims);
+            [
+                binned(&ctx, &mut prims.clone(), &range).map(|split| split.left_count),
+                small(&ctx, &mut prims.clone(), &range).map(|split| split.left_count),
+                sweep(&ctx, &mut prims, &range).map(|split| split.left_count),
+            ]
+        };
+        assert_eq!(splits(LeafTests::OneByOne, 4), [Some(2); 3], "one by one, four split in two");
+        assert_eq!(splits(LeafTests::InBlocksOf(4), 4), [None; 3], "in blocks, four stay one leaf");
+        for split in splits(LeafTests::InBlocksOf(4), 5) {
+            assert!(matches!(split, Some(1..=4)), "in blocks, five split into two blocks: {split:?}");
+        }
+        assert_eq!(LeafTests::InBlocksOf(4).steps(5), 2);
+        assert_eq!(LeafTests::OneByOne.steps(5), 5);
+    }
     /// The small sweep ranks integer keys where every other sweep sorts by
     /// [`by_centroid`]; both must give one order, or the trees would differ
     /// with the range's length. Signed zeros, subnormals, infinities and

@@ -70,7 +70,7 @@ pub(crate) fn build(boxes: &[BoxA], ctx: &Context) -> Tree {
     let root_area = range.bounds.half_area();
     let budget = (refs.len() as f32 * DUPLICATE_BUDGET) as usize;
     let subtree = build_node(ctx, root_area, refs, range, 0, budget);
-    layout(&subtree.slots, subtree.order, ctx.traversal_cost)
+    layout(&subtree.slots, subtree.order, ctx)
 }
 
 /// A subtree before layout: its slots (links relative to its own first

@@ -29,8 +29,8 @@ pub(crate) struct WideTree<const W: usize> {
     pub(crate) leaves: usize,
     /// Edges on the longest path from the root to a leaf.
     pub(crate) depth: usize,
-    /// SAH cost in units of one triangle test, each wide node costing
-    /// `traversal_cost`, relative to the root's area.
+    /// SAH cost in units of one test of a block of four triangles, each
+    /// wide node costing `traversal_cost`, relative to the root's area.
     pub(crate) sah_cost: f32,
 }
 
@@ -227,7 +227,8 @@ impl Collapser<'_> {
         let (first, first_block) = self.first_blocks[at];
         debug_assert_eq!(first, leaf.first());
         tree.leaves += 1;
-        *cost += self.relative_area(leaf) * leaf.count() as f64;
-        ChildRef::leaf(first_block as usize, leaf.count().div_ceil(TriangleBlock::LANES as u32) as usize)
+        let blocks = leaf.count().div_ceil(TriangleBlock::LANES as u32);
+        *cost += self.relative_area(leaf) * blocks as f64;
+        ChildRef::leaf(first_block as usize, blocks as usize)
     }
 }

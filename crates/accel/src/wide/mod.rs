@@ -24,7 +24,7 @@ use std::time::Instant;
 
 use rtgi_math::{Aabb, Vec3};
 
-use crate::bvh::BinaryTree;
+use crate::bvh::{BinaryTree, LeafTests};
 use crate::contract::{HitFilter, QueryKind, Structure};
 use crate::simd::triangles::TriangleBlock;
 use crate::{BuildParams, BuildStats, Counter, Hit, Intersector, SplitMethod, TriangleSource};
@@ -62,7 +62,7 @@ impl<const W: usize, N: NodeLayout<W>> WideBvh<W, N> {
     pub fn new(triangles: &(impl TriangleSource + ?Sized), method: SplitMethod, params: &BuildParams) -> Self {
         let start = Instant::now();
         let params = BuildParams { max_leaf_size: params.max_leaf_size.min(Self::MAX_LEAF_SIZE), ..params.clone() };
-        let binary = BinaryTree::new(triangles, method, &params);
+        let binary = BinaryTree::new(triangles, method, &params, LeafTests::InBlocksOf(TriangleBlock::LANES));
         let tree = collapse::collapse::<W>(&binary, triangles, params.traversal_cost);
         let (node_count, memory_bytes) = (
             tree.nodes.len(),
@@ -168,6 +168,28 @@ mod tests {
     use super::*;
     use crate::simd::triangles::TriangleBlock;
     use rtgi_math::Rng;
+
+    /// Four triangles in a row, a tenth apart, are one block: the wide
+    /// builds price a leaf by its blocks, so splitting the row in two
+    /// (which pays when a leaf is priced by its triangles) would only add
+    /// a block and a box test. Across many such rows, every block is full.
+    #[test]
+    fn wide_builds_fill_their_blocks() {
+        let row = |y: f32| {
+            (0..4).map(move |i| {
+                let x = i as f32 * 1.1;
+                [Vec3::new(x, y, 0.0), Vec3::new(x + 1.0, y, 0.0), Vec3::new(x, y + 1.0, 0.0)]
+            })
+        };
+        let one_row: Vec<[Vec3; 3]> = row(0.0).collect();
+        let params = crate::AccelKind::Bvh8.default_params();
+        assert_eq!(Bvh8::new(&one_row, SplitMethod::BinnedSah, &params).blocks.len(), 1);
+        assert_eq!(Bvh4::new(&one_row, SplitMethod::BinnedSah, &params).blocks.len(), 1);
+        let rows: Vec<[Vec3; 3]> = (0..32).flat_map(|r| row(r as f32 * 10.0)).collect();
+        let bvh = Bvh8::new(&rows, SplitMethod::BinnedSah, &params);
+        assert_eq!(bvh.blocks.len(), 32, "32 rows of four in 64 blocks: {:?}", bvh.stats.leaf_size_histogram);
+        check_tree(&bvh, &rows);
+    }
 
     /// Every hittable triangle in exactly one block and inside every box
     /// on its path from the root, and references that stay inside the
