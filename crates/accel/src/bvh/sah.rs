@@ -2,13 +2,12 @@
 //! MacDonald and Booth 1990): the expected cost of a split is
 //! `C_trav + (A_L N_L + A_R N_R) / A` in units of one triangle test, where
 //! `A` are surface areas and `N` primitive counts; a leaf costs `N`, or
-//! for leaves tested in blocks the number of blocks ([`LeafTests`]).
+//! for leaves tested in blocks the number of blocks
+//! ([`LeafTests`](super::split::LeafTests)).
 
 use rtgi_math::Vec3A;
 
 use super::median::{by_centroid, object_median};
-#[cfg(doc)]
-use super::split::LeafTests;
 use super::split::{BuildRef, Context, RangeBounds, Split};
 use crate::SahAxes;
 use crate::boxa::BoxA;
@@ -371,8 +370,9 @@ mod tests {
     /// one, a leaf costs 4 and two leaves of two cost 1 + 2 · 2 · 2.1/4.3
     /// ≈ 2.95, so every sweep splits them; priced in blocks of four, the
     /// leaf costs one block and the split 1 + 2 · 2.1/4.3 ≈ 1.98, so every
-    /// sweep keeps them together. Five in a row still take two blocks
-    /// either way, and a split into four and one is what pays.
+    /// sweep keeps them together. Five in a row take two blocks however
+    /// they are split, so every sweep splits them into two leaves of one
+    /// block each.
     #[test]
     fn leaves_priced_in_blocks_keep_a_block_of_four_together() {
         let row = |count: u32| -> Vec<PrimRef> {
@@ -402,6 +402,7 @@ mod tests {
         assert_eq!(LeafTests::InBlocksOf(4).steps(5), 2);
         assert_eq!(LeafTests::OneByOne.steps(5), 5);
     }
+
     /// The small sweep ranks integer keys where every other sweep sorts by
     /// [`by_centroid`]; both must give one order, or the trees would differ
     /// with the range's length. Signed zeros, subnormals, infinities and

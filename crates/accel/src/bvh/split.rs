@@ -129,7 +129,7 @@ pub(crate) struct Context {
     pub(crate) sah_axes: crate::SahAxes,
     pub(crate) traversal_cost: f32,
     /// Primitives a leaf tests in one step (see [`LeafTests`]).
-    pub(crate) leaf_tests: LeafTests,
+    leaf_tests: LeafTests,
 }
 
 impl Context {

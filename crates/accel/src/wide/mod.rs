@@ -187,7 +187,7 @@ mod tests {
         assert_eq!(Bvh4::new(&one_row, SplitMethod::BinnedSah, &params).blocks.len(), 1);
         let rows: Vec<[Vec3; 3]> = (0..32).flat_map(|r| row(r as f32 * 10.0)).collect();
         let bvh = Bvh8::new(&rows, SplitMethod::BinnedSah, &params);
-        assert_eq!(bvh.blocks.len(), 32, "32 rows of four in 64 blocks: {:?}", bvh.stats.leaf_size_histogram);
+        assert_eq!(bvh.blocks.len(), 32, "32 rows of four in 32 blocks: {:?}", bvh.stats.leaf_size_histogram);
         check_tree(&bvh, &rows);
     }
 
