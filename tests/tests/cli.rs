@@ -138,3 +138,18 @@ fn shared_cornell_box_renders_with_its_colours() {
     }
     assert!(reddish > 100 && greenish > 100, "red {reddish}, green {greenish}");
 }
+
+#[test]
+fn a_thread_count_from_the_environment_that_is_not_a_count_is_refused() {
+    for command in [&["render", "--quick", "-o", "/nonexistent/x.png"][..], &["rays", "-o", "/nonexistent/r.bin"]] {
+        let output = std::process::Command::new(RTGI)
+            .args(command)
+            .env("RTGI_THREADS", "many")
+            .current_dir(rtgi_tests::workspace_root())
+            .output()
+            .unwrap();
+        let stderr = String::from_utf8_lossy(&output.stderr);
+        assert!(output.status.code().is_some_and(|c| c != 0 && c != 101), "{command:?}: {stderr}");
+        assert!(stderr.contains("RTGI_THREADS=many"), "{command:?}: {stderr}");
+    }
+}

@@ -729,15 +729,66 @@ pub(crate) struct ToneArgs {
 /// Worker threads: shared by every command that runs in parallel.
 #[derive(Debug, Args)]
 pub(crate) struct ThreadArgs {
-    /// Worker threads [default: one per core]
-    #[arg(short = 't', long = "threads", value_parser = clap::value_parser!(u32).range(1..=1024))]
-    pub(crate) count: Option<u32>,
+    /// Worker threads: every thread that works, loading and building included [default:
+    /// $RTGI_THREADS, else one per core]
+    #[arg(short = 't', long = "threads", value_parser = clap::value_parser!(u32).range(1..=MAX_THREADS as i64))]
+    count: Option<u32>,
 }
 
+/// Most worker threads accepted by `--threads` and `RTGI_THREADS`.
+const MAX_THREADS: u32 = 1024;
+
 impl ThreadArgs {
+    /// `--threads`, else `RTGI_THREADS`; `None` for one per core.
+    pub(crate) fn count(&self) -> anyhow::Result<Option<u32>> {
+        match self.count {
+            Some(count) => Ok(Some(count)),
+            None => threads_from_environment(),
+        }
+    }
+
     /// A pool of that many worker threads.
     pub(crate) fn pool(&self) -> anyhow::Result<rayon::ThreadPool> {
-        crate::common::thread_pool(self.count)
+        crate::common::thread_pool(self.count()?)
+    }
+}
+
+impl Command {
+    /// The worker threads the command asks for: `--threads`, else
+    /// `RTGI_THREADS` (which commands without `--threads` read too); `None`
+    /// for one per core.
+    pub(crate) fn threads(&self) -> anyhow::Result<Option<u32>> {
+        let args = match self {
+            Command::Render(args) => &args.threads,
+            Command::Trace(args) => &args.threads,
+            Command::Bench(args) => &args.threads,
+            Command::Heatmap(args) => &args.threads,
+            Command::BenchEffects(args) => &args.threads,
+            Command::Verify(args) => &args.threads,
+            Command::Experiment(args) => &args.threads,
+            Command::Script(args) | Command::Repl(args) => &args.threads,
+            Command::BvhBoxes(_)
+            | Command::Info(_)
+            | Command::Compare(_)
+            | Command::Merge(_)
+            | Command::Gallery(_)
+            | Command::Rays(_) => return threads_from_environment(),
+        };
+        args.count()
+    }
+}
+
+/// The environment variable that sets the worker threads of every command
+/// (a cluster task's CPUs, say); `--threads` overrides it.
+pub(crate) const THREADS_VARIABLE: &str = "RTGI_THREADS";
+
+/// `RTGI_THREADS`, checked as clap checks `--threads`.
+fn threads_from_environment() -> anyhow::Result<Option<u32>> {
+    let Some(value) = std::env::var_os(THREADS_VARIABLE) else { return Ok(None) };
+    let value = value.to_string_lossy();
+    match value.trim().parse::<u32>() {
+        Ok(count) if (1..=MAX_THREADS).contains(&count) => Ok(Some(count)),
+        _ => anyhow::bail!("{THREADS_VARIABLE}={value}: expected a number of threads from 1 to {MAX_THREADS}"),
     }
 }
 

@@ -43,6 +43,16 @@ pub(crate) fn load_scene(path: Option<&Path>) -> Result<LoadedScene> {
     Ok(LoadedScene { scene, name, load_ms })
 }
 
+/// Sizes rayon's global pool to `threads` worker threads (one per core
+/// when `None`); called once, before any parallel work.
+pub(crate) fn size_global_pool(threads: Option<u32>) -> Result<()> {
+    let mut pool = rayon::ThreadPoolBuilder::new();
+    if let Some(threads) = threads {
+        pool = pool.num_threads(threads as usize);
+    }
+    pool.build_global().context("cannot start worker threads")
+}
+
 /// A pool of `threads` worker threads, or one per core.
 pub(crate) fn thread_pool(threads: Option<u32>) -> Result<rayon::ThreadPool> {
     let mut pool = rayon::ThreadPoolBuilder::new();

@@ -34,6 +34,13 @@ pub fn main() -> ExitCode {
         Err(e) => return cli::report_parse_error(e),
     };
     let _ = common::ALLOW_OUTSIDE_SCENE.set(cli.allow_outside_scene);
+    // Rayon's global pool runs whatever no command's own pool runs (loading
+    // a scene, the passes of a render): it gets the same count, so that
+    // `--threads N` bounds every thread that works, not only the pool's.
+    if let Err(e) = cli.command.threads().and_then(common::size_global_pool) {
+        eprintln!("error: {}", one_line(&e));
+        return ExitCode::FAILURE;
+    }
     let result = match cli.command {
         cli::Command::Render(args) => render_cmd::run(&args),
         cli::Command::Trace(args) => trace_cmd::run(&args),

@@ -252,8 +252,11 @@ pub(crate) fn render_given(args: &RenderArgs, given: Option<Given<'_>>) -> Resul
             Done::Adapted(image, outcome)
         }
         None => {
-            let (accumulation, half) =
-                render_progressively(args, &renderer, started, from_script, resumed, halfway, &mut printed)?;
+            // In the pool: the passes' tiles run on its threads, however
+            // many the process's global pool has (a script's `one thread`).
+            let (accumulation, half) = pool.install(|| {
+                render_progressively(args, &renderer, started, from_script, resumed, halfway, &mut printed)
+            })?;
             half_image = half;
             Done::Progressive(accumulation)
         }

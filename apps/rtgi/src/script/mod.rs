@@ -51,7 +51,7 @@ pub(crate) fn run(args: &ScriptArgs) -> Result<()> {
     let mut session = Session::new(SessionOptions {
         output: Some(args.output.clone()),
         seed: args.seed.value,
-        threads: args.threads.count,
+        threads: args.threads.count()?,
         model_paths: args.model_paths.clone(),
     });
     for script in &args.scripts {
