@@ -1,10 +1,11 @@
-//! Loading scales linearly: an OBJ whose faces crowd around one vertex
-//! loads in a time linear in its faces (issue 12: a fan of 100,000
-//! triangles without normals took minutes, computing smooth normals in a
-//! time quadratic in the valence of its centre).
+//! An OBJ whose faces crowd around one vertex loads, with the right normals
+//! (issue 12: a fan of 100,000 triangles without normals took minutes,
+//! computing smooth normals in a time quadratic in the valence of its
+//! centre). That the work is linear is counted, not timed, by the unit
+//! tests of `MeshBuilder` (`crates/scene/src/mesh.rs`), which every
+//! importer's triangles go through.
 
 use std::fmt::Write as _;
-use std::time::{Duration, Instant};
 
 use rtgi_math::Vec3;
 use rtgi_scene::Scene;
@@ -25,16 +26,12 @@ fn fan_obj(count: u32) -> String {
 }
 
 #[test]
-fn a_fan_of_100000_triangles_without_normals_loads_in_linear_time() {
+fn a_fan_of_100000_triangles_without_normals_loads_with_the_fan_s_normal() {
     let dir = scratch_dir("loading_scale");
     let path = dir.join("fan.obj");
     std::fs::write(&path, fan_obj(100_000)).unwrap();
 
-    let start = Instant::now();
     let scene = Scene::load(&path).unwrap_or_else(|e| panic!("{e}"));
-    let took = start.elapsed();
-
-    assert!(took < Duration::from_secs(5), "loading took {took:?}");
     assert_eq!(scene.triangles.len(), 100_000);
     // One centre vertex, whose normal is the fan's (+z, as every face's).
     let centre = scene.triangles[0].vertices[0];
