@@ -24,43 +24,67 @@ fn render_room(out: &Path, extra: &[&str]) -> Run {
     rtgi(&args)
 }
 
+/// `rtgi ARGS --json`, which must succeed: its summary, and what it said on standard error.
+fn summary(args: &[&str]) -> (serde_json::Value, String) {
+    let run = rtgi(&[args, &["--json"]].concat());
+    assert!(run.success, "{run:?}");
+    let json = serde_json::from_str(&run.stdout).unwrap_or_else(|e| panic!("not JSON ({e}): {}", run.stdout));
+    (json, run.stderr)
+}
+
+/// [`render_room`] with `--json`.
+fn render_room_summary(out: &Path, extra: &[&str]) -> (serde_json::Value, String) {
+    let mut args = vec!["render", ROOM, "-o", path_str(out), "--width", "32", "--height", "32", "--spp", "2"];
+    args.extend(extra);
+    summary(&args)
+}
+
 #[test]
 fn a_room_lit_only_from_outside_is_said_to_be_almost_black() {
     let dir = scratch_dir("almost-black");
-    let run = render_room(&dir.join("black.png"), &["--light", "point:5,5,5:100"]);
-    assert!(run.success, "{run:?}");
-    assert!(run.stderr.contains("warning: the image is almost black (100% of its pixels)"), "{run:?}");
-    assert!(run.stderr.contains("--environment") && run.stderr.contains("--at"), "{run:?}");
+    let (json, stderr) = render_room_summary(&dir.join("black.png"), &["--light", "point:5,5,5:100"]);
+    assert_eq!(json["legibility"]["looks"], "almost black", "{json}");
+    assert_eq!(json["legibility"]["fraction"], 1.0, "{json}");
+    // The warning says what to do, in the options' words.
+    assert!(stderr.contains("warning: the image is almost black (100% of its pixels)"), "{stderr}");
+    assert!(stderr.contains("--environment") && stderr.contains("--at"), "{stderr}");
 }
 
 #[test]
 fn an_overexposed_image_is_said_to_be_almost_white() {
     let dir = scratch_dir("almost-white");
-    let run = render_room(&dir.join("white.png"), &["--light", "point:0,0.5,0:100", "--exposure", "12"]);
-    assert!(run.success, "{run:?}");
-    assert!(run.stderr.contains("warning: the image is almost white"), "{run:?}");
-    assert!(run.stderr.contains("lower --exposure"), "{run:?}");
+    let (json, stderr) =
+        render_room_summary(&dir.join("white.png"), &["--light", "point:0,0.5,0:100", "--exposure", "12"]);
+    assert_eq!(json["legibility"]["looks"], "almost white", "{json}");
+    assert_eq!((json["exposure"]["stops"].as_f64(), &json["exposure"]["automatic"]), (Some(12.0), &false.into()));
+    assert!(stderr.contains("warning: the image is almost white") && stderr.contains("lower --exposure"), "{stderr}");
     // Left to the automatic exposure, the same light gives an image that shows something.
+    let (json, stderr) = render_room_summary(&dir.join("auto.png"), &["--light", "point:0,0.5,0:100"]);
+    assert!(json["legibility"].is_null() && !stderr.contains("warning"), "{json} {stderr}");
+    assert_eq!((&json["exposure"]["automatic"], &json["exposure"]["tone_map"]), (&true.into(), &"aces".into()));
+    // The text says the same as the JSON.
     let run = render_room(&dir.join("auto.png"), &["--light", "point:0,0.5,0:100"]);
-    assert!(run.success && !run.stderr.contains("warning"), "{run:?}");
     assert!(run.stdout.contains("(automatic; --exposure sets it), aces tone map"), "{run:?}");
 }
 
 #[test]
 fn an_enclosed_unlit_view_gets_a_room_light_and_says_so() {
     let dir = scratch_dir("room-light");
+    let (json, _) = render_room_summary(&dir.join("room.png"), &[]);
+    let lamp: Vec<f64> = json["room_light"].as_array().expect("a room light").iter().flat_map(|c| c.as_f64()).collect();
+    assert_eq!(lamp.len(), 3, "{json}");
+    assert!(json["legibility"].is_null(), "{json}");
     let run = render_room(&dir.join("room.png"), &[]);
-    assert!(run.success, "{run:?}");
     assert!(run.stdout.contains("note: the camera is enclosed by the scene"), "{run:?}");
-    assert!(!run.stderr.contains("almost black"), "{run:?}");
 }
 
 #[test]
 fn a_camera_that_sees_only_the_backs_of_faces_is_said_to_be_inside_geometry() {
     let dir = scratch_dir("buried-camera");
-    let run = render_room(&dir.join("outside.png"), &["--at", "0,0,1.5", "--look", "0,0,0"]);
-    assert!(run.success, "{run:?}");
-    assert!(run.stderr.contains("warning: the camera seems to be inside geometry"), "{run:?}");
+    let (json, stderr) = render_room_summary(&dir.join("outside.png"), &["--at", "0,0,1.5", "--look", "0,0,0"]);
+    assert_eq!(json["camera"]["source"], "options", "{json}");
+    assert!(json["camera"]["inside_geometry"].as_f64().is_some_and(|f| f > 0.5), "{json}");
+    assert!(stderr.contains("warning: the camera seems to be inside geometry"), "{stderr}");
 }
 
 #[test]
@@ -68,16 +92,23 @@ fn without_o_the_image_is_named_after_the_scene_in_the_current_folder() {
     let dir = scratch_dir("default-output");
     let scene = workspace_root().join(ROOM);
     let run: Run = Command::new(RTGI)
-        .args(["render", path_str(&scene), "--quick", "-t", "1"])
+        .args(["render", path_str(&scene), "--quick", "-t", "1", "--json"])
         .current_dir(&dir)
         .output()
         .unwrap()
         .into();
     assert!(run.success, "{run:?}");
+    let json: serde_json::Value = serde_json::from_str(&run.stdout).unwrap();
+    assert_eq!(json["outputs"][0]["path"], "closed-room.png", "{json}");
     let image = image::open(dir.join("closed-room.png")).expect("closed-room.png in the current folder");
-    // --quick: a quarter of the default 512 x 512.
+    // --quick: a quarter of the default 512 x 512, and at most 4 samples per pixel.
     assert_eq!((image.width(), image.height()), (128, 128));
-    assert!(run.stdout.contains("at 4 spp"), "{run:?}");
+    let render = &json["render"];
+    assert_eq!(
+        (&render["width"], &render["height"], &render["samples_per_pixel"]),
+        (&128.into(), &128.into(), &4.into())
+    );
+    assert_eq!(render["threads"], 1, "{json}");
 }
 
 #[test]
@@ -176,16 +207,18 @@ fn info_numbers_cameras_and_names_texture_files() {
     ) else {
         return; // shared_scene said which is missing
     };
-    let run = rtgi(&["info", path_str(&helmet)]);
-    assert!(run.success, "{run:?}");
-    assert!(run.stdout.contains("  [0] image 0 from 'Default_albedo.jpg' (2048x2048)"), "{}", run.stdout);
-    let run = rtgi(&["info", path_str(&cameras)]);
-    assert!(run.success, "{run:?}");
-    assert!(run.stdout.contains("  [0] at (0.5, 0.5, 3)"), "{}", run.stdout);
+    let (json, _) = summary(&["info", path_str(&helmet)]);
+    let texture = &json["textures"][0];
+    assert_eq!(texture["name"], "image 0 from 'Default_albedo.jpg'", "{json}");
+    assert_eq!((&texture["width"], &texture["height"]), (&2048.into(), &2048.into()));
+    let (json, _) = summary(&["info", path_str(&cameras)]);
+    assert_eq!(json["cameras"][0]["position"], serde_json::json!([0.5, 0.5, 3.0]), "{json}");
+    let (json, stderr) = summary(&["info", path_str(&transmission)]);
+    assert_eq!(json["extensions_unsupported"], serde_json::json!(["KHR_xmp"]), "{json}");
+    assert_eq!(json["warnings"].as_array().unwrap().iter().filter(|w| w.to_string().contains("KHR_xmp")).count(), 1);
+    assert_eq!(stderr.matches("KHR_xmp is not supported").count(), 1, "warned once: {stderr}");
+    // The text marks it.
     let run = rtgi(&["info", path_str(&transmission)]);
-    assert!(run.success, "{run:?}");
-    let said = format!("{}{}", run.stdout, run.stderr);
-    assert_eq!(said.matches("KHR_xmp is not supported").count(), 1, "{said}");
     assert!(run.stdout.contains("KHR_xmp (ignored)"), "{}", run.stdout);
 }
 
@@ -200,8 +233,9 @@ fn info_says_why_it_counts_more_vertices_than_positions() {
         "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 1\nvn 0 0 1\nvn 0 1 0\nf 1//1 2//1 3//1\nf 2//2 4//2 3//2\n",
     )
     .unwrap();
+    let (json, _) = summary(&["info", path_str(&obj)]);
+    assert_eq!((&json["vertices"], &json["positions"]), (&6.into(), &4.into()), "{json}");
     let run = rtgi(&["info", path_str(&obj)]);
-    assert!(run.success, "{run:?}");
     assert!(
         run.stdout.contains("vertices    6 (4 distinct positions: corners at one position are split"),
         "{}",
@@ -237,15 +271,21 @@ fn of_two_file_cameras_the_one_that_sees_the_model_is_used_at_its_aspect_ratio()
     let dir = scratch_dir("two-cameras");
     let scene = two_camera_gltf(&dir);
     let out = dir.join("two.png");
-    let run = rtgi(&["render", path_str(&scene), "-o", path_str(&out), "--spp", "1"]);
-    assert!(run.success, "{run:?}");
-    // (The loader numbers the cameras in its own order of the nodes.)
-    assert!(run.stderr.contains("of the file's 2 (0 to 1), the one that sees most of the model (100% of"), "{run:?}");
+    let (json, stderr) = summary(&["render", path_str(&scene), "-o", path_str(&out), "--spp", "1"]);
+    let camera = &json["camera"];
+    // (The loader numbers the cameras in its own order of the nodes: the one facing the model is 0.)
+    assert_eq!((&camera["source"], &camera["index"], &camera["file_cameras"]), (&"file".into(), &0.into(), &2.into()));
+    assert!(camera["direction"][2].as_f64().is_some_and(|z| z < 0.0), "it looks at the model, along -Z: {json}");
+    assert!(camera["file_choice"].as_str().is_some_and(|c| c.contains("the one that sees most")), "{json}");
+    assert!(stderr.contains("of the file's 2 (0 to 1), the one that sees most of the model (100% of"), "{stderr}");
     // 512 wide, as tall as the camera's aspect ratio of 1.5 asks.
+    assert_eq!((&json["render"]["width"], &json["render"]["height"]), (&512.into(), &341.into()));
     assert_eq!(image::image_dimensions(&out).unwrap(), (512, 341));
     // A size given wins; an index given needs no note.
-    let run = rtgi(&["render", path_str(&scene), "-o", path_str(&out), "--spp", "1", "--camera", "0", "--width", "64"]);
-    assert!(run.success && !run.stderr.contains("note: the view is"), "{run:?}");
+    let (json, stderr) =
+        summary(&["render", path_str(&scene), "-o", path_str(&out), "--spp", "1", "--camera", "0", "--width", "64"]);
+    assert_eq!((&json["camera"]["index"], &json["camera"]["file_choice"]), (&0.into(), &serde_json::Value::Null));
+    assert!(!stderr.contains("note: the view is"), "{stderr}");
     assert_eq!(image::image_dimensions(&out).unwrap(), (64, 512));
 }
 
@@ -262,17 +302,23 @@ fn the_automatic_view_says_which_view_it_took_and_a_given_one_does_not() {
         let mut args = vec!["render", path_str(&model), "-o", path_str(&out), "--width", "24", "--height", "24"];
         args.extend(["--spp", "1"]);
         args.extend(extra);
-        rtgi(&args)
+        summary(&args)
     };
-    let run = render(&[]);
-    assert!(run.success, "{run:?}");
-    let note = "note: the automatic view is a three-quarter shot of the model's front, from +Z and above; --at (and \
-                --look) choose another";
-    assert!(run.stderr.contains(note), "{run:?}");
+    let (json, stderr) = render(&[]);
+    assert_eq!(json["camera"]["source"], "automatic", "{json}");
+    let view = "a three-quarter shot of the model's front, from +Z and above";
+    assert_eq!(json["camera"]["automatic_view"], view, "{json}");
+    assert!(
+        stderr.contains(&format!("note: the automatic view is {view}; --at (and --look) choose another")),
+        "{stderr}"
+    );
     // A field of view keeps the automatic view; a position or a target replaces it.
-    assert!(render(&["--fov", "30"]).stderr.contains(note));
+    let (json, _) = render(&["--fov", "30"]);
+    assert_eq!((&json["camera"]["source"], &json["camera"]["automatic_view"]), (&"automatic".into(), &view.into()));
+    assert!((json["camera"]["vertical_fov_degrees"].as_f64().unwrap() - 30.0).abs() < 1e-4, "{json}");
     for given in [&["--at", "2,2,2"][..], &["--look", "0,0.2,0"][..]] {
-        let run = render(given);
-        assert!(run.success && !run.stderr.contains("automatic view"), "{given:?}: {run:?}");
+        let (json, stderr) = render(given);
+        assert_eq!(json["camera"]["source"], "options", "{given:?}: {json}");
+        assert!(json["camera"]["automatic_view"].is_null() && !stderr.contains("automatic view"), "{given:?}");
     }
 }

@@ -631,6 +631,11 @@ pub(crate) struct RenderArgs {
 
     #[command(flatten)]
     pub(crate) job: crate::render_job::JobArgs,
+
+    /// Print the summary as JSON (the plan, the camera and how it was chosen, the exposure, the
+    /// times and the files written) instead of text; warnings and notes still go to standard error
+    #[arg(long)]
+    pub(crate) json: bool,
 }
 
 impl RenderArgs {

@@ -19,6 +19,7 @@ mod progress;
 mod rays_cmd;
 mod render_cmd;
 mod render_job;
+mod render_summary;
 mod script;
 mod trace_cmd;
 mod verify_cmd;

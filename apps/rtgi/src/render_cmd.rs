@@ -19,6 +19,10 @@ use crate::interrupt;
 use crate::output::{out, outln};
 use crate::progress::Progress;
 use crate::render_job::{Ending, Renderer, ResumeOfAnotherRender, StoppedBySignal, Totals, run_passes};
+use crate::render_summary::{
+    AdaptiveSummary, BuildSummary, CameraSummary, ExposureSummary, LegibilitySummary, OutputSummary, PartSummary,
+    PassesSummary, RenderSummary, SceneSummary,
+};
 
 /// Extension of accumulation files: checkpoints and the parts of split renders.
 pub(crate) const ACCUMULATION_EXTENSION: &str = "accum";
@@ -195,6 +199,13 @@ pub(crate) fn render_given(args: &RenderArgs, given: Option<Given<'_>>) -> Resul
             (Structure::Committed(committed), view)
         }
     };
+    let camera_choice = args.camera.choice();
+    let camera_summary = CameraSummary::new(
+        &prepared.camera,
+        camera_choice.index,
+        camera_choice.at.is_some() || camera_choice.look.is_some(),
+        scene.cameras.len(),
+    );
     let (camera, room_light) = (prepared.camera.camera, prepared.room_light);
     // A file camera's aspect ratio shapes the image unless its size was given.
     if let Some(aspect) = camera.aspect.filter(|&a| a.is_finite() && a > 0.0 && !args.size.given()) {
@@ -211,13 +222,18 @@ pub(crate) fn render_given(args: &RenderArgs, given: Option<Given<'_>>) -> Resul
     if args.lighting.filter_glossy.is_none() && denoising {
         settings.filter_glossy = Some(PREVIEW_FILTER_GLOSSY);
     }
-    let mut printed = out!("{}", EffectPlan::new(&scene, &settings));
+    // With --json the prose is left out and the summary printed at the end.
+    let prose = !args.json;
+    let plan = EffectPlan::new(&scene, &settings);
+    let mut printed = if prose { out!("{plan}") } else { Ok(()) };
     macro_rules! say {
         ($($arg:tt)*) => {
-            printed = printed.and_then(|()| outln!($($arg)*))
+            if prose {
+                printed = printed.and_then(|()| outln!($($arg)*))
+            }
         };
     }
-    if let Some(light) = room_light {
+    if let Some(light) = &room_light {
         let p = light.position;
         say!(
             "  note: the camera is enclosed by the scene (no sky reaches it) and nothing emits light, so a lamp \
@@ -235,7 +251,7 @@ pub(crate) fn render_given(args: &RenderArgs, given: Option<Given<'_>>) -> Resul
             let mut rounds_printed = Ok(());
             let (image, outcome) = pool.install(|| {
                 render_adaptive(&scene, accel.as_ref(), &camera, &settings, &mut |round| {
-                    if rounds_printed.is_ok() {
+                    if prose && rounds_printed.is_ok() {
                         rounds_printed = outln!(
                             "round       {} samples per pixel: {} pixels rendered, {} of {} within the noise target, \
                              {:.0} ms",
@@ -262,6 +278,7 @@ pub(crate) fn render_given(args: &RenderArgs, given: Option<Given<'_>>) -> Resul
         }
     };
     let (ending, totals) = rendered.ending_and_totals();
+    let mut outputs = Vec::new();
     let done = rendered.samples_done();
     if let Done::Progressive((accumulation, ..)) = &rendered
         && let Some(path) = job.checkpoint_path()
@@ -269,6 +286,11 @@ pub(crate) fn render_given(args: &RenderArgs, given: Option<Given<'_>>) -> Resul
     {
         accumulation.write(path)?;
         say!("checkpoint  {} ({} of {} samples per pixel)", path.display(), accumulation.samples().end, samples.end);
+        outputs.push(OutputSummary {
+            path: path.display().to_string(),
+            kind: "checkpoint".into(),
+            samples_per_pixel: accumulation.samples_done(),
+        });
     }
     let simulates_light = settings.integrator.simulates_light();
     let image = match &rendered {
@@ -310,6 +332,11 @@ pub(crate) fn render_given(args: &RenderArgs, given: Option<Given<'_>>) -> Resul
             let aov_settings = RenderSettings { integrator: *kind, ..settings.clone() };
             let (aov, _) = pool.install(|| render(&scene, accel.as_ref(), &camera, &aov_settings, &|_| {}));
             aov.write(path, &tone_map)?;
+            outputs.push(OutputSummary {
+                path: path.display().to_string(),
+                kind: kind.to_string(),
+                samples_per_pixel: aov_settings.samples_per_pixel,
+            });
         }
     }
 
@@ -354,6 +381,13 @@ pub(crate) fn render_given(args: &RenderArgs, given: Option<Given<'_>>) -> Resul
     }
     let rays_per_second = totals.rays as f64 / totals.render_seconds.max(1e-9);
     say!("rays        {} ({:.3} Mrays/s)", totals.rays, rays_per_second * 1e-6);
+    let adaptive_summary = match &rendered {
+        Done::Progressive(_) => None,
+        Done::Adapted(_, outcome) => Some(AdaptiveSummary {
+            fewest_samples: outcome.samples.iter().copied().min().unwrap_or(0),
+            mean_samples: outcome.total_samples() as f64 / outcome.samples.len().max(1) as f64,
+        }),
+    };
     let stopped_by = match ending {
         Ending::Complete => None,
         Ending::TimeLimit => Some(format!("the time limit ({} s)", job.time_limit.unwrap_or_default())),
@@ -362,6 +396,7 @@ pub(crate) fn render_given(args: &RenderArgs, given: Option<Given<'_>>) -> Resul
     if let Some(reason) = &stopped_by {
         say!("stopped     by {reason} with {done} of {} samples per pixel", samples.end);
     }
+    let (mut exposure, mut looks) = (None, None);
     if wrote_output {
         let partial = if matches!(rendered, Done::Progressive(_)) && done < samples.len() as u32 {
             format!(" ({done} samples per pixel)")
@@ -369,13 +404,19 @@ pub(crate) fn render_given(args: &RenderArgs, given: Option<Given<'_>>) -> Resul
             String::new()
         };
         say!("wrote       {}{partial}", output.display());
+        let kind = if is_accumulation(&output) { "accumulation" } else { "image" };
+        outputs.insert(
+            0,
+            OutputSummary { path: output.display().to_string(), kind: kind.into(), samples_per_pixel: done },
+        );
         if OutputFormat::from_path(&output).is_ok_and(|f| f == OutputFormat::Png) {
             let how = if args.tone.exposure.is_some() { "--exposure" } else { "automatic; --exposure sets it" };
             say!("exposure    {:+.1} stops ({how}), {} tone map", tone_map.exposure, tone_map.operator);
+            exposure = Some(ExposureSummary::new(&tone_map, args.tone.exposure.is_none()));
         }
         if let Some(image) = &image {
             let phrasing = if from_script { Phrasing::Script } else { Phrasing::Options };
-            warn_if_illegible(image, &tone_map, args.tone.exposure.is_some(), phrasing);
+            looks = warn_if_illegible(image, &tone_map, args.tone.exposure.is_some(), phrasing);
         }
     } else {
         say!("wrote       nothing: no sample finished");
@@ -386,6 +427,37 @@ pub(crate) fn render_given(args: &RenderArgs, given: Option<Given<'_>>) -> Resul
         }
     } else if !aov_outputs.is_empty() {
         say!("skipped     the AOVs (they are written when the render completes)");
+    }
+    if args.json {
+        let summary = RenderSummary {
+            scene: SceneSummary { name: scene_name.clone(), triangles: scene.triangles.len(), load_ms },
+            plan,
+            camera: camera_summary,
+            room_light: room_light.as_ref().map(|light| light.position.to_array()),
+            build: BuildSummary { variant: build.variant.to_string(), ms: build.build_ms },
+            render: PassesSummary {
+                ms: totals.render_seconds * 1e3,
+                width: settings.width,
+                height: settings.height,
+                samples_per_pixel: spp,
+                samples_done: done,
+                sampler: settings.sampler.to_string(),
+                threads: pool.current_num_threads(),
+                passes: totals.passes,
+                rays: totals.rays,
+                mrays_per_second: rays_per_second * 1e-6,
+                adaptive: adaptive_summary,
+            },
+            denoise_ms,
+            exposure,
+            legibility: looks.map(LegibilitySummary::new),
+            part: job
+                .is_part()
+                .then_some(PartSummary { rows: [rows.start, rows.end], samples: [samples.start, samples.end] }),
+            stopped_by: stopped_by.clone(),
+            outputs,
+        };
+        printed = printed.and_then(|()| outln!("{}", serde_json::to_string_pretty(&summary)?));
     }
     match ending {
         Ending::Signal(signal) => Err(StoppedBySignal(signal).into()),
@@ -470,7 +542,7 @@ fn render_progressively(
                 ))
                 .into());
             }
-            if printed.is_ok() {
+            if !args.json && printed.is_ok() {
                 *printed = outln!(
                     "resuming   {} at {} of {} samples per pixel",
                     resume.display(),
@@ -544,8 +616,15 @@ fn adaptive_summary(args: &RenderArgs, outcome: &AdaptiveOutcome, spp: u32, samp
 
 /// Says so when the image came out almost black or almost white, with the
 /// options that help.
-fn warn_if_illegible(image: &HdrImage, tone_map: &ToneMap, exposure_given: bool, phrasing: Phrasing) {
-    match legibility(image, tone_map) {
+/// Warns when the image looks almost black or almost white, and says which.
+fn warn_if_illegible(
+    image: &HdrImage,
+    tone_map: &ToneMap,
+    exposure_given: bool,
+    phrasing: Phrasing,
+) -> Option<Legibility> {
+    let looks = legibility(image, tone_map);
+    match looks {
         Some(Legibility::AlmostBlack(fraction)) => {
             // A script's images are not exposed (as the course's are not).
             let exposure = if exposure_given && phrasing == Phrasing::Options { "raise --exposure, or " } else { "" };
@@ -568,6 +647,7 @@ fn warn_if_illegible(image: &HdrImage, tone_map: &ToneMap, exposure_given: bool,
         }
         None => {}
     }
+    looks
 }
 
 /// The exposure and tone map of an image's PNG ([`recipe::tone_map`]).
