@@ -24,18 +24,61 @@ pub fn shared_scenes() -> PathBuf {
 }
 
 /// The path of a shared scene file, or `None` after saying why the calling
-/// test skips.
+/// test skips ([`skip_without`]: a failure where `RTGI_REQUIRE_SCENES` is set).
 pub fn shared_scene(relative: &str) -> Option<PathBuf> {
     let path = shared_scenes().join(relative);
     if path.is_file() {
         Some(path)
     } else {
-        eprintln!(
-            "skipping: shared scene {} not found (set {SCENES_VARIABLE} to the folder of shared scenes)",
-            path.display()
+        skip_without(
+            Requirement::Scenes,
+            &format!(
+                "shared scene {} not found (set {SCENES_VARIABLE} to the folder of shared scenes)",
+                path.display()
+            ),
         );
         None
     }
+}
+
+/// What some tests need of the machine beyond the workspace, which a
+/// developer's machine may lack and CI must have.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Requirement {
+    /// The shared third-party scenes ([`shared_scenes`]).
+    Scenes,
+    /// A real Slurm (Debian's `slurm-wlm` and `munge`, and root).
+    Slurm,
+    /// Intel Embree 3 (`libembree-dev`) and a build with the `embree` feature.
+    Embree,
+}
+
+impl Requirement {
+    /// The environment variable that turns a skip for want of this into a failure.
+    pub fn variable(self) -> &'static str {
+        match self {
+            Requirement::Scenes => "RTGI_REQUIRE_SCENES",
+            Requirement::Slurm => "RTGI_REQUIRE_SLURM",
+            Requirement::Embree => "RTGI_REQUIRE_EMBREE",
+        }
+    }
+
+    /// Whether a skip for want of this fails the test (the variable is set,
+    /// to anything but `0` or nothing).
+    pub fn required(self) -> bool {
+        std::env::var_os(self.variable()).is_some_and(|v| !v.is_empty() && v != "0")
+    }
+}
+
+/// Says on standard error why the calling test skips, for want of
+/// `requirement`; panics with that reason instead where the requirement's
+/// variable is set (CI sets them all), so that a green run cannot mean
+/// "nothing real was tried". The caller returns after it.
+pub fn skip_without(requirement: Requirement, why: &str) {
+    if requirement.required() {
+        panic!("{why}; {} is set, so this skip is a failure", requirement.variable());
+    }
+    eprintln!("skipping: {why} ({} makes this a failure)", requirement.variable());
 }
 
 /// Side of the renders compared with the Cornell box reference,
@@ -178,4 +221,28 @@ pub fn for_every_variant(
         );
         check(&label, accel.as_ref(), &params);
     }
+}
+
+/// Where `accel` answers `rays` otherwise than the linear scan with the
+/// same intersector does, bit for bit (closest hit: triangle, `t`, `beta`,
+/// `gamma`; any hit), one line per difference, labelled with `label`.
+pub fn differences_from_linear_scan(
+    label: &str,
+    accel: &dyn rtgi_accel::Accel,
+    reference: &rtgi_accel::LinearScan,
+    rays: &[rtgi_math::Ray],
+) -> Vec<String> {
+    use rtgi_accel::Accel as _;
+    let mut differences = Vec::new();
+    for ray in rays {
+        let (got, expected) = (accel.intersect(ray), reference.intersect(ray));
+        if !rtgi_accel::verify::same_hit(got, expected) {
+            differences.push(format!("{label}: closest hit {got:?}, the linear scan's {expected:?}, for {ray:?}"));
+        }
+        let (got, expected) = (accel.occluded(ray), reference.occluded(ray));
+        if got != expected {
+            differences.push(format!("{label}: occluded {got}, the linear scan's {expected}, for {ray:?}"));
+        }
+    }
+    differences
 }

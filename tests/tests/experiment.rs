@@ -62,7 +62,10 @@ fn every_knob_writes_its_table_json_and_plots() {
         let build = &json["build"];
         assert!(build["commit"].as_str().is_some_and(|c| c.len() >= 7), "{json}");
         assert!(build["rustc"].as_str().is_some_and(|c| c.starts_with("rustc")), "{build}");
-        assert!(build["profile"].as_str().is_some() && build["dirty"].is_null() || build["dirty"].is_string());
+        assert!(build["profile"].as_str().is_some_and(|p| !p.is_empty()), "{build}");
+        // Clean, or dirty with the 16 hex digits of the difference's hash.
+        let dirty_hash = |d: &str| d.len() == 16 && d.bytes().all(|b| b.is_ascii_hexdigit());
+        assert!(build["dirty"].is_null() || build["dirty"].as_str().is_some_and(dirty_hash), "{build}");
         assert!(json["date"].as_str().is_some_and(|d| d.starts_with("20") && d.ends_with('Z')), "{}", json["date"]);
         commits.insert(build["commit"].as_str().unwrap().to_owned());
         assert!(json["command"].as_str().is_some_and(|c| c.contains("experiment all")), "{}", json["command"]);

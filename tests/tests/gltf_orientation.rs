@@ -93,7 +93,10 @@ fn rendered_silhouette(scene: &Scene, width: u32, height: u32) -> Option<Silhoue
 fn every_glb_and_gltf_model_faces_as_in_its_screenshot() {
     let root = shared_scenes().join("gltf");
     let Ok(models) = std::fs::read_dir(&root) else {
-        eprintln!("skipped: {} not found (set RTGI_SCENES)", root.display());
+        rtgi_tests::skip_without(
+            rtgi_tests::Requirement::Scenes,
+            &format!("{} not found (set {})", root.display(), rtgi_tests::SCENES_VARIABLE),
+        );
         return;
     };
     let mut compared = 0;

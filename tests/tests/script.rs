@@ -473,7 +473,10 @@ fn the_course_stage_scripts_run_on_the_shared_scenes() {
     if !scenes.join("cornell-box/CornellBox-Original.obj").is_file()
         || !scenes.join("sponza-dabrovic/sponza.obj").is_file()
     {
-        eprintln!("skipping: the shared scenes are not at {} (set RTGI_SCENES)", scenes.display());
+        rtgi_tests::skip_without(
+            rtgi_tests::Requirement::Scenes,
+            &format!("the shared scenes are not at {} (set {})", scenes.display(), rtgi_tests::SCENES_VARIABLE),
+        );
         return;
     }
     let dir = scratch_dir("script-stages");

@@ -7,7 +7,7 @@
 //! render is stopped ahead of the limit with its checkpoint saved.
 //!
 //! Needs Debian's `slurm-wlm` and `munge` and root; says so and passes
-//! otherwise, as the Embree tests do.
+//! otherwise, and fails where `RTGI_REQUIRE_SLURM` is set (as CI sets it).
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -43,7 +43,10 @@ impl Cluster {
             .unwrap()
             .into();
         if run.code == Some(3) {
-            eprintln!("skipped: no Slurm to test on ({}); apt-get install slurm-wlm munge", run.stderr.trim());
+            rtgi_tests::skip_without(
+                rtgi_tests::Requirement::Slurm,
+                &format!("no Slurm to test on ({}); apt-get install slurm-wlm munge", run.stderr.trim()),
+            );
             return None;
         }
         assert!(run.success, "the local Slurm did not start: {run:?}");
