@@ -13,10 +13,15 @@
 # machine's drift falls on all of them alike; each cell is the median of
 # the runs (min-max), and the ratio is to the shipped profile's median.
 # Writes docs/release-profiles.md (every run listed under its table, which
-# tests/release_profiles_doc.rs checks) and the table into the README
+# tests/tests/workspace/release_profiles_doc.rs checks) and the table into the README
 # between its release-profiles markers.
 #
 #   benches/release-profiles.sh [--runs N] [LTO:CGU ...]
+#   benches/release-profiles.sh --tabulate
+#
+# --tabulate measures nothing: it writes the table again from the runs
+# recorded in docs/release-profiles.md (after a change to how the table is
+# made, say), keeping the document's account of when and where they ran.
 #
 # The default configurations vary one knob at a time around the shipped
 # thin:4, and add off:16, the fastest to build. A run takes about 40
@@ -25,6 +30,11 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 
 runs=5
+tabulate=no
+if [[ "${1:-}" == "--tabulate" ]]; then
+    tabulate=yes
+    shift
+fi
 if [[ "${1:-}" == "--runs" ]]; then
     runs="${2:?--runs needs a number}"
     shift 2
@@ -39,13 +49,25 @@ shipped_cgu="$(sed -n '/^\[profile.release\]/,/^\[/s/^codegen-units = \([0-9]*\)
 shipped="$shipped_lto:$shipped_cgu"
 [[ " ${configs[*]} " == *" $shipped "* ]] || configs=("$shipped" "${configs[@]}")
 
+declare -A clean relink trace_runs render_runs
+if [[ "$tabulate" == yes ]]; then
+    configs=()
+    while read -r config _ build_clean build_relink _ rest; do
+        configs+=("$config")
+        clean[$config]="$build_clean" relink[$config]="$build_relink"
+        trace_runs[$config]="${rest%% render: *}" render_runs[$config]="${rest##* render: }"
+    done < <(sed -n '/^```text$/,/^```$/{/ build: /p}' docs/release-profiles.md)
+    [[ ${#configs[@]} -gt 0 ]] || { echo "release-profiles: no runs in docs/release-profiles.md" >&2; exit 1; }
+    runs="$(wc -w <<<"${trace_runs[${configs[0]}]}")"
+fi
+
 shared="${RTGI_SCENES:-$PWD/../shared/scenes}"
 bunny="$shared/bunny/stanford-bunny.obj"
 cornell="$shared/cornell-box/CornellBox-Original.obj"
 for scene in "$bunny" "$cornell"; do
     [[ -f "$scene" ]] || { echo "release-profiles: no scene at $scene (set RTGI_SCENES)" >&2; exit 1; }
 done
-if [[ -n "$(git status --porcelain -- crates apps Cargo.toml Cargo.lock)" ]]; then
+if [[ "$tabulate" == no && -n "$(git status --porcelain -- crates apps Cargo.toml Cargo.lock)" ]]; then
     echo "release-profiles: the sources have uncommitted changes; commit them so that the table names its code" >&2
     exit 1
 fi
@@ -64,8 +86,8 @@ build() { # LTO CGU DIR
         cargo build --release --locked --quiet -p rtgi --bin rtgi
 }
 
-declare -A clean relink
 for config in "${configs[@]}"; do
+    [[ "$tabulate" == yes ]] && break
     lto="${config%%:*}" cgu="${config##*:}"
     dir="target/profiles/$lto-$cgu"
     rm -rf "$dir"
@@ -78,9 +100,10 @@ for config in "${configs[@]}"; do
     echo "  ${clean[$config]} s from clean, ${relink[$config]} s after touching crates/render/src/lib.rs" >&2
 done
 
-"$scratch/rtgi-${shipped/:/-}" rays "$bunny" --kind surface --count 1000000 -o "$scratch/bunny.rays" >/dev/null
-declare -A trace_runs render_runs
+[[ "$tabulate" == yes ]] ||
+    "$scratch/rtgi-${shipped/:/-}" rays "$bunny" --kind surface --count 1000000 -o "$scratch/bunny.rays" >/dev/null
 for ((run = 1; run <= runs; run++)); do
+    [[ "$tabulate" == yes ]] && break
     echo "run $run of $runs ..." >&2
     for config in "${configs[@]}"; do
         rtgi="$scratch/rtgi-${config/:/-}"
@@ -98,10 +121,12 @@ for ((run = 1; run <= runs; run++)); do
 done
 
 median() { printf '%s\n' "$@" | sort -g | awk '{ v[NR] = $1 } END { print v[int((NR + 1) / 2)] }'; }
-cell() { # RUNS...: "median (min-max)"
+cell() { # RUNS...: "median (min-max)", rounded by awk in double precision (bash's printf
+    # rounds in long double: 1.675 to 1.67, where a double's 1.675 rounds to 1.68)
     local sorted
     sorted="$(printf '%s\n' "$@" | sort -g)"
-    printf '%.2f (%.2f–%.2f)' "$(median "$@")" "$(head -n 1 <<<"$sorted")" "$(tail -n 1 <<<"$sorted")"
+    awk -v m="$(median "$@")" -v lo="$(head -n 1 <<<"$sorted")" -v hi="$(tail -n 1 <<<"$sorted")" \
+        'BEGIN { printf "%.2f (%.2f–%.2f)", m, lo, hi }'
 }
 ratio() { awk -v a="$1" -v b="$2" 'BEGIN { printf "%.2f×", a / b }'; }
 
@@ -119,13 +144,19 @@ done
 
 commit="$(git rev-parse --short=10 HEAD)"
 cpu="$(sed -n 's/^model name[[:space:]]*: //p' /proc/cpuinfo | head -n 1)"
+if [[ "$tabulate" == yes ]]; then
+    # The account of the runs, as measured.
+    header="$(sed -n '1,/^| LTO /{/^| LTO /!p}' docs/release-profiles.md)"
+else
+    header="# The release profile, measured
+
+Written by \`benches/release-profiles.sh\` on $(date -u +%Y-%m-%d) at $commit, on $(nproc) cores of an $cpu,
+$runs runs of each rate, the binaries taking turns. Builds are one each, \`cargo build --release -p rtgi\`
+in a target directory of its own; a rebuild follows \`touch crates/render/src/lib.rs\`.
+Rates are medians (min–max); ratios are to the shipped profile's medians."
+fi
 {
-    echo "# The release profile, measured"
-    echo
-    echo "Written by \`benches/release-profiles.sh\` on $(date -u +%Y-%m-%d) at $commit, on $(nproc) cores of an $cpu,"
-    echo "$runs runs of each rate, the binaries taking turns. Builds are one each, \`cargo build --release -p rtgi\`"
-    echo "in a target directory of its own; a rebuild follows \`touch crates/render/src/lib.rs\`."
-    echo "Rates are medians (min–max); ratios are to the shipped profile's medians."
+    echo "$header"
     echo
     echo "$table"
     echo

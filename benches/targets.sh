@@ -8,7 +8,7 @@
 #   (camera rays one at a time and in batches of 16, incoherent rays, the
 #   wide build), 2 threads, its medians of 15 alternating runs; skipped, with
 #   a message, where Embree 3 is not installed (apt install libembree-dev);
-# - cut-outs: the voxel world of tests/cutouts.rs, rendered and traced with
+# - cut-outs: the voxel world of tests/tests/render/cutouts.rs, rendered and traced with
 #   the alpha test and with it off (--effects=-alpha, --no-alpha), in turn;
 # - interiors: default renders of Sponza and the conference room against
 #   the build the issue measured (--baseline, 90894cd), by
@@ -16,7 +16,7 @@
 # - the Cornell box path traced at 256x256, 1024 spp, depth 64.
 #
 # It takes about 15 minutes on 2 cores; run it on an otherwise idle machine.
-# tests/tests/targets_doc.rs checks that the table agrees with the runs.
+# tests/tests/workspace/targets_doc.rs checks that the table agrees with the runs.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -195,7 +195,7 @@ cpu="$(sed -n 's/^model name[[:space:]]*: //p' /proc/cpuinfo | head -n 1)"
 {
     echo "# Issue 24's performance targets, measured"
     echo
-    echo "<!-- written by benches/targets.sh; tests/tests/targets_doc.rs checks the table against the runs below -->"
+    echo "<!-- written by benches/targets.sh; tests/tests/workspace/targets_doc.rs checks the table against the runs below -->"
     echo "Measured from $started to $(date -u +%Y-%m-%dT%H:%M:%SZ) on ${cpu:-an unknown CPU} ($(nproc) cores), 2 threads, at commit $commit, by \`benches/targets.sh --runs $runs --baseline $baseline\`."
     echo "Figures are medians: of the runs below, and for the rows against Embree of the \`peers\` example's 15 alternating runs, whose medians are the runs listed."
     [[ "$embree" == yes ]] || echo "Embree 3 was not installed, so the rows against it were not measured."

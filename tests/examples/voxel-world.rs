@@ -1,4 +1,4 @@
-//! Writes the voxel world of `tests/cutouts.rs` (OBJ, MTL and a PNG atlas)
+//! Writes the voxel world of `tests/tests/render/cutouts.rs` (OBJ, MTL and a PNG atlas)
 //! into a folder: `voxel-world DIR [SIDE]`, SIDE columns a side (48 by
 //! default, as in the test).
 

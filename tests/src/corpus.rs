@@ -1,5 +1,5 @@
 //! The fixed corpus of mutated scene files (`tests/corpus/`) that
-//! `tests/loader_corpus.rs` loads, and the files its scenes may reference.
+//! `tests/tests/scene/loader_corpus.rs` loads, and the files its scenes may reference.
 //! The fuzz targets (`fuzz/`) give the same answers to references.
 
 use std::path::PathBuf;

@@ -1,6 +1,7 @@
 //! Helpers shared by the end-to-end tests: finding the shared scenes,
 //! running the CLI, scratch folders.
 
+pub mod convergence;
 pub mod corpus;
 pub mod voxel_world;
 
@@ -86,7 +87,7 @@ pub fn skip_without(requirement: Requirement, why: &str) {
 pub const CORNELL_SIZE: u32 = 64;
 
 /// The shared Cornell box path traced as its reference was
-/// (`tests/cornell_reference.rs`): `CORNELL_SIZE` square, framed as
+/// (`tests/tests/render/cornell_reference.rs`): `CORNELL_SIZE` square, framed as
 /// `rtgi render` frames a scene without a camera (40° field of view),
 /// default settings otherwise.
 pub fn render_cornell_box(
@@ -113,8 +114,13 @@ pub fn render_cornell_box(
 /// passes and kept (its path printed) when it fails, for a look at what the
 /// failing run wrote, or when `RTGI_KEEP_SCRATCH` is set (to measure or
 /// profile on the scenes a test builds).
+///
+/// The folder is this process's own and this call's own: tests of one
+/// binary run side by side, and two may choose the same name.
 pub fn scratch_dir(test: &str) -> ScratchDir {
-    let dir = std::env::temp_dir().join(format!("rtgi-tests-{}-{test}", std::process::id()));
+    static CALLS: std::sync::atomic::AtomicU32 = std::sync::atomic::AtomicU32::new(0);
+    let call = CALLS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+    let dir = std::env::temp_dir().join(format!("rtgi-tests-{}-{call}-{test}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
     std::fs::create_dir_all(&dir).expect("cannot create a scratch folder");
     ScratchDir(dir)

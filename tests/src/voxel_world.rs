@@ -1,5 +1,5 @@
 //! A voxel world with cut-outs, written as OBJ + MTL + PNG: the scene of
-//! issue 24's cut-out target, generated rather than stored. `tests/cutouts.rs`
+//! issue 24's cut-out target, generated rather than stored. `tests/tests/render/cutouts.rs`
 //! times it, and `cargo run --release -p rtgi-tests --example voxel-world`
 //! writes it for `benches/targets.sh` and for anyone who wants to look.
 

@@ -3,7 +3,7 @@
 //! the white furnace (inside a closed sphere whose walls reflect `ρ` and
 //! emit `Le`, every pixel converges to `Le / (1 − ρ)`).
 //!
-//! `tests/light_transport.rs` checks the renderer against them, and the
+//! `tests/tests/render/light_transport.rs` checks the renderer against them, and the
 //! `analytic` knob reports each estimator's bias against them.
 
 use rtgi_math::Vec3;

@@ -41,7 +41,7 @@ fn subject_kind(subject: &Subject) -> Result<AccelKind, ExperimentError> {
 }
 
 /// Squares whose shared diagonal the rays cross exactly, as in
-/// `tests/hard_cases.rs`: at the origin, 2^20 and 2^24 away, and tiny;
+/// `tests/tests/accel/hard_cases.rs`: at the origin, 2^20 and 2^24 away, and tiny;
 /// `(size, offset, bits)` with the grid `size / 2^bits` no finer than the
 /// coordinates' ulp, so that every ray's aim is exact.
 const SHARED_EDGES: [(f32, f32, u32); 4] =

@@ -5,7 +5,7 @@
 //!
 //! ```sh
 //! cargo run --release -p rtgi -- experiment all --out docs/experiments
-//! RTGI_BLESS=1 cargo test -p rtgi-tests --test experiment_index   # the README's summary
+//! RTGI_BLESS=1 cargo test -p rtgi-tests --test workspace experiment_index   # the README's summary
 //! ```
 
 use std::path::{Path, PathBuf};
@@ -52,7 +52,7 @@ fn the_readme_summary_is_the_json() {
     assert!(
         readme[start..end] == generated,
         "the README's summary of the experiments differs from docs/experiments/*.json; rewrite it with \
-         RTGI_BLESS=1 cargo test -p rtgi-tests --test experiment_index"
+         RTGI_BLESS=1 cargo test -p rtgi-tests --test workspace experiment_index"
     );
 }
 

@@ -3,7 +3,7 @@
 //! them, plus inputs the fuzzers found) loads to `Ok` or a clean `Err`,
 //! never a panic.
 //!
-//! `cargo test -p rtgi-tests --test loader_corpus -- --ignored` rewrites the
+//! `cargo test -p rtgi-tests --test scene loader_corpus -- --ignored` rewrites the
 //! seeds and mutations (`seed-*`, `mut-*`); other files (`crash-*`) are kept.
 
 use std::panic::{AssertUnwindSafe, catch_unwind};

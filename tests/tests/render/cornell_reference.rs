@@ -7,7 +7,7 @@
 //! the light transport, regenerate it with
 //!
 //! ```text
-//! RTGI_BLESS=1 cargo test --release -p rtgi-tests --test cornell_reference
+//! RTGI_BLESS=1 cargo test --release -p rtgi-tests --test render cornell_reference
 //! ```
 //!
 //! and look at it (and at a full-size render) before committing.

@@ -4,7 +4,7 @@
 //!
 //! The references were rendered by rtgi and looked at; after an intended
 //! change of the images, regenerate them with
-//! `RTGI_BLESS=1 cargo test -p rtgi-tests --test gltf_references` and look
+//! `RTGI_BLESS=1 cargo test -p rtgi-tests --test scene gltf_references` and look
 //! at them again before committing.
 
 use rtgi_accel::{AccelKind, BuildParams};

@@ -1,0 +1,13 @@
+//! The workspace around the code: deployment scripts (on a real Slurm),
+//! the experiments and their report, the generated docs' tables, and a
+//! build that does nothing when nothing changed.
+//!
+//! One test binary for the theme, a module a file.
+
+mod deploy;
+mod experiment;
+mod experiment_index;
+mod noop_build;
+mod release_profiles_doc;
+mod slurm_cluster;
+mod targets_doc;
