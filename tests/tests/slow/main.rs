@@ -1,5 +1,5 @@
 //! Statistical tests too slow for every `cargo test`, which CI runs by
-//! name: `cargo test -p rtgi-tests --test slow` (a few minutes in the
+//! name: `cargo test --workspace --test slow` (a few minutes in the
 //! debug profile on 2 cores). `cargo test --workspace` leaves this binary
 //! out (`test = false` in `tests/Cargo.toml`), not `#[ignore]`, so that
 //! these tests are one command away and never silently unrun in CI.
