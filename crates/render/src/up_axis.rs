@@ -76,8 +76,12 @@ pub fn turned_up(up: Vec3) -> Quat {
     }
 }
 
-/// The model's up direction ([`UpAxis`]), judged by its flat base.
+/// The model's up direction ([`UpAxis`]): the one its file's format fixes
+/// ([`Scene::up`], +Y for glTF), else judged by its flat base.
 pub fn detect_up(scene: &Scene) -> UpAxis {
+    if let Some(up) = scene.up.and_then(|up| up.try_normalize()) {
+        return UpAxis { up, base_share: None };
+    }
     let bounds = scene.bounds();
     if bounds.is_empty() {
         return UpAxis::Y;
@@ -211,6 +215,13 @@ mod tests {
         assert_eq!(detect_up(&column(1, true)), UpAxis::Y);
         assert_eq!(detect_up(&column(2, false)), UpAxis::Y);
         assert_eq!(detect_up(&column(0, false)), UpAxis::Y);
+    }
+
+    #[test]
+    fn a_format_that_fixes_up_is_not_second_guessed() {
+        // A glTF statue on a base across Z is still +Y up, as its format says.
+        let gltf = Scene { up: Some(Vec3::Y), ..column(2, true) };
+        assert_eq!(detect_up(&gltf), UpAxis::Y);
     }
 
     #[test]

@@ -43,8 +43,12 @@ pub(crate) fn load(
     validate_accessors(&gltf.document, &buffers).map_err(&error)?;
     check_node_hierarchy(gltf.document.as_json()).map_err(&error)?;
 
-    let mut scene =
-        Scene { extensions_used: gltf.document.extensions_used().map(str::to_owned).collect(), ..Scene::default() };
+    let mut scene = Scene {
+        extensions_used: gltf.document.extensions_used().map(str::to_owned).collect(),
+        // glTF 2.0, section 3.4 ("Coordinate System and Units"): +Y is up.
+        up: Some(Vec3::Y),
+        ..Scene::default()
+    };
     let textures = TextureTable::new(&gltf.document, files, &buffers, &mut scene, sources);
     for material in gltf.document.materials() {
         scene.materials.push(convert_material(&material, &textures));

@@ -95,6 +95,10 @@ pub struct Scene {
     pub lights: Vec<Light>,
     /// The format extensions the file uses (glTF's `extensionsUsed`).
     pub extensions_used: Vec<String>,
+    /// The up direction the file's format fixes: +Y for glTF, whose
+    /// specification makes +Y up. `None` where the format has no
+    /// convention (OBJ), so that a renderer may judge it from the model.
+    pub up: Option<Vec3>,
     /// Problems that did not stop the import (a missing texture, an unknown
     /// material, an MTL statement that could not be read, a reference
     /// refused because it leads outside the scene's folder).
@@ -242,7 +246,11 @@ impl Scene {
     }
 
     /// Appends `other`, renumbering its vertices, materials and textures.
+    /// The result keeps an up direction only where both had the same one
+    /// (or this scene was empty).
     pub fn append(&mut self, other: Scene) {
+        let empty = self.vertices.is_empty() && self.triangles.is_empty();
+        self.up = if empty || self.up == other.up { other.up } else { None };
         let vertex_base = self.vertices.len() as u32;
         let material_base = self.materials.len() as u32;
         let texture_base = self.textures.len() as u32;

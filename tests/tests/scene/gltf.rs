@@ -24,6 +24,8 @@ fn sample_models_load_with_their_triangle_counts() {
         let Some(path) = shared_scene(file) else { continue };
         let scene = Scene::load(&path).unwrap_or_else(|e| panic!("{e}"));
         assert_eq!(scene.triangles.len(), triangles, "{file}");
+        // glTF fixes +Y as up (section 3.4 of the specification): nothing to guess.
+        assert_eq!(scene.up, Some(Vec3::Y), "{file}");
         // Every texture a material names was found and decoded.
         assert!(scene.warnings.iter().all(|w| !w.contains("image")), "{file}: {:?}", scene.warnings);
     }
@@ -199,4 +201,21 @@ fn instanced_meshes_appear_once_per_node_and_mirrors_keep_their_winding() {
         assert!(normal.z > 0.0, "{t:?}");
     }
     assert!(corners.iter().any(|t| t.iter().any(|p| p.x < 0.0)), "the mirrored instance");
+}
+
+#[test]
+fn a_description_keeps_an_up_axis_only_where_its_meshes_agree() {
+    let dir = scratch_dir("description-up");
+    let Some(gltf) = shared_scene("gltf/Box/glTF/Box.gltf") else { return };
+    std::fs::copy(&gltf, dir.join("Box.gltf")).unwrap();
+    std::fs::copy(gltf.with_file_name("Box0.bin"), dir.join("Box0.bin")).unwrap();
+    std::fs::write(dir.join("tri.obj"), "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n").unwrap();
+    let load = |meshes: &[&str], name: &str| {
+        let text: String = meshes.iter().map(|m| format!("[[mesh]]\nfile = \"{m}\"\n")).collect();
+        std::fs::write(dir.join(name), text).unwrap();
+        Scene::load(&dir.join(name)).unwrap_or_else(|e| panic!("{e}"))
+    };
+    assert_eq!(load(&["Box.gltf"], "gltf.toml").up, Some(Vec3::Y));
+    assert_eq!(load(&["tri.obj"], "obj.toml").up, None, "OBJ has no convention");
+    assert_eq!(load(&["Box.gltf", "tri.obj"], "both.toml").up, None, "mixed: the renderer judges");
 }
