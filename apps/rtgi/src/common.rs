@@ -46,20 +46,21 @@ pub(crate) fn load_scene(path: Option<&Path>) -> Result<LoadedScene> {
 /// Sizes rayon's global pool to `threads` worker threads (one per core
 /// when `None`); called once, before any parallel work.
 pub(crate) fn size_global_pool(threads: Option<u32>) -> Result<()> {
-    let mut pool = rayon::ThreadPoolBuilder::new();
-    if let Some(threads) = threads {
-        pool = pool.num_threads(threads as usize);
-    }
-    pool.build_global().context("cannot start worker threads")
+    pool_builder(threads).build_global().context("cannot start worker threads")
 }
 
 /// A pool of `threads` worker threads, or one per core.
 pub(crate) fn thread_pool(threads: Option<u32>) -> Result<rayon::ThreadPool> {
-    let mut pool = rayon::ThreadPoolBuilder::new();
-    if let Some(threads) = threads {
-        pool = pool.num_threads(threads as usize);
+    pool_builder(threads).build().context("cannot start worker threads")
+}
+
+/// A builder of `threads` worker threads; rayon's default (one per core) when `None`.
+fn pool_builder(threads: Option<u32>) -> rayon::ThreadPoolBuilder {
+    let builder = rayon::ThreadPoolBuilder::new();
+    match threads {
+        Some(threads) => builder.num_threads(threads as usize),
+        None => builder,
     }
-    pool.build().context("cannot start worker threads")
 }
 
 /// A name beside `path` for a temporary file of this process.

@@ -340,6 +340,13 @@ pub(crate) fn render_given(args: &RenderArgs, given: Option<Given<'_>>) -> Resul
         }
     }
 
+    let adaptive_samples = match &rendered {
+        Done::Progressive(_) => None,
+        Done::Adapted(_, outcome) => Some(AdaptiveSummary {
+            fewest_samples: outcome.samples.iter().copied().min().unwrap_or(0),
+            mean_samples: outcome.total_samples() as f64 / outcome.samples.len().max(1) as f64,
+        }),
+    };
     let build = accel.as_ref().build_stats();
     say!("scene       {scene_name}");
     say!("triangles   {}", scene.triangles.len());
@@ -356,8 +363,8 @@ pub(crate) fn render_given(args: &RenderArgs, given: Option<Given<'_>>) -> Resul
             totals.passes
         ),
         Done::Adapted(_, outcome) => {
-            let fewest = outcome.samples.iter().copied().min().unwrap_or(0);
-            let mean = outcome.total_samples() as f64 / outcome.samples.len().max(1) as f64;
+            let AdaptiveSummary { fewest_samples: fewest, mean_samples: mean } =
+                adaptive_samples.as_ref().expect("an adaptive render has its figures");
             say!(
                 "render      {:.1} ms, {}x{} at {fewest} to {} spp (mean {mean:.1}), {} threads, {} round(s)",
                 totals.render_seconds * 1e3,
@@ -381,13 +388,6 @@ pub(crate) fn render_given(args: &RenderArgs, given: Option<Given<'_>>) -> Resul
     }
     let rays_per_second = totals.rays as f64 / totals.render_seconds.max(1e-9);
     say!("rays        {} ({:.3} Mrays/s)", totals.rays, rays_per_second * 1e-6);
-    let adaptive_summary = match &rendered {
-        Done::Progressive(_) => None,
-        Done::Adapted(_, outcome) => Some(AdaptiveSummary {
-            fewest_samples: outcome.samples.iter().copied().min().unwrap_or(0),
-            mean_samples: outcome.total_samples() as f64 / outcome.samples.len().max(1) as f64,
-        }),
-    };
     let stopped_by = match ending {
         Ending::Complete => None,
         Ending::TimeLimit => Some(format!("the time limit ({} s)", job.time_limit.unwrap_or_default())),
@@ -446,7 +446,7 @@ pub(crate) fn render_given(args: &RenderArgs, given: Option<Given<'_>>) -> Resul
                 passes: totals.passes,
                 rays: totals.rays,
                 mrays_per_second: rays_per_second * 1e-6,
-                adaptive: adaptive_summary,
+                adaptive: adaptive_samples,
             },
             denoise_ms,
             exposure,
@@ -454,7 +454,7 @@ pub(crate) fn render_given(args: &RenderArgs, given: Option<Given<'_>>) -> Resul
             part: job
                 .is_part()
                 .then_some(PartSummary { rows: [rows.start, rows.end], samples: [samples.start, samples.end] }),
-            stopped_by: stopped_by.clone(),
+            stopped_by,
             outputs,
         };
         printed = printed.and_then(|()| outln!("{}", serde_json::to_string_pretty(&summary)?));
@@ -615,8 +615,7 @@ fn adaptive_summary(args: &RenderArgs, outcome: &AdaptiveOutcome, spp: u32, samp
 }
 
 /// Says so when the image came out almost black or almost white, with the
-/// options that help.
-/// Warns when the image looks almost black or almost white, and says which.
+/// options that help; returns which.
 fn warn_if_illegible(
     image: &HdrImage,
     tone_map: &ToneMap,
