@@ -26,6 +26,11 @@ pub(crate) struct Cli {
     /// TOML description) reach outside the scene file's folder: only for scenes you trust
     #[arg(long, global = true)]
     pub(crate) allow_outside_scene: bool,
+
+    /// The material variant of a glTF scene to render (KHR_materials_variants; `rtgi info`
+    /// lists a scene's variants); without it each primitive has its default material
+    #[arg(long, global = true, value_name = "NAME")]
+    pub(crate) variant: Option<String>,
 }
 
 #[derive(Debug, Subcommand)]

@@ -22,6 +22,9 @@ pub(crate) struct LoadedScene {
 /// `--allow-outside-scene`, set once by `main` for every command.
 pub(crate) static ALLOW_OUTSIDE_SCENE: std::sync::OnceLock<bool> = std::sync::OnceLock::new();
 
+/// `--variant`, set once by `main` for every command.
+pub(crate) static GLTF_VARIANT: std::sync::OnceLock<Option<String>> = std::sync::OnceLock::new();
+
 /// Loads a scene file (or the built-in Cornell box) and prints its warnings.
 /// References outside the scene's folder are refused unless `--allow-outside-scene`.
 pub(crate) fn load_scene(path: Option<&Path>) -> Result<LoadedScene> {
@@ -30,6 +33,7 @@ pub(crate) fn load_scene(path: Option<&Path>) -> Result<LoadedScene> {
         Some(path) => {
             let options = LoadOptions {
                 allow_outside_folder: ALLOW_OUTSIDE_SCENE.get() == Some(&true),
+                gltf_variant: GLTF_VARIANT.get().cloned().flatten(),
                 ..LoadOptions::default()
             };
             (Scene::load_with(path, &options)?, path.display().to_string())

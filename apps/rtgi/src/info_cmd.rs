@@ -6,7 +6,7 @@ use anyhow::{Context, Result, bail};
 use rtgi_accel::AccelKind;
 use rtgi_image::HdrImage;
 use rtgi_render::{EffectPlan, RenderSettings};
-use rtgi_scene::{AlphaMode, LightKind, SUPPORTED_GLTF_EXTENSIONS};
+use rtgi_scene::{AlphaMode, LightKind, gltf_extension_support};
 use serde::Serialize;
 
 use crate::cli::{CompareArgs, InfoArgs};
@@ -28,6 +28,10 @@ struct Info {
     bounds: Option<[[f32; 3]; 2]>,
     extensions_used: Vec<String>,
     extensions_unsupported: Vec<String>,
+    /// Each extension the file uses, with how rtgi renders it.
+    extensions: Vec<ExtensionInfo>,
+    /// The file's material variants (KHR_materials_variants), which `--variant` chooses from.
+    material_variants: Vec<String>,
     warnings: Vec<String>,
     /// What `rtgi render` with the given options would simulate, and why.
     plan: EffectPlan,
@@ -45,6 +49,15 @@ struct MaterialInfo {
     transmission: f32,
     ior: f32,
     alpha: String,
+}
+
+#[derive(Debug, Serialize)]
+struct ExtensionInfo {
+    name: String,
+    /// simulated, approximated, not visual or unsupported.
+    support: &'static str,
+    /// How it is approximated, or what the image lacks without it.
+    detail: &'static str,
 }
 
 #[derive(Debug, Serialize)]
@@ -147,9 +160,18 @@ pub(crate) fn run(args: &InfoArgs) -> Result<()> {
         extensions_unsupported: scene
             .extensions_used
             .iter()
-            .filter(|e| !SUPPORTED_GLTF_EXTENSIONS.contains(&e.as_str()))
+            .filter(|e| !gltf_extension_support(e).is_supported())
             .cloned()
             .collect(),
+        extensions: scene
+            .extensions_used
+            .iter()
+            .map(|name| {
+                let support = gltf_extension_support(name);
+                ExtensionInfo { name: name.clone(), support: support.label(), detail: support.detail() }
+            })
+            .collect(),
+        material_variants: scene.material_variants.clone(),
         extensions_used: scene.extensions_used.clone(),
         warnings: scene.warnings.clone(),
         plan: EffectPlan::new(&scene, &settings),
@@ -219,14 +241,15 @@ fn print_text(info: &Info) -> Result<()> {
             c.aspect.map_or(String::new(), |aspect| format!(", aspect {aspect}"))
         )?;
     }
-    if !info.extensions_used.is_empty() {
-        // The loader has warned about the unsupported ones already.
-        let named: Vec<String> = info
-            .extensions_used
-            .iter()
-            .map(|e| if info.extensions_unsupported.contains(e) { format!("{e} (ignored)") } else { e.clone() })
-            .collect();
-        outln!("extensions  {}", named.join(", "))?;
+    if !info.extensions.is_empty() {
+        outln!("extensions  {}", info.extensions.len())?;
+        for e in &info.extensions {
+            let detail = if e.detail.is_empty() { String::new() } else { format!(": {}", e.detail) };
+            outln!("  {:<36} {}{detail}", e.name, e.support)?;
+        }
+    }
+    if !info.material_variants.is_empty() {
+        outln!("variants    {} (--variant NAME renders one)", info.material_variants.join(", "))?;
     }
     out!("{}", info.plan)
 }

@@ -35,6 +35,7 @@ pub fn main() -> ExitCode {
         Err(e) => return cli::report_parse_error(e),
     };
     let _ = common::ALLOW_OUTSIDE_SCENE.set(cli.allow_outside_scene);
+    let _ = common::GLTF_VARIANT.set(cli.variant.clone());
     // Rayon's global pool runs whatever no command's own pool runs (loading
     // a scene, the passes of a render): it gets the same count, so that
     // `--threads N` bounds every thread that works, not only the pool's.
@@ -70,6 +71,14 @@ pub fn main() -> ExitCode {
             if let Some(render_job::StoppedBySignal(signal)) = e.downcast_ref() {
                 eprintln!("rtgi: {e}");
                 return ExitCode::from(interrupt::exit_status(*signal));
+            }
+            // A file rtgi cannot render for want of an extension is a usage
+            // problem of the input, as a bad argument is: exit status 2.
+            if e.chain().any(|cause| {
+                matches!(cause.downcast_ref(), Some(rtgi_scene::SceneError::UnsupportedGltfExtension { .. }))
+            }) {
+                eprintln!("error: {}", one_line(&e));
+                return ExitCode::from(2);
             }
             if e.downcast_ref::<render_job::ResumeOfAnotherRender>().is_some() {
                 eprintln!("error: {}", one_line(&e));

@@ -30,7 +30,14 @@ pub fn has_alpha(scene: &Scene) -> bool {
 pub fn alpha_accepts(scene: &Scene, triangle: u32, beta: f32, gamma: f32, u: f32) -> bool {
     let triangle = &scene.triangles[triangle as usize];
     let material = &scene.materials[triangle.material as usize];
-    decide(scene, material, u, || scene.interpolate(triangle, beta, gamma, |v| v.uv))
+    let set = coordinate_set(scene, material);
+    decide(scene, material, u, || scene.texture_coords(triangle, beta, gamma)[set])
+}
+
+/// The texture coordinate set the alpha of `material` is read with: its
+/// base colour texture's (an MTL mask reads set 0, as MTL has no other).
+fn coordinate_set(scene: &Scene, material: &Material) -> usize {
+    material.base_color_texture.map_or(0, |t| scene.textures[t.0 as usize].uv_map().set.min(1) as usize)
 }
 
 /// [`alpha_accepts`] prepared for a scene: the corners' texture
@@ -62,8 +69,12 @@ impl<'a> AlphaTest<'a> {
             if scene.materials[t.material as usize].alpha_mode != AlphaMode::Opaque {
                 with_alpha[i / 64] |= 1 << (i % 64);
             }
-            triangles
-                .push(AlphaTriangle { uv: t.vertices.map(|v| scene.vertices[v as usize].uv), material: t.material });
+            let set = coordinate_set(scene, &scene.materials[t.material as usize]);
+            let uv = t.vertices.map(|v| {
+                let vertex = &scene.vertices[v as usize];
+                if set == 1 { vertex.uv1 } else { vertex.uv }
+            });
+            triangles.push(AlphaTriangle { uv, material: t.material });
         }
         Self { scene, with_alpha, triangles }
     }
@@ -77,7 +88,7 @@ impl<'a> AlphaTest<'a> {
         }
         let AlphaTriangle { uv: [a, b, c], material } = self.triangles[i];
         let material = &self.scene.materials[material as usize];
-        // The arithmetic of `Scene::interpolate`, for the same bits.
+        // The arithmetic of `Scene::texture_coords`, for the same bits.
         decide(self.scene, material, u, || a * (1.0 - beta - gamma) + b * beta + c * gamma)
     }
 }
@@ -95,8 +106,9 @@ fn mask_lookup<'s>(scene: &'s Scene, material: &Material) -> Option<(&'s Texture
     (material.base_color_texture != Some(id) || channel != 3).then_some((mask, channel))
 }
 
-/// Whether `material` at the texture coordinates `uv()` counts as hit for
-/// the uniform number `u`.
+/// Whether `material` at the texture coordinates `uv()` (of the set
+/// [`coordinate_set`] names, before the textures' transforms) counts as
+/// hit for the uniform number `u`.
 #[inline(always)]
 fn decide(scene: &Scene, material: &Material, u: f32, uv: impl FnOnce() -> Vec2) -> bool {
     // Both modes accept from a threshold up, so bounds that fall on one
@@ -117,7 +129,9 @@ fn decide(scene: &Scene, material: &Material, u: f32, uv: impl FnOnce() -> Vec2)
     let uv = uv();
     let base = base.map(|t| (&scene.textures[t.0 as usize], 3));
     let mask = mask_lookup(scene, material);
-    let bounds = |lookup: Option<(&Texture, usize)>| lookup.map_or(Some((1.0, 1.0)), |(t, c)| t.channel_bounds(uv, c));
+    let bounds = |lookup: Option<(&Texture, usize)>| {
+        lookup.map_or(Some((1.0, 1.0)), |(t, c)| t.channel_bounds(t.uv_map().transform(uv), c))
+    };
     if let (Some((base_low, base_high)), Some((mask_low, mask_high))) = (bounds(base), bounds(mask))
         && (0.0..=f32::MAX).contains(&material.opacity)
     {
@@ -129,7 +143,8 @@ fn decide(scene: &Scene, material: &Material, u: f32, uv: impl FnOnce() -> Vec2)
             return low_accepted;
         }
     }
-    let value = |lookup: Option<(&Texture, usize)>| lookup.map_or(1.0, |(t, c)| t.sample_channel(uv, c));
+    let value =
+        |lookup: Option<(&Texture, usize)>| lookup.map_or(1.0, |(t, c)| t.sample_channel(t.uv_map().transform(uv), c));
     accepts(material.opacity * value(base) * value(mask))
 }
 
@@ -213,7 +228,14 @@ mod tests {
         for (m, _) in scene.materials.iter().enumerate() {
             let first = scene.vertices.len() as u32;
             for uv in [Vec2::new(-1.3, -0.7), Vec2::new(2.1, -0.2), Vec2::new(0.4, 1.9)] {
-                scene.vertices.push(Vertex { position: Vec3::ZERO, normal: Vec3::Z, uv, tangent: Vec4::X });
+                scene.vertices.push(Vertex {
+                    position: Vec3::ZERO,
+                    normal: Vec3::Z,
+                    uv,
+                    uv1: Vec2::ZERO,
+                    color: Vec4::ONE,
+                    tangent: Vec4::X,
+                });
             }
             scene.triangles.push(Triangle { vertices: [first, first + 1, first + 2], material: m as u32 });
         }
@@ -250,7 +272,14 @@ mod tests {
             });
             let first = scene.vertices.len() as u32;
             for uv in [Vec2::ZERO, Vec2::X, Vec2::Y] {
-                scene.vertices.push(Vertex { position: Vec3::ZERO, normal: Vec3::Z, uv, tangent: Vec4::X });
+                scene.vertices.push(Vertex {
+                    position: Vec3::ZERO,
+                    normal: Vec3::Z,
+                    uv,
+                    uv1: Vec2::ZERO,
+                    color: Vec4::ONE,
+                    tangent: Vec4::X,
+                });
             }
             let material = scene.materials.len() as u32 - 1;
             scene.triangles.push(Triangle { vertices: [first, first + 1, first + 2], material });

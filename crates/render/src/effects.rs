@@ -323,16 +323,33 @@ impl EffectPlan {
             .iter()
             .filter(|t| scene.materials.get(t.material as usize).is_some_and(Material::is_emissive))
             .count();
+        let unlit = with(|m| m.unlit);
+        let unlit_triangles = scene
+            .triangles
+            .iter()
+            .filter(|t| scene.materials.get(t.material as usize).is_some_and(|m| m.unlit))
+            .count();
         let emission = if !lighting {
             decide(Effect::Emission, false, not_lit())
-        } else if emissive_triangles > 0 {
-            let reason = format!(
-                "{} of {} {}",
-                count(emissive_triangles, "triangle"),
-                names(&emitters),
-                agree(emissive_triangles, "emits")
-            );
-            decide(Effect::Emission, true, reason)
+        } else if emissive_triangles > 0 || unlit_triangles > 0 {
+            let mut reasons = Vec::new();
+            if emissive_triangles > 0 {
+                reasons.push(format!(
+                    "{} of {} {}",
+                    count(emissive_triangles, "triangle"),
+                    names(&emitters),
+                    agree(emissive_triangles, "emits")
+                ));
+            }
+            if unlit_triangles > 0 {
+                reasons.push(format!(
+                    "{} of {} {} unlit (KHR_materials_unlit): the view sees their colour unshaded",
+                    count(unlit_triangles, "triangle"),
+                    names(&unlit),
+                    if unlit_triangles == 1 { "is" } else { "are" }
+                ));
+            }
+            decide(Effect::Emission, true, reasons.join("; "))
         } else {
             decide(Effect::Emission, false, "no material emits".into())
         };

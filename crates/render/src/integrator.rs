@@ -296,6 +296,10 @@ impl<'a, A: Accel + ?Sized> Transport<'a, A> {
         // The least density of the path's bounces so far (not counting
         // deltas), which path regularisation widens later lobes by.
         let mut least_pdf = f32::INFINITY;
+        // The absorption of the medium the ray travels in (KHR_materials_volume),
+        // set where a path refracts into a mesh with a volume and cleared where
+        // it leaves one; a medium inside another is not tracked.
+        let mut medium: Option<Vec3> = None;
         let mut depth = 0;
         loop {
             let mut u: [f32; dim::COUNT] = std::array::from_fn(|_| rng.next_f32());
@@ -313,6 +317,15 @@ impl<'a, A: Accel + ?Sized> Transport<'a, A> {
                 Some(hit) => hit,
                 None => self.closest::<S>(&ray, u[dim::ALPHA]),
             };
+            if let (Some(absorption), Some(hit)) = (medium, &hit) {
+                // Beer–Lambert: the light reaching here lost exp(−σ d) on the way.
+                let distance = hit.t * ray.direction.length();
+                throughput *= Vec3::new(
+                    (-absorption.x * distance).exp(),
+                    (-absorption.y * distance).exp(),
+                    (-absorption.z * distance).exp(),
+                );
+            }
             let Some(hit) = hit else {
                 match self.environment {
                     Some(environment) if compiled(S, Effect::Emission) && (depth > 0 || self.environment_in_view) => {
@@ -338,6 +351,16 @@ impl<'a, A: Accel + ?Sized> Transport<'a, A> {
                     self.lights.pdf_emitter(hit.triangle, wo, hit.t * direction_length)
                 });
                 radiance += self.clamp(depth, throughput * emitted * weight);
+            }
+            if material.unlit {
+                // KHR_materials_unlit: the surface shows its colour as it is
+                // and reflects nothing. Its colour is not a light to sample,
+                // so a ray that finds it counts in full.
+                if compiled(S, Effect::Emission) {
+                    let color = crate::shade::albedo(scene, &hit, compiled(S, Effect::Textures));
+                    radiance += self.clamp(depth, throughput * color);
+                }
+                break;
             }
             if depth == self.max_depth {
                 break;
@@ -410,6 +433,12 @@ impl<'a, A: Accel + ?Sized> Transport<'a, A> {
             if !throughput.is_finite() || throughput.max_element() <= 0.0 {
                 break;
             }
+            if !reflects_only && wi.dot(geometric) * wo_side < 0.0 {
+                // Refracted: into the mesh's medium (against the outward
+                // normal, which the shading normal gives) or out of it.
+                let entering = wi.dot(frame.z) < 0.0;
+                medium = if entering { material.volume.as_ref().map(|v| v.absorption()) } else { None };
+            }
             ray = interaction.point.spawn_ray(wi);
         }
         radiance
@@ -458,13 +487,15 @@ impl<'a, A: Accel + ?Sized> Transport<'a, A> {
         let point =
             SurfacePoint::on_triangle_with_shape(&corners, hit.beta, hit.gamma, self.shapes[hit.triangle as usize]);
         let mut normal = scene.interpolate(triangle, hit.beta, hit.gamma, |v| v.normal);
-        let mut base_color = material.base_color;
+        // COLOR_0 multiplies the base colour (white where a file has none).
+        let vertex_color = scene.interpolate(triangle, hit.beta, hit.gamma, |v| v.color).truncate();
+        let mut base_color = material.base_color * vertex_color;
         let mut roughness = material.roughness;
         let mut metallic = material.metallic;
         let mut transmission = material.transmission;
         if compiled(S, Effect::Textures) {
-            let uv = scene.interpolate(triangle, hit.beta, hit.gamma, |v| v.uv);
-            let texture = |id: rtgi_scene::TextureId| scene.textures[id.0 as usize].sample(uv);
+            let coords = scene.texture_coords(triangle, hit.beta, hit.gamma);
+            let texture = |id: rtgi_scene::TextureId| scene.textures[id.0 as usize].lookup(coords);
             if let Some(id) = material.base_color_texture {
                 base_color *= texture(id).truncate();
             }
@@ -521,10 +552,20 @@ impl<'a, A: Accel + ?Sized> Transport<'a, A> {
         };
         if u < transmission {
             let ior = material.ior.max(1.0 + 1e-4);
-            // MTL's refracting materials are solid glass; glTF's transmission
-            // without KHR_materials_volume is a thin-walled surface.
+            // MTL's refracting materials are solid glass, as are glTF's with
+            // KHR_materials_volume; glTF's transmission without it is a
+            // thin-walled surface.
             let lobe = match material.model {
                 SurfaceModel::DiffuseSpecular => Bsdf::Dielectric { ior, tint: Vec3::ONE },
+                // KHR_materials_volume: the mesh is a solid of the medium,
+                // refracting where light enters and leaves it.
+                SurfaceModel::MetallicRoughness if material.volume.is_some() => {
+                    if self.glossy && roughness * roughness >= MIN_ALPHA {
+                        Bsdf::RoughDielectric { ior, tint: base_color, alpha: roughness * roughness }
+                    } else {
+                        Bsdf::Dielectric { ior, tint: base_color }
+                    }
+                }
                 SurfaceModel::MetallicRoughness if self.glossy && roughness * roughness >= MIN_ALPHA => {
                     Bsdf::RoughThinDielectric { ior, tint: base_color, alpha: roughness * roughness }
                 }

@@ -326,8 +326,8 @@ pub struct EmissiveTriangle {
     pub triangle: u32,
     /// Its corners in world space.
     pub corners: [Vec3; 3],
-    /// Texture coordinates of its corners, for a textured emission.
-    pub uvs: [Vec2; 3],
+    /// Both texture coordinate sets of its corners, for a textured emission.
+    pub uvs: [[Vec2; 2]; 3],
     /// Unit geometric normal (right-hand rule); the front side.
     pub normal: Vec3,
     /// The triangle's [`rtgi_math::elongation`], for the error bound of points on it.
@@ -350,8 +350,8 @@ impl EmissiveTriangle {
         }
         let texture = self.texture.map_or(Vec3::ONE, |t| {
             let [a, b, c] = self.uvs;
-            let uv = (1.0 - beta - gamma) * a + beta * b + gamma * c;
-            scene.textures[t.0 as usize].sample(uv).truncate()
+            let coords = std::array::from_fn(|set| (1.0 - beta - gamma) * a[set] + beta * b[set] + gamma * c[set]);
+            scene.textures[t.0 as usize].lookup(coords).truncate()
         });
         self.emission * texture
     }
@@ -446,7 +446,7 @@ impl LightSet {
                 sources.push(Source::Triangle(EmissiveTriangle {
                     triangle: index as u32,
                     corners,
-                    uvs: triangle.vertices.map(|v| scene.vertices[v as usize].uv),
+                    uvs: triangle.vertices.map(|v| [scene.vertices[v as usize].uv, scene.vertices[v as usize].uv1]),
                     normal: cross / (2.0 * area),
                     elongation: rtgi_math::elongation(&corners),
                     area,

@@ -17,6 +17,10 @@ const AMBIENT: f32 = 0.2;
 pub fn shade_primary(scene: &Scene, ray: &Ray, hit: &Hit, textures: bool) -> Vec3 {
     let emission = emission(scene, hit, textures);
     let albedo = albedo(scene, hit, textures);
+    // An unlit surface shows its colour as it is (KHR_materials_unlit).
+    if scene.materials[scene.triangles[hit.triangle as usize].material as usize].unlit {
+        return albedo + emission;
+    }
     let normal = shading_normal(scene, hit);
     let cosine = normal.dot(-ray.direction.normalize()).abs();
     albedo * (AMBIENT + (1.0 - AMBIENT) * cosine) + emission
@@ -28,20 +32,22 @@ pub fn emission(scene: &Scene, hit: &Hit, textures: bool) -> Vec3 {
     let material = &scene.materials[triangle.material as usize];
     material.emission
         * material.emission_texture.filter(|_| textures).map_or(Vec3::ONE, |t| {
-            let uv = scene.interpolate(triangle, hit.beta, hit.gamma, |v| v.uv);
-            scene.textures[t.0 as usize].sample(uv).truncate()
+            let coords = scene.texture_coords(triangle, hit.beta, hit.gamma);
+            scene.textures[t.0 as usize].lookup(coords).truncate()
         })
 }
 
-/// The surface colour at the hit: base colour times texture (if `textures`).
+/// The surface colour at the hit: base colour times vertex colour, times
+/// texture (if `textures`).
 pub fn albedo(scene: &Scene, hit: &Hit, textures: bool) -> Vec3 {
     let triangle = &scene.triangles[hit.triangle as usize];
     let material = &scene.materials[triangle.material as usize];
     let texture = material.base_color_texture.filter(|_| textures).map_or(Vec3::ONE, |t| {
-        let uv = scene.interpolate(triangle, hit.beta, hit.gamma, |v| v.uv);
-        scene.textures[t.0 as usize].sample(uv).truncate()
+        let coords = scene.texture_coords(triangle, hit.beta, hit.gamma);
+        scene.textures[t.0 as usize].lookup(coords).truncate()
     });
-    material.base_color * texture
+    let vertex_color = scene.interpolate(triangle, hit.beta, hit.gamma, |v| v.color).truncate();
+    material.base_color * vertex_color * texture
 }
 
 /// The closest hit of `ray`; with `cut_outs`, the alpha test and the

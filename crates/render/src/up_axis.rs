@@ -151,7 +151,7 @@ pub(crate) mod test_models {
     use rtgi_scene::{Material, Scene, Triangle, Vertex};
 
     fn vertex(position: Vec3) -> Vertex {
-        Vertex { position, normal: Vec3::Y, uv: Vec2::ZERO, tangent: Vec4::ZERO }
+        Vertex { position, normal: Vec3::Y, uv: Vec2::ZERO, uv1: Vec2::ZERO, color: Vec4::ONE, tangent: Vec4::ZERO }
     }
 
     /// A lumpy column along `axis` (a statue), closed at its low end by a

@@ -28,11 +28,14 @@ pub struct LoadOptions {
     /// The most triangles a scene may have; glTF files that instance large
     /// meshes many times are refused before their triangles are built.
     pub max_triangles: usize,
+    /// The glTF material variant (KHR_materials_variants) to render, by
+    /// name; `None` renders each primitive's default material.
+    pub gltf_variant: Option<String>,
 }
 
 impl Default for LoadOptions {
     fn default() -> Self {
-        Self { allow_outside_folder: false, max_triangles: DEFAULT_MAX_TRIANGLES }
+        Self { allow_outside_folder: false, max_triangles: DEFAULT_MAX_TRIANGLES, gltf_variant: None }
     }
 }
 

@@ -17,14 +17,10 @@ use rayon::prelude::*;
 use rtgi_math::{Mat3, Mat4, Vec2, Vec3, Vec4};
 
 use crate::files::Files;
-use crate::{
-    AlphaMode, Camera, ColorEncoding, Light, LightKind, Material, MeshBuilder, Scene, SceneError, SurfaceModel,
-    Texture, TextureId, Wrap,
-};
-
-/// Extensions this importer understands; others are reported by `rtgi info`.
-pub const SUPPORTED_GLTF_EXTENSIONS: &[&str] =
-    &["KHR_lights_punctual", "KHR_materials_transmission", "KHR_materials_ior", "KHR_materials_emissive_strength"];
+use crate::gltf_accessor::read_floats;
+use crate::gltf_extensions::{ExtensionSupport, gltf_extension_support};
+use crate::gltf_material::{TextureRequests, convert_material};
+use crate::{Camera, ColorEncoding, Light, LightKind, Material, MeshBuilder, Scene, SceneError, SurfaceModel, Texture};
 
 pub(crate) fn load(
     bytes: &[u8],
@@ -38,6 +34,17 @@ pub(crate) fn load(
     // first, then validated, then checked for everything else the crate
     // would unwrap or reach `unreachable!()` on, before any accessor is read.
     let gltf = gltf::Gltf::from_slice_without_validation(bytes).map_err(|e| error(e.to_string()))?;
+    // A required extension rtgi lacks is named as such, before the `gltf`
+    // crate's validation blames the file for it.
+    for extension in &gltf.document.as_json().extensions_required {
+        if let ExtensionSupport::Unsupported(lacks) = gltf_extension_support(extension) {
+            return Err(SceneError::UnsupportedGltfExtension {
+                path: path.to_owned(),
+                extension: extension.clone(),
+                lacks,
+            });
+        }
+    }
     validate_document(gltf.document.as_json()).map_err(&error)?;
     let buffers = load_buffers(&gltf, files, sources).map_err(&error)?;
     validate_accessors(&gltf.document, &buffers).map_err(&error)?;
@@ -49,10 +56,19 @@ pub(crate) fn load(
         up: Some(Vec3::Y),
         ..Scene::default()
     };
-    let textures = TextureTable::new(&gltf.document, files, &buffers, &mut scene, sources);
+    let mut textures = TextureRequests::new(0);
     for material in gltf.document.materials() {
-        scene.materials.push(convert_material(&material, &textures));
+        scene.materials.push(convert_material(&material, &gltf.document, &mut textures));
     }
+    decode_textures(&textures, &gltf.document, files, &buffers, &mut scene, sources);
+    for (set, count) in &textures.unsupported_sets {
+        scene.warnings.push(format!(
+            "{}: {count} texture references read texture coordinate set {set}; only sets 0 and 1 are kept, so they read set 1",
+            path.display()
+        ));
+    }
+    let variant = choose_variant(&gltf.document, files.options.gltf_variant.as_deref()).map_err(&error)?;
+    scene.material_variants = gltf.document.variants().into_iter().flatten().map(|v| v.name().to_owned()).collect();
     let default_material = scene.materials.len() as u32;
     scene.materials.push(Material {
         name: "glTF default".into(),
@@ -81,8 +97,8 @@ pub(crate) fn load(
         }
         let transform = parent * Mat4::from_cols_array_2d(&node.transform().matrix());
         if let Some(mesh) = node.mesh() {
-            add_mesh(&mesh, &transform, &buffers, default_material, &mut scene, &mut skipped_primitives)
-                .map_err(&error)?;
+            let materials = MaterialChoice { default: default_material, variant };
+            add_mesh(&mesh, &transform, &buffers, materials, &mut scene, &mut skipped_primitives).map_err(&error)?;
             if scene.triangles.len() > files.options.max_triangles {
                 return Err(error(format!(
                     "more than {} triangles (the limit of LoadOptions::max_triangles)",
@@ -127,8 +143,11 @@ pub(crate) fn load(
         ));
     }
     for extension in &scene.extensions_used {
-        if !SUPPORTED_GLTF_EXTENSIONS.contains(&extension.as_str()) {
-            scene.warnings.push(format!("{}: extension {extension} is not supported and is ignored", path.display()));
+        if let ExtensionSupport::Unsupported(lacks) = gltf_extension_support(extension) {
+            scene.warnings.push(format!(
+                "{}: uses {extension}, which rtgi does not support, so the image lacks it: {lacks}",
+                path.display()
+            ));
         }
     }
     Ok(scene)
@@ -230,7 +249,15 @@ fn validate_document(root: &gltf::json::Root) -> Result<(), String> {
         }
     }
     let mut errors = Vec::new();
-    root.validate(root, gltf::json::Path::new, &mut |path, error| errors.push(format!("{}: {error}", path())));
+    root.validate(root, gltf::json::Path::new, &mut |path, error| {
+        let path = path();
+        // The crate refuses required extensions it has no feature for;
+        // those rtgi reads itself (from their JSON) are checked above.
+        if path.as_str().starts_with("extensionsRequired") {
+            return;
+        }
+        errors.push(format!("{path}: {error}"));
+    });
     if !errors.is_empty() {
         let more = if errors.len() > 3 { format!(" (and {} more)", errors.len() - 3) } else { String::new() };
         return Err(format!("invalid glTF: {}{more}", errors[..errors.len().min(3)].join("; ")));
@@ -266,13 +293,18 @@ fn validate_document(root: &gltf::json::Root) -> Result<(), String> {
             }
             for (semantic, accessor) in &primitive.attributes {
                 let kind = accessor_kind(accessor.value());
-                let ok = match semantic {
-                    Checked::Valid(Semantic::Positions | Semantic::Normals) => {
-                        kind == Some((Type::Vec3, ComponentType::F32))
+                // Floats, or the integers KHR_mesh_quantization allows.
+                let ok = match (semantic, kind) {
+                    (_, None) => false,
+                    (Checked::Valid(Semantic::Positions | Semantic::Normals), Some((t, c))) => {
+                        t == Type::Vec3 && c != ComponentType::U32
                     }
-                    Checked::Valid(Semantic::Tangents) => kind == Some((Type::Vec4, ComponentType::F32)),
-                    Checked::Valid(Semantic::TexCoords(_)) => {
-                        matches!(kind, Some((Type::Vec2, ComponentType::F32 | ComponentType::U8 | ComponentType::U16)))
+                    (Checked::Valid(Semantic::Tangents), Some((t, c))) => t == Type::Vec4 && c != ComponentType::U32,
+                    (Checked::Valid(Semantic::TexCoords(_)), Some((t, c))) => {
+                        t == Type::Vec2 && c != ComponentType::U32
+                    }
+                    (Checked::Valid(Semantic::Colors(_)), Some((t, c))) => {
+                        matches!(t, Type::Vec3 | Type::Vec4) && c != ComponentType::U32
                     }
                     _ => true,
                 };
@@ -372,136 +404,101 @@ fn validate_accessors(document: &gltf::Document, buffers: &[Vec<u8>]) -> Result<
     Ok(())
 }
 
-/// What distinguishes one decoded texture from another: the image, whether
-/// it holds colour (sRGB) or data (linear), and the sampler's wrap modes.
-type TextureKey = (usize, bool, Wrap, Wrap);
-
-/// Decoded textures, one per [`TextureKey`] that materials use.
-struct TextureTable {
-    ids: HashMap<TextureKey, TextureId>,
-}
-
-fn texture_key(texture: &gltf::Texture<'_>, srgb: bool) -> TextureKey {
-    use gltf::texture::WrappingMode;
-    let wrap = |mode: WrappingMode| match mode {
-        WrappingMode::ClampToEdge => Wrap::ClampToEdge,
-        WrappingMode::MirroredRepeat => Wrap::MirroredRepeat,
-        WrappingMode::Repeat => Wrap::Repeat,
-    };
-    let sampler = texture.sampler();
-    (texture.source().index(), srgb, wrap(sampler.wrap_s()), wrap(sampler.wrap_t()))
-}
-
-impl TextureTable {
-    fn new(
-        document: &gltf::Document,
-        files: &Files<'_>,
-        buffers: &[Vec<u8>],
-        scene: &mut Scene,
-        sources: &mut Vec<PathBuf>,
-    ) -> Self {
-        // Which images are used as colour (sRGB) and which as data (linear).
-        let mut wanted: Vec<TextureKey> = Vec::new();
-        for m in document.materials() {
-            let pbr = m.pbr_metallic_roughness();
-            let mut want = |t: Option<gltf::Texture<'_>>, srgb: bool| {
-                if let Some(t) = t {
-                    let key = texture_key(&t, srgb);
-                    if !wanted.contains(&key) {
-                        wanted.push(key);
-                    }
+/// Decodes the images the materials asked for, once per image and
+/// encoding, in parallel, and adds one texture per request (requests that
+/// differ only in wrap modes or coordinates share the decoded texels).
+fn decode_textures(
+    textures: &TextureRequests,
+    document: &gltf::Document,
+    files: &Files<'_>,
+    buffers: &[Vec<u8>],
+    scene: &mut Scene,
+    sources: &mut Vec<PathBuf>,
+) {
+    let images: Vec<gltf::Image<'_>> = document.images().collect();
+    let mut decodings: Vec<(usize, bool)> = Vec::new();
+    for request in &textures.requests {
+        if !decodings.contains(&(request.image, request.srgb)) {
+            decodings.push((request.image, request.srgb));
+        }
+    }
+    // Files are read in order (for `sources`), then decoded in parallel.
+    let mut read: HashMap<usize, Result<Vec<u8>, String>> = HashMap::new();
+    for &(index, _) in &decodings {
+        read.entry(index).or_insert_with(|| match images[index].source() {
+            gltf::image::Source::View { view, .. } => {
+                let buffer = &buffers[view.buffer().index()];
+                match view.offset().checked_add(view.length()) {
+                    Some(end) if end <= buffer.len() => Ok(buffer[view.offset()..end].to_vec()),
+                    _ => Err(format!("image {index} lies outside its buffer")),
                 }
+            }
+            gltf::image::Source::Uri { uri, .. } => {
+                read_uri(uri, files, sources).map_err(|e| format!("image {index}: {e}"))
+            }
+        });
+    }
+    let decoded: Vec<Result<Texture, String>> = decodings
+        .par_iter()
+        .map(|&(index, srgb)| {
+            let encoding = if srgb { ColorEncoding::Srgb } else { ColorEncoding::Linear };
+            // The image's name where it has one, and where its pixels are,
+            // for `rtgi info` and messages.
+            let source = match images[index].source() {
+                gltf::image::Source::Uri { uri, .. } if uri.starts_with("data:") => "a data URI".to_owned(),
+                gltf::image::Source::Uri { uri, .. } => format!("'{uri}'"),
+                gltf::image::Source::View { view, .. } => format!("buffer view {}", view.index()),
             };
-            want(pbr.base_color_texture().map(|i| i.texture()), true);
-            want(m.emissive_texture().map(|i| i.texture()), true);
-            want(pbr.metallic_roughness_texture().map(|i| i.texture()), false);
-            want(m.normal_texture().map(|n| n.texture()), false);
-            want(m.transmission().and_then(|t| t.transmission_texture()).map(|i| i.texture()), false);
-        }
-        let images: Vec<gltf::Image<'_>> = document.images().collect();
-        // Files are read in order (for `sources`), then decoded in parallel.
-        let mut read: HashMap<usize, Result<Vec<u8>, String>> = HashMap::new();
-        for &(index, ..) in &wanted {
-            read.entry(index).or_insert_with(|| match images[index].source() {
-                gltf::image::Source::View { view, .. } => {
-                    let buffer = &buffers[view.buffer().index()];
-                    match view.offset().checked_add(view.length()) {
-                        Some(end) if end <= buffer.len() => Ok(buffer[view.offset()..end].to_vec()),
-                        _ => Err(format!("image {index} lies outside its buffer")),
-                    }
-                }
-                gltf::image::Source::Uri { uri, .. } => {
-                    read_uri(uri, files, sources).map_err(|e| format!("image {index}: {e}"))
-                }
-            });
-        }
-        let decoded: Vec<Result<Texture, String>> = wanted
-            .par_iter()
-            .map(|&(index, srgb, wrap_u, wrap_v)| {
-                let encoding = if srgb { ColorEncoding::Srgb } else { ColorEncoding::Linear };
-                let bytes = read[&index].as_ref().map_err(Clone::clone)?;
-                // The image's name where it has one, and where its pixels are,
-                // for `rtgi info` and messages.
-                let source = match images[index].source() {
-                    gltf::image::Source::Uri { uri, .. } if uri.starts_with("data:") => "a data URI".to_owned(),
-                    gltf::image::Source::Uri { uri, .. } => format!("'{uri}'"),
-                    gltf::image::Source::View { view, .. } => format!("buffer view {}", view.index()),
-                };
-                let name = match images[index].name() {
-                    Some(name) => format!("image {index} '{name}' from {source}"),
-                    None => format!("image {index} from {source}"),
-                };
-                Texture::decode(bytes, &name, encoding).map(|t| t.with_wrap(wrap_u, wrap_v))
-            })
-            .collect();
-        let mut ids = HashMap::new();
-        for (key, texture) in wanted.into_iter().zip(decoded) {
-            let texture = texture.unwrap_or_else(|message| {
+            let name = match images[index].name() {
+                Some(name) => format!("image {index} '{name}' from {source}"),
+                None => format!("image {index} from {source}"),
+            };
+            let bytes = read[&index].as_ref().map_err(Clone::clone)?;
+            Texture::decode(bytes, &name, encoding)
+        })
+        .collect();
+    let decoded: Vec<Texture> = decoded
+        .into_iter()
+        .map(|texture| {
+            texture.unwrap_or_else(|message| {
                 scene.warnings.push(message.clone());
                 Texture::missing(message)
-            });
-            ids.insert(key, TextureId(scene.textures.len() as u32));
-            scene.textures.push(texture);
-        }
-        Self { ids }
-    }
-
-    fn get(&self, texture: gltf::Texture<'_>, srgb: bool) -> Option<TextureId> {
-        self.ids.get(&texture_key(&texture, srgb)).copied()
+            })
+        })
+        .collect();
+    for request in &textures.requests {
+        let at = decodings.iter().position(|d| *d == (request.image, request.srgb)).expect("every request is decoded");
+        let [wrap_u, wrap_v] = request.wrap;
+        scene.textures.push(decoded[at].clone().with_wrap(wrap_u, wrap_v).with_uv_map(request.uv_map));
     }
 }
 
-fn convert_material(m: &gltf::Material<'_>, textures: &TextureTable) -> Material {
-    let pbr = m.pbr_metallic_roughness();
-    let [r, g, b, a] = pbr.base_color_factor();
-    let emission = Vec3::from(m.emissive_factor()) * m.emissive_strength().unwrap_or(1.0);
-    Material {
-        name: m.name().unwrap_or("unnamed").to_owned(),
-        model: SurfaceModel::MetallicRoughness,
-        base_color: Vec3::new(r, g, b),
-        base_color_texture: pbr.base_color_texture().and_then(|i| textures.get(i.texture(), true)),
-        specular: Vec3::ZERO,
-        shininess: 0.0,
-        roughness: pbr.roughness_factor(),
-        emission,
-        ior: m.ior().unwrap_or(1.5),
-        opacity: a,
-        metallic: pbr.metallic_factor(),
-        metallic_roughness_texture: pbr.metallic_roughness_texture().and_then(|i| textures.get(i.texture(), false)),
-        emission_texture: m.emissive_texture().and_then(|i| textures.get(i.texture(), true)),
-        normal_texture: m.normal_texture().and_then(|n| textures.get(n.texture(), false).map(|t| (t, n.scale()))),
-        transmission: m.transmission().map_or(0.0, |t| t.transmission_factor()),
-        transmission_texture: m
-            .transmission()
-            .and_then(|t| t.transmission_texture())
-            .and_then(|i| textures.get(i.texture(), false)),
-        alpha_mode: match m.alpha_mode() {
-            gltf::material::AlphaMode::Opaque => AlphaMode::Opaque,
-            gltf::material::AlphaMode::Mask => AlphaMode::Mask { cutoff: m.alpha_cutoff().unwrap_or(0.5) },
-            gltf::material::AlphaMode::Blend => AlphaMode::Blend,
-        },
-        alpha_texture: None,
-        double_sided: m.double_sided(),
+/// The index of the material variant `name` (KHR_materials_variants), or an
+/// error listing the file's variants.
+fn choose_variant(document: &gltf::Document, name: Option<&str>) -> Result<Option<u32>, String> {
+    let Some(name) = name else { return Ok(None) };
+    let variants: Vec<String> = document.variants().into_iter().flatten().map(|v| v.name().to_owned()).collect();
+    match variants.iter().position(|v| v == name) {
+        Some(index) => Ok(Some(index as u32)),
+        None if variants.is_empty() => Err(format!("there is no material variant '{name}': the file has none")),
+        None => Err(format!("there is no material variant '{name}' (the file's variants: {})", variants.join(", "))),
+    }
+}
+
+/// Which material a primitive gets: its variant's where one is chosen and
+/// maps it, else its own, else the default.
+#[derive(Clone, Copy)]
+struct MaterialChoice {
+    default: u32,
+    variant: Option<u32>,
+}
+
+impl MaterialChoice {
+    fn of(&self, primitive: &gltf::Primitive<'_>) -> u32 {
+        let mapped = self.variant.and_then(|variant| {
+            primitive.mappings().find(|m| m.variants().contains(&variant)).and_then(|m| m.material().index())
+        });
+        mapped.or(primitive.material().index()).map_or(self.default, |i| i as u32)
     }
 }
 
@@ -530,10 +527,11 @@ fn add_mesh(
     mesh: &gltf::Mesh<'_>,
     transform: &Mat4,
     buffers: &[Vec<u8>],
-    default_material: u32,
+    materials: MaterialChoice,
     scene: &mut Scene,
     skipped: &mut HashMap<String, usize>,
 ) -> Result<(), String> {
+    use gltf::mesh::Semantic;
     let normal_matrix = Mat3::from_mat4(*transform).inverse().transpose();
     // A mirroring transform turns counter-clockwise triangles clockwise.
     let flip = transform.determinant() < 0.0;
@@ -542,28 +540,46 @@ fn add_mesh(
             *skipped.entry(format!("{:?}", primitive.mode())).or_default() += 1;
             continue;
         }
-        let reader = primitive.reader(|buffer| buffers.get(buffer.index()).map(Vec::as_slice));
-        let Some(positions) = reader.read_positions() else {
+        // Attributes are read as floats whatever their type (KHR_mesh_quantization).
+        let attribute = |semantic: Semantic| primitive.get(&semantic);
+        let Some(positions) = attribute(Semantic::Positions) else {
             return Err(format!("mesh {} has a primitive without positions", mesh.index()));
         };
-        let positions: Vec<Vec3> = positions.map(|p| transform.transform_point3(Vec3::from(p))).collect();
-        let normals: Vec<Vec3> = reader
-            .read_normals()
-            .map(|n| n.map(|n| (normal_matrix * Vec3::from(n)).normalize_or_zero()).collect())
-            .unwrap_or_default();
-        let tangents: Vec<Vec4> = reader
-            .read_tangents()
-            .map(|t| {
-                t.map(|t| {
-                    let direction = (Mat3::from_mat4(*transform) * Vec3::new(t[0], t[1], t[2])).normalize_or_zero();
-                    // A mirroring transform also mirrors the bitangent.
-                    direction.extend(if flip { -t[3] } else { t[3] })
-                })
-                .collect()
+        let positions: Vec<Vec3> = read_floats(&positions, buffers, [0.0; 3])
+            .into_iter()
+            .map(|p| transform.transform_point3(Vec3::from(p)))
+            .collect();
+        let normals: Vec<Vec3> = attribute(Semantic::Normals)
+            .map(|a| {
+                let normals = read_floats(&a, buffers, [0.0; 3]);
+                normals.into_iter().map(|n| (normal_matrix * Vec3::from(n)).normalize_or_zero()).collect()
             })
             .unwrap_or_default();
-        let uvs: Vec<Vec2> =
-            reader.read_tex_coords(0).map(|t| t.into_f32().map(Vec2::from).collect()).unwrap_or_default();
+        let tangents: Vec<Vec4> = attribute(Semantic::Tangents)
+            .map(|a| {
+                let tangents = read_floats(&a, buffers, [0.0, 0.0, 0.0, 1.0]);
+                tangents
+                    .into_iter()
+                    .map(|t| {
+                        let direction = (Mat3::from_mat4(*transform) * Vec3::new(t[0], t[1], t[2])).normalize_or_zero();
+                        // A mirroring transform also mirrors the bitangent.
+                        direction.extend(if flip { -t[3] } else { t[3] })
+                    })
+                    .collect()
+            })
+            .unwrap_or_default();
+        let texture_coords = |set: u32| -> Vec<Vec2> {
+            attribute(Semantic::TexCoords(set))
+                .map(|a| read_floats(&a, buffers, [0.0; 2]).into_iter().map(Vec2::from).collect())
+                .filter(|uvs: &Vec<Vec2>| uvs.len() == positions.len())
+                .unwrap_or_default()
+        };
+        let (uvs, second_uvs) = (texture_coords(0), texture_coords(1));
+        let colors: Vec<Vec4> = attribute(Semantic::Colors(0))
+            .map(|a| read_floats(&a, buffers, [1.0; 4]).into_iter().map(Vec4::from).collect())
+            .filter(|colors: &Vec<Vec4>| colors.len() == positions.len())
+            .unwrap_or_default();
+        let reader = primitive.reader(|buffer| buffers.get(buffer.index()).map(Vec::as_slice));
         let indices: Vec<u32> = match reader.read_indices() {
             Some(indices) => indices.into_u32().collect(),
             None => (0..positions.len() as u32).collect(),
@@ -572,11 +588,14 @@ fn add_mesh(
             return Err(format!("mesh {} has index {bad} past its {} vertices", mesh.index(), positions.len()));
         }
         let has_normals = normals.len() == positions.len();
-        let has_uvs = uvs.len() == positions.len();
-        let material = primitive.material().index().map_or(default_material, |i| i as u32);
+        let has_uvs = !uvs.is_empty();
+        let material = materials.of(&primitive);
         // glTF asks for flat normals where a mesh has none.
         let tangents = if has_normals && tangents.len() == normals.len() { tangents } else { Vec::new() };
-        let mut builder = MeshBuilder::new(positions, uvs, normals).with_flat_normals().with_tangents(tangents);
+        let mut builder = MeshBuilder::new(positions, uvs, normals)
+            .with_flat_normals()
+            .with_tangents(tangents)
+            .with_per_position(second_uvs, colors);
         for t in indices.chunks_exact(3) {
             let corners = if flip { [t[0], t[2], t[1]] } else { [t[0], t[1], t[2]] };
             builder.push(corners, has_uvs.then_some(corners), has_normals.then_some(corners), material);

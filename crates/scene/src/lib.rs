@@ -30,10 +30,14 @@ mod camera;
 pub mod description;
 mod files;
 pub use files::{DEFAULT_MAX_TRIANGLES, FileReader, LoadOptions};
+mod gltf_accessor;
+mod gltf_extensions;
 mod gltf_import;
-pub use gltf_import::SUPPORTED_GLTF_EXTENSIONS;
+mod gltf_material;
+pub use gltf_extensions::{ExtensionSupport, GLTF_EXTENSIONS, gltf_extension_support, supported_gltf_extensions};
 mod light;
 mod material;
+mod material_layers;
 mod mesh;
 mod mtl;
 pub mod obj;
@@ -44,9 +48,10 @@ mod texture;
 pub use camera::Camera;
 pub use light::{Light, LightKind, LightSpecError};
 pub use material::{AlphaMode, Material, SurfaceModel};
+pub use material_layers::{Anisotropy, Clearcoat, DielectricSpecular, Iridescence, Sheen, Volume};
 pub use mesh::MeshBuilder;
 pub use resolve::resolve_case_insensitive;
-pub use texture::{ColorEncoding, MAX_TEXTURE_BYTES, MAX_TEXTURE_SIDE, Texture, TextureId, Wrap};
+pub use texture::{ColorEncoding, MAX_TEXTURE_BYTES, MAX_TEXTURE_SIDE, Texture, TextureId, UvMap, Wrap};
 
 use std::path::{Path, PathBuf};
 
@@ -62,6 +67,12 @@ pub struct Vertex {
     /// Texture coordinates with the origin at the top left of the image (OBJ's
     /// bottom-left `v` is flipped on import).
     pub uv: Vec2,
+    /// The second set of texture coordinates (glTF's `TEXCOORD_1`), for
+    /// textures whose [`UvMap`] reads set 1; zero where the file has none.
+    pub uv1: Vec2,
+    /// The vertex colour (glTF's `COLOR_0`, linear RGBA), which multiplies
+    /// the base colour; white where the file has none.
+    pub color: Vec4,
     /// Unit tangent along increasing u, perpendicular to the normal, for
     /// normal maps; `w` (±1) gives the bitangent: `cross(normal, tangent) * w`.
     /// From the file where it has them, else computed from the texture
@@ -95,6 +106,9 @@ pub struct Scene {
     pub lights: Vec<Light>,
     /// The format extensions the file uses (glTF's `extensionsUsed`).
     pub extensions_used: Vec<String>,
+    /// The names of the file's material variants (glTF's
+    /// KHR_materials_variants), of which [`LoadOptions::gltf_variant`] chose one.
+    pub material_variants: Vec<String>,
     /// The up direction the file's format fixes: +Y for glTF, whose
     /// specification makes +Y up. `None` where the format has no
     /// convention (OBJ), so that a renderer may judge it from the model.
@@ -144,6 +158,20 @@ pub enum SceneError {
         path: PathBuf,
         /// What is wrong, naming the accessor, node or image where known.
         message: String,
+    },
+    /// The glTF file requires an extension rtgi does not support: the file
+    /// may be valid, but rtgi cannot render it.
+    #[error(
+        "{path} uses {extension}, which rtgi does not support ({lacks}); it supports: {}",
+        supported_gltf_extensions().collect::<Vec<_>>().join(", ")
+    )]
+    UnsupportedGltfExtension {
+        /// The file.
+        path: PathBuf,
+        /// The extension the file lists in `extensionsRequired`.
+        extension: String,
+        /// What rendering without it would lose.
+        lacks: &'static str,
     },
     /// The file's extension is none of `.obj`, `.gltf`, `.glb`, `.toml`.
     #[error("{path}: unsupported scene format (expected .obj, .gltf, .glb or .toml)")]
@@ -269,8 +297,18 @@ impl Scene {
         self.cameras.extend(other.cameras);
         self.lights.extend(other.lights);
         self.extensions_used.extend(other.extensions_used);
+        self.material_variants.extend(other.material_variants);
         self.warnings.extend(other.warnings);
         self.sources.extend(other.sources);
+    }
+
+    /// Both texture coordinate sets at barycentric coordinates `(beta,
+    /// gamma)`, for [`Texture::lookup`].
+    #[inline]
+    pub fn texture_coords(&self, triangle: &Triangle, beta: f32, gamma: f32) -> [Vec2; 2] {
+        let [a, b, c] = triangle.vertices.map(|v| &self.vertices[v as usize]);
+        let alpha = 1.0 - beta - gamma;
+        [a.uv * alpha + b.uv * beta + c.uv * gamma, a.uv1 * alpha + b.uv1 * beta + c.uv1 * gamma]
     }
 
     /// Interpolates a vertex attribute at barycentric coordinates `(beta, gamma)`.

@@ -1,6 +1,7 @@
 use rtgi_math::Vec3;
 
 use crate::TextureId;
+use crate::material_layers::{Anisotropy, Clearcoat, DielectricSpecular, Iridescence, Sheen, Volume};
 
 /// A surface's appearance.
 ///
@@ -21,6 +22,11 @@ use crate::TextureId;
 /// scale, emissive factor (times KHR_materials_emissive_strength) and
 /// texture, alpha mode and cutoff, double-sided, KHR_materials_transmission
 /// (factor and texture) and KHR_materials_ior; `specular` and `shininess` stay zero.
+/// The extensions of glTF's layered material fill the layer fields
+/// ([`dielectric_specular`](Self::dielectric_specular), [`sheen`](Self::sheen),
+/// [`clearcoat`](Self::clearcoat), [`iridescence`](Self::iridescence),
+/// [`anisotropy`](Self::anisotropy), [`volume`](Self::volume)), and
+/// KHR_materials_unlit sets [`unlit`](Self::unlit).
 #[derive(Clone, Debug, PartialEq)]
 pub struct Material {
     /// The name the file gives the material (`newmtl`, or glTF's `name`).
@@ -64,6 +70,23 @@ pub struct Material {
     pub alpha_texture: Option<TextureId>,
     /// Whether the back side is lit as the front (glTF); OBJ surfaces are two-sided.
     pub double_sided: bool,
+    /// The camera sees the base colour as it is, unshaded, and the surface
+    /// reflects no light (KHR_materials_unlit).
+    pub unlit: bool,
+    /// The strength and tint of a dielectric's specular reflection (KHR_materials_specular).
+    pub dielectric_specular: DielectricSpecular,
+    /// A fabric sheen over the base (KHR_materials_sheen).
+    pub sheen: Option<Sheen>,
+    /// A clear coat over everything else (KHR_materials_clearcoat).
+    pub clearcoat: Option<Clearcoat>,
+    /// Thin-film interference on the base's Fresnel reflection (KHR_materials_iridescence).
+    pub iridescence: Option<Iridescence>,
+    /// Stretched microfacets (KHR_materials_anisotropy).
+    pub anisotropy: Option<Anisotropy>,
+    /// The medium inside a transmitting mesh (KHR_materials_volume).
+    pub volume: Option<Volume>,
+    /// KHR_materials_dispersion's `dispersion` (20 / Abbe number); 0 is none.
+    pub dispersion: f32,
 }
 
 /// The two ways the importers describe reflectance.
@@ -113,6 +136,14 @@ impl Default for Material {
             alpha_mode: AlphaMode::Opaque,
             alpha_texture: None,
             double_sided: true,
+            unlit: false,
+            dielectric_specular: DielectricSpecular::default(),
+            sheen: None,
+            clearcoat: None,
+            iridescence: None,
+            anisotropy: None,
+            volume: None,
+            dispersion: 0.0,
         }
     }
 }
@@ -123,20 +154,41 @@ impl Material {
         self.emission.max_element() > 0.0
     }
 
-    /// Shifts texture references when scenes are merged.
-    pub(crate) fn offset_textures(&mut self, base: u32) {
-        for t in [
+    fn texture_slots_mut(&mut self) -> Vec<&mut TextureId> {
+        let mut slots: Vec<&mut Option<TextureId>> = vec![
             &mut self.base_color_texture,
             &mut self.metallic_roughness_texture,
             &mut self.emission_texture,
             &mut self.transmission_texture,
-        ]
-        .into_iter()
-        .flatten()
-        {
-            t.0 += base;
+            &mut self.alpha_texture,
+            &mut self.dielectric_specular.factor_texture,
+            &mut self.dielectric_specular.color_texture,
+        ];
+        if let Some(sheen) = &mut self.sheen {
+            slots.extend([&mut sheen.color_texture, &mut sheen.roughness_texture]);
         }
-        if let Some((t, _)) = &mut self.normal_texture {
+        let mut normal_maps: Vec<&mut Option<(TextureId, f32)>> = vec![&mut self.normal_texture];
+        if let Some(coat) = &mut self.clearcoat {
+            slots.extend([&mut coat.factor_texture, &mut coat.roughness_texture]);
+            normal_maps.push(&mut coat.normal_texture);
+        }
+        if let Some(film) = &mut self.iridescence {
+            slots.extend([&mut film.factor_texture, &mut film.thickness_texture]);
+        }
+        if let Some(anisotropy) = &mut self.anisotropy {
+            slots.push(&mut anisotropy.texture);
+        }
+        if let Some(volume) = &mut self.volume {
+            slots.push(&mut volume.thickness_texture);
+        }
+        let mut ids: Vec<&mut TextureId> = slots.into_iter().flatten().collect();
+        ids.extend(normal_maps.into_iter().flatten().map(|(t, _)| t));
+        ids
+    }
+
+    /// Shifts texture references when scenes are merged.
+    pub(crate) fn offset_textures(&mut self, base: u32) {
+        for t in self.texture_slots_mut() {
             t.0 += base;
         }
     }

@@ -40,6 +40,11 @@ pub struct MeshBuilder {
     crease_angle_degrees: f32,
     /// Tangents given by the file, indexed like the normals.
     tangents: Vec<Vec4>,
+    /// A second texture coordinate set, indexed like the positions (glTF's
+    /// `TEXCOORD_1`, whose index is the position's); empty where there is none.
+    second_uvs: Vec<Vec2>,
+    /// Vertex colours, indexed like the positions; empty where there are none.
+    colors: Vec<Vec4>,
 }
 
 impl MeshBuilder {
@@ -52,7 +57,18 @@ impl MeshBuilder {
             faces: Vec::new(),
             crease_angle_degrees: CREASE_ANGLE_DEGREES,
             tangents: Vec::new(),
+            second_uvs: Vec::new(),
+            colors: Vec::new(),
         }
+    }
+
+    /// A second texture coordinate set and vertex colours, one per
+    /// position (either may be empty): formats such as glTF index every
+    /// attribute of a vertex with the position's index.
+    pub fn with_per_position(mut self, second_uvs: Vec<Vec2>, colors: Vec<Vec4>) -> Self {
+        self.second_uvs = second_uvs;
+        self.colors = colors;
+        self
     }
 
     /// Tangents from the file, one per normal; they are used where faces
@@ -109,6 +125,8 @@ impl MeshBuilder {
                         position: self.positions[position_index as usize],
                         normal,
                         uv: face.uvs.map_or(Vec2::ZERO, |u| self.uvs[u[corner] as usize]),
+                        uv1: self.second_uvs.get(position_index as usize).copied().unwrap_or(Vec2::ZERO),
+                        color: self.colors.get(position_index as usize).copied().unwrap_or(Vec4::ONE),
                         tangent: tangent.unwrap_or(Vec4::ZERO),
                     });
                     scene.vertices.len() as u32 - 1

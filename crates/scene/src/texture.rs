@@ -1,8 +1,8 @@
 use std::ops::{Add, Mul};
 use std::path::Path;
-use std::sync::{LazyLock, OnceLock};
+use std::sync::{Arc, LazyLock, OnceLock};
 
-use rtgi_math::{Vec2, Vec4};
+use rtgi_math::{Vec2, Vec3, Vec4};
 
 use crate::texel_range::TexelRanges;
 
@@ -61,18 +61,80 @@ impl Wrap {
     }
 }
 
-/// An 8-bit RGBA image, sampled with bilinear filtering and its wrap modes.
+/// Which texture coordinates a texture reads, and how it transforms them
+/// (glTF's `texCoord` and KHR_texture_transform): the coordinates of set
+/// [`set`](Self::set), mapped by an affine transform.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct UvMap {
+    /// The vertex's texture coordinate set: 0 ([`Vertex::uv`](crate::Vertex::uv)) or 1 ([`Vertex::uv1`](crate::Vertex::uv1)).
+    pub set: u8,
+    /// Rows of the 2 × 3 affine matrix applied to the coordinates: `u' = m[0] · (u, v, 1)`, `v' = m[1] · (u, v, 1)`.
+    pub matrix: [Vec3; 2],
+}
+
+impl Default for UvMap {
+    fn default() -> Self {
+        UvMap::IDENTITY
+    }
+}
+
+impl UvMap {
+    /// Set 0, untransformed.
+    pub const IDENTITY: UvMap = UvMap { set: 0, matrix: [Vec3::X, Vec3::Y] };
+
+    /// KHR_texture_transform's `offset`, `rotation` (radians) and `scale`
+    /// on set `set`: the matrix translation · rotation · scale of the
+    /// extension's specification, where rotation turns (u, v) by
+    /// `[cos r, sin r; -sin r, cos r]`.
+    pub fn from_offset_rotation_scale(set: u8, offset: Vec2, rotation: f32, scale: Vec2) -> UvMap {
+        let (sin, cos) = rotation.sin_cos();
+        UvMap {
+            set,
+            matrix: [
+                Vec3::new(cos * scale.x, sin * scale.y, offset.x),
+                Vec3::new(-sin * scale.x, cos * scale.y, offset.y),
+            ],
+        }
+    }
+
+    /// Whether the map reads set 0 untransformed.
+    pub fn is_identity(&self) -> bool {
+        *self == UvMap::IDENTITY
+    }
+
+    /// The coordinates a lookup reads, from a point's two coordinate sets.
+    #[inline]
+    pub fn apply(&self, coords: [Vec2; 2]) -> Vec2 {
+        self.transform(coords[(self.set as usize).min(1)])
+    }
+
+    /// Coordinates of the map's set, transformed (the identity's bits are kept).
+    #[inline]
+    pub fn transform(&self, uv: Vec2) -> Vec2 {
+        if self.matrix == UvMap::IDENTITY.matrix {
+            return uv;
+        }
+        let uv = uv.extend(1.0);
+        Vec2::new(self.matrix[0].dot(uv), self.matrix[1].dot(uv))
+    }
+}
+
+/// An 8-bit RGBA image, sampled with bilinear filtering and its wrap modes,
+/// at the coordinates its [`UvMap`] picks.
 ///
 /// Texels are kept as bytes (a quarter of the memory of floats) and decoded
-/// through a table on lookup.
+/// through a table on lookup; textures that differ only in their map or
+/// wrap modes share them.
 #[derive(Clone, PartialEq)]
 pub struct Texture {
     /// Where the texture came from, for messages.
     pub name: String,
     width: u32,
     height: u32,
-    texels: Vec<[u8; 4]>,
+    texels: Arc<[[u8; 4]]>,
     encoding: ColorEncoding,
+    /// The coordinates it reads.
+    uv_map: UvMap,
     /// Wrap modes along u and v.
     wrap: [Wrap; 2],
     /// Whether any texel is less than fully opaque: asked for every
@@ -140,8 +202,9 @@ impl Texture {
             width,
             height,
             has_alpha: texels.iter().any(|t| t[3] < 255),
-            texels,
+            texels: texels.into(),
             encoding,
+            uv_map: UvMap::IDENTITY,
             wrap: [Wrap::Repeat; 2],
             ranges: Default::default(),
         })
@@ -152,6 +215,25 @@ impl Texture {
     pub fn with_wrap(mut self, u: Wrap, v: Wrap) -> Self {
         self.wrap = [u, v];
         self
+    }
+
+    /// This texture reading the coordinates `map` picks (the texels are shared, not copied).
+    #[must_use]
+    pub fn with_uv_map(mut self, map: UvMap) -> Self {
+        self.uv_map = map;
+        self
+    }
+
+    /// The coordinates the texture reads.
+    pub fn uv_map(&self) -> &UvMap {
+        &self.uv_map
+    }
+
+    /// The linear value at a point whose coordinate sets are `coords`
+    /// ([`Scene::texture_coords`](crate::Scene::texture_coords)), through the texture's [`UvMap`].
+    #[inline]
+    pub fn lookup(&self, coords: [Vec2; 2]) -> Vec4 {
+        self.sample(self.uv_map.apply(coords))
     }
 
     /// Decodes a PNG or JPEG file.
@@ -198,6 +280,7 @@ impl Texture {
             height: 8,
             texels: texels.collect(),
             encoding: ColorEncoding::Srgb,
+            uv_map: UvMap::IDENTITY,
             wrap: [Wrap::Repeat; 2],
             has_alpha: false,
             ranges: Default::default(),

@@ -213,13 +213,18 @@ fn info_numbers_cameras_and_names_texture_files() {
     assert_eq!((&texture["width"], &texture["height"]), (&2048.into(), &2048.into()));
     let (json, _) = summary(&["info", path_str(&cameras)]);
     assert_eq!(json["cameras"][0]["position"], serde_json::json!([0.5, 0.5, 3.0]), "{json}");
+    // KHR_xmp is metadata: listed as nothing to render, with no warning.
     let (json, stderr) = summary(&["info", path_str(&transmission)]);
-    assert_eq!(json["extensions_unsupported"], serde_json::json!(["KHR_xmp"]), "{json}");
-    assert_eq!(json["warnings"].as_array().unwrap().iter().filter(|w| w.to_string().contains("KHR_xmp")).count(), 1);
-    assert_eq!(stderr.matches("KHR_xmp is not supported").count(), 1, "warned once: {stderr}");
-    // The text marks it.
+    assert_eq!(json["extensions_unsupported"], serde_json::json!([]), "{json}");
+    let xmp = json["extensions"].as_array().unwrap().iter().find(|e| e["name"] == "KHR_xmp").cloned();
+    assert_eq!(xmp.map(|e| e["support"].clone()), Some("not visual".into()), "{json}");
+    assert!(!stderr.contains("KHR_xmp"), "{stderr}");
     let run = rtgi(&["info", path_str(&transmission)]);
-    assert!(run.stdout.contains("KHR_xmp (ignored)"), "{}", run.stdout);
+    assert!(
+        run.stdout.lines().any(|l| l.contains("KHR_materials_transmission") && l.contains("simulated")),
+        "{}",
+        run.stdout
+    );
 }
 
 #[test]
