@@ -28,6 +28,18 @@ impl Frame {
         Self { x, y, z }
     }
 
+    /// A frame whose `z` is the given unit vector and whose `x` is `x_hint`
+    /// made perpendicular to it (an anisotropic surface's direction of
+    /// stretch); [`Frame::from_z`] where the hint is parallel to `z` or zero.
+    #[inline]
+    pub fn from_z_and_x(z: Vec3, x_hint: Vec3) -> Self {
+        let x = (x_hint - z * z.dot(x_hint)).normalize_or_zero();
+        if x == Vec3::ZERO {
+            return Self::from_z(z);
+        }
+        Self { x, y: z.cross(x), z }
+    }
+
     #[inline]
     /// `v` in this frame's coordinates (its components along `x`, `y`, `z`).
     pub fn to_local(&self, v: Vec3) -> Vec3 {
@@ -53,6 +65,17 @@ pub fn uniform_sphere(u: f32, v: f32) -> Vec3 {
 mod tests {
     use super::*;
     use proptest::prelude::*;
+
+    #[test]
+    fn a_frame_from_a_hint_points_x_along_it_and_falls_back_where_it_is_parallel() {
+        let z = Vec3::new(0.0, 0.6, 0.8);
+        let frame = Frame::from_z_and_x(z, Vec3::new(1.0, 1.0, 0.0));
+        assert!(frame.x.dot(z).abs() < 1e-6 && (frame.x.length() - 1.0).abs() < 1e-6);
+        assert!(frame.x.x > 0.7, "x follows the hint: {}", frame.x);
+        assert!((frame.x.cross(frame.y) - z).length() < 1e-6, "right-handed");
+        assert_eq!(Frame::from_z_and_x(z, z * 2.0), Frame::from_z(z));
+        assert_eq!(Frame::from_z_and_x(z, Vec3::ZERO), Frame::from_z(z));
+    }
 
     proptest! {
         #[test]

@@ -38,6 +38,14 @@ pub enum Effect {
     NormalMaps,
     /// Alpha tests: cut-outs and blended surfaces let rays through.
     Alpha,
+    /// A fabric's sheen over the base (glTF's KHR_materials_sheen).
+    Sheen,
+    /// A clear coat over the base (KHR_materials_clearcoat).
+    Clearcoat,
+    /// Thin-film interference colouring reflections (KHR_materials_iridescence).
+    Iridescence,
+    /// Highlights stretched along a direction (KHR_materials_anisotropy).
+    Anisotropy,
 }
 
 impl Effect {
@@ -52,6 +60,10 @@ impl Effect {
         Effect::Textures,
         Effect::NormalMaps,
         Effect::Alpha,
+        Effect::Sheen,
+        Effect::Clearcoat,
+        Effect::Iridescence,
+        Effect::Anisotropy,
     ];
 
     /// The effect's name in plans and overrides (`direct-light`, `glossy`, ...).
@@ -66,6 +78,26 @@ impl Effect {
             Effect::Textures => "textures",
             Effect::NormalMaps => "normal-maps",
             Effect::Alpha => "alpha",
+            Effect::Sheen => "sheen",
+            Effect::Clearcoat => "clearcoat",
+            Effect::Iridescence => "iridescence",
+            Effect::Anisotropy => "anisotropy",
+        }
+    }
+
+    /// The layers of glTF's material besides its base: each is simulated
+    /// only where a material has it, and forcing one on where none has it
+    /// changes nothing.
+    pub const LAYERS: &'static [Effect] = &[Effect::Sheen, Effect::Clearcoat, Effect::Iridescence, Effect::Anisotropy];
+
+    /// Whether `material` has the layer `self` (false for effects that are not layers).
+    pub fn layer_of(self, material: &Material) -> bool {
+        match self {
+            Effect::Sheen => material.sheen.is_some(),
+            Effect::Clearcoat => material.clearcoat.is_some(),
+            Effect::Iridescence => material.iridescence.is_some(),
+            Effect::Anisotropy => material.anisotropy.is_some(),
+            _ => false,
         }
     }
 }
@@ -251,10 +283,12 @@ pub(crate) fn transmits(m: &Material) -> bool {
 }
 
 fn is_textured(m: &Material) -> bool {
-    m.base_color_texture.is_some()
-        || m.metallic_roughness_texture.is_some()
-        || m.emission_texture.is_some()
-        || m.transmission_texture.is_some()
+    !m.textures().is_empty()
+}
+
+/// The materials (of those in use) that have the layer `layer`.
+fn with_layer<'m>(used: &[&'m Material], layer: Effect) -> Vec<&'m Material> {
+    used.iter().copied().filter(|m| layer.layer_of(m)).collect()
 }
 
 /// Emitters whose power is below this fraction of what the default sky
@@ -459,10 +493,10 @@ impl EffectPlan {
         };
 
         let glossy = with(is_glossy);
-        if !lighting {
-            decide(Effect::Glossy, false, not_lit());
+        let glossy_enabled = if !lighting {
+            decide(Effect::Glossy, false, not_lit())
         } else if glossy.is_empty() {
-            decide(Effect::Glossy, false, "every material is diffuse".into());
+            decide(Effect::Glossy, false, "every material is diffuse".into())
         } else {
             // MTL sums beyond 1 are scaled down as the surfaces are shaded (`energy_conserving`); say so.
             let excess = |m: &Material| (m.base_color + m.specular).max_element();
@@ -491,8 +525,8 @@ impl EffectPlan {
                     agree(glossy.len(), "reflects"),
                     names(&glossy)
                 ),
-            );
-        }
+            )
+        };
 
         let refracting = with(transmits);
         if !lighting {
@@ -537,6 +571,24 @@ impl EffectPlan {
                 true,
                 format!("{} with alpha (mask or blend): {}", count(masked.len(), "material"), names(&masked)),
             );
+        }
+
+        for &layer in Effect::LAYERS {
+            let layered = with_layer(&used, layer);
+            if !lighting {
+                decide(layer, false, not_lit());
+            } else if layered.is_empty() {
+                decide(layer, false, format!("no material has {layer}"));
+            } else if !glossy_enabled {
+                decide(layer, false, format!("glossy reflection is off, and {layer} is a glossy layer"));
+            } else {
+                let n = layered.len();
+                decide(
+                    layer,
+                    true,
+                    format!("{} {} {layer}: {}", count(n, "material"), agree(n, "has"), names(&layered)),
+                );
+            }
         }
 
         let default_environment = default_environment && environment;
@@ -591,6 +643,10 @@ impl EffectPlan {
             .iter()
             .filter_map(|effect| {
                 let planned = enabled.contains(effect);
+                // Forcing on a layer no material has would change nothing.
+                if !planned && Effect::LAYERS.contains(&effect) && !scene.materials.iter().any(|m| effect.layer_of(m)) {
+                    return None;
+                }
                 let mut effects = settings.effects.clone();
                 if planned {
                     effects.off.insert(effect);

@@ -154,6 +154,12 @@ impl Material {
         self.emission.max_element() > 0.0
     }
 
+    /// Every texture the material refers to.
+    pub fn textures(&self) -> Vec<TextureId> {
+        // A copy, so that one list of the slots serves both directions.
+        self.clone().texture_slots_mut().into_iter().map(|t| *t).collect()
+    }
+
     fn texture_slots_mut(&mut self) -> Vec<&mut TextureId> {
         let mut slots: Vec<&mut Option<TextureId>> = vec![
             &mut self.base_color_texture,

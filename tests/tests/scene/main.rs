@@ -4,6 +4,7 @@
 //! One test binary for the theme, a module a file.
 
 mod gltf;
+mod gltf_extensions;
 mod gltf_orientation;
 mod gltf_references;
 mod loader_api;
