@@ -236,8 +236,8 @@ pub(crate) fn render_given(args: &RenderArgs, given: Option<Given<'_>>) -> Resul
     if let Some(light) = &room_light {
         let p = light.position;
         say!(
-            "  note: the camera is enclosed by the scene (no sky reaches it) and nothing emits light, so a lamp \
-             at {:.3},{:.3},{:.3} hangs over the room in view; --light or --environment chooses others",
+            "  note: no sky reaches the camera or the surfaces it sees, and the scene's own lights leave them \
+             dark, so a lamp at {:.3},{:.3},{:.3} hangs over the room in view; --light or --environment chooses others",
             p.x,
             p.y,
             p.z

@@ -294,6 +294,11 @@ pub fn default_sampler(samples_per_pixel: u32) -> PixelSampler {
 /// For a camera that no sky can reach (a closed room) in a scene that
 /// would get the default sky and sun, adds a point light over the room in
 /// view ([`room_light`]) and returns it: otherwise the image would be black.
+///
+/// Enclosure is judged by the surfaces in view, not the camera alone: a
+/// camera in a pocket of an open world (a hollow in a voxel terrain) sees
+/// surfaces the sky reaches, and a cave lit by its own lava sees surfaces
+/// its emitters light, however weak they are beside a sky; neither gets a lamp.
 pub fn light_enclosed_camera(
     scene: &mut Scene,
     accel: &dyn Accel,
@@ -303,10 +308,22 @@ pub fn light_enclosed_camera(
     if !EffectPlan::new(scene, settings).default_environment || sky_visibility(accel, camera.position) >= ENCLOSED {
         return None;
     }
+    let aspect = settings.width as f32 / settings.height.max(1) as f32;
+    if let Some(view) = view_light(scene, accel, camera, aspect, settings.up)
+        && (view.sky >= OPEN_VIEW_IRRADIANCE || view.own >= OPEN_VIEW_IRRADIANCE)
+    {
+        return None;
+    }
     let light = room_light(scene, accel, camera, settings.up);
     scene.lights.push(light.clone());
     Some(light)
 }
+
+/// The mean irradiance on the surfaces in view (from the default sky and
+/// sun, or from the scene's own lights) from which a view counts as lit
+/// without a lamp: a fiftieth of the π that the room lamp brings to the
+/// point the camera looks at.
+const OPEN_VIEW_IRRADIANCE: f32 = UNLIT_VIEW * std::f32::consts::PI;
 
 /// For a scene whose own lights would get no default sky, probes the view
 /// ([`view_light`]): when they leave it dark, marks the settings so that

@@ -157,6 +157,9 @@ pub(crate) fn convert_material(
     let pbr = m.pbr_metallic_roughness();
     let [r, g, b, a] = pbr.base_color_factor();
     let emission = Vec3::from(m.emissive_factor()) * m.emissive_strength().unwrap_or(1.0);
+    // Requested in the order of the core material's slots, so that textures are numbered as the material lists them.
+    let base_color_texture = textures.info(pbr.base_color_texture(), true);
+    let metallic_roughness_texture = textures.info(pbr.metallic_roughness_texture(), false);
     let normal_texture = m.normal_texture().map(|n| {
         let transform = n.extension_value("KHR_texture_transform").map(Transform::from_json);
         (textures.request(&n.texture(), false, n.tex_coord(), transform), n.scale())
@@ -207,7 +210,7 @@ pub(crate) fn convert_material(
         name: m.name().unwrap_or("unnamed").to_owned(),
         model: SurfaceModel::MetallicRoughness,
         base_color: Vec3::new(r, g, b),
-        base_color_texture: textures.info(pbr.base_color_texture(), true),
+        base_color_texture,
         specular: Vec3::ZERO,
         shininess: 0.0,
         roughness: pbr.roughness_factor(),
@@ -215,7 +218,7 @@ pub(crate) fn convert_material(
         ior: m.ior().unwrap_or(1.5),
         opacity: a,
         metallic: pbr.metallic_factor(),
-        metallic_roughness_texture: textures.info(pbr.metallic_roughness_texture(), false),
+        metallic_roughness_texture,
         emission_texture: textures.info(m.emissive_texture(), true),
         normal_texture,
         transmission: m.transmission().map_or(0.0, |t| t.transmission_factor()),

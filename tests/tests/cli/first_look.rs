@@ -75,7 +75,33 @@ fn an_enclosed_unlit_view_gets_a_room_light_and_says_so() {
     assert_eq!(lamp.len(), 3, "{json}");
     assert!(json["legibility"].is_null(), "{json}");
     let run = render_room(&dir.join("room.png"), &[]);
-    assert!(run.stdout.contains("note: the camera is enclosed by the scene"), "{run:?}");
+    assert!(run.stdout.contains("note: no sky reaches the camera or the surfaces it sees"), "{run:?}");
+}
+
+/// A cave in a large world (McGuire's lost_empire: a voxel world whose lava
+/// is weak beside a sky over the whole world): the closed room with a small
+/// glowing patch on its ceiling and a wall far away. The emitters are too
+/// weak to light the world, so the plan keeps the default sky; but they
+/// light the view, so the cave gets no lamp, and nothing says nothing emits.
+#[test]
+fn an_enclosed_view_lit_by_the_scenes_own_weak_emitters_gets_no_lamp() {
+    let dir = scratch_dir("lit-cave");
+    let room = std::fs::read_to_string(workspace_root().join("tests/scenes/closed-room.obj")).unwrap();
+    let extra = "mtllib lava.mtl\nv -0.1 0.99 -0.1\nv 0.1 0.99 -0.1\nv 0.1 0.99 0.1\nv -0.1 0.99 0.1\n\
+                 usemtl lava\nf 9 10 11 12\nv 100 -1 -100\nv 100 -1 100\nv 100 100 100\nusemtl rock\nf 13 14 15\n";
+    std::fs::write(dir.join("cave.obj"), format!("{room}{extra}")).unwrap();
+    std::fs::write(dir.join("lava.mtl"), "newmtl lava\nKd 0 0 0\nKe 50 20 5\nnewmtl rock\nKd 0.5 0.5 0.5\n").unwrap();
+    let toml = "[[mesh]]\nfile = \"cave.obj\"\n[camera]\nposition = [0.0, 0.0, 0.0]\ndirection = [0.0, -0.3, -1.0]\nup = [0.0, 1.0, 0.0]\nvertical_fov_degrees = 60.0\n";
+    std::fs::write(dir.join("cave.toml"), toml).unwrap();
+    let (scene, out) = (dir.join("cave.toml"), dir.join("cave.png"));
+    let args = ["render", path_str(&scene), "-o", path_str(&out), "--width", "32", "--height", "32", "--spp", "2"];
+    let (json, _) = summary(&args);
+    assert!(json["room_light"].is_null(), "{json}");
+    let environment =
+        json["plan"]["effects"].as_array().unwrap().iter().find(|e| e["effect"] == "environment").cloned();
+    assert!(environment.is_some_and(|e| e["reason"].as_str().unwrap().contains("too little to light it")), "{json}");
+    let run = rtgi(&args);
+    assert!(!run.stdout.contains("nothing emits") && !run.stdout.contains("lamp"), "{run:?}");
 }
 
 #[test]
