@@ -49,6 +49,8 @@ struct MaterialInfo {
     transmission: f32,
     ior: f32,
     alpha: String,
+    /// What glTF's material extensions add: unlit, specular, sheen, clearcoat, ...
+    layers: Vec<String>,
 }
 
 #[derive(Debug, Serialize)]
@@ -120,6 +122,7 @@ pub(crate) fn run(args: &InfoArgs) -> Result<()> {
                 transmission: m.transmission,
                 ior: m.ior,
                 alpha: see_through(m),
+                layers: layers(m),
             })
             .collect(),
         textures: scene
@@ -191,6 +194,47 @@ pub(crate) fn run(args: &InfoArgs) -> Result<()> {
     Ok(())
 }
 
+/// The layers glTF's material extensions give a material, each with its factors.
+fn layers(m: &rtgi_scene::Material) -> Vec<String> {
+    let v = |c: rtgi_math::Vec3| format!("({:.3}, {:.3}, {:.3})", c.x, c.y, c.z);
+    let mut layers = Vec::new();
+    if m.unlit {
+        layers.push("unlit".to_owned());
+    }
+    let specular = &m.dielectric_specular;
+    if *specular != rtgi_scene::DielectricSpecular::default() {
+        layers.push(format!("specular {} colour {}", specular.factor, v(specular.color)));
+    }
+    if let Some(sheen) = &m.sheen {
+        layers.push(format!("sheen {} roughness {}", v(sheen.color), sheen.roughness));
+    }
+    if let Some(coat) = &m.clearcoat {
+        let normal = if coat.normal_texture.is_some() { " with its own normal map" } else { "" };
+        layers.push(format!("clearcoat {} roughness {}{normal}", coat.factor, coat.roughness));
+    }
+    if let Some(film) = &m.iridescence {
+        layers.push(format!(
+            "iridescence {} (film index {}, {}-{} nm)",
+            film.factor, film.ior, film.thickness_min, film.thickness_max
+        ));
+    }
+    if let Some(anisotropy) = &m.anisotropy {
+        layers.push(format!("anisotropy {} at {} rad", anisotropy.strength, anisotropy.rotation));
+    }
+    if let Some(volume) = &m.volume {
+        layers.push(format!(
+            "volume: thickness {}, attenuation {} over {}",
+            volume.thickness,
+            v(volume.attenuation_color),
+            volume.attenuation_distance
+        ));
+    }
+    if m.dispersion > 0.0 {
+        layers.push(format!("dispersion {} (approximated: no colour fringes)", m.dispersion));
+    }
+    layers
+}
+
 fn print_text(info: &Info) -> Result<()> {
     let v = |a: [f32; 3]| format!("({}, {}, {})", a[0], a[1], a[2]);
     outln!("scene       {}", info.scene)?;
@@ -221,6 +265,9 @@ fn print_text(info: &Info) -> Result<()> {
             v(m.emission),
             m.alpha
         )?;
+        if !m.layers.is_empty() {
+            outln!("  {:<24} {}", "", m.layers.join("; "))?;
+        }
     }
     outln!("textures    {}", info.textures.len())?;
     for (index, t) in info.textures.iter().enumerate() {

@@ -175,6 +175,10 @@ pub struct PlannedEffect {
     pub forced: bool,
     /// Why the effect is simulated or not.
     pub reason: String,
+    /// Whether anything in the scene calls for the effect at all: false for
+    /// a material layer no material has, which the printed plan leaves out.
+    #[serde(skip)]
+    pub applies: bool,
 }
 
 /// Which effects a render simulates, and why.
@@ -347,7 +351,7 @@ impl EffectPlan {
                 (_, true) if needed => format!("forced off ({reason})"),
                 _ => reason,
             };
-            effects.push(PlannedEffect { effect, enabled, forced, reason });
+            effects.push(PlannedEffect { effect, enabled, forced, reason, applies: true });
             enabled
         };
 
@@ -591,6 +595,12 @@ impl EffectPlan {
             }
         }
 
+        for e in effects.iter_mut() {
+            if Effect::LAYERS.contains(&e.effect) && !e.forced && with_layer(&used, e.effect).is_empty() {
+                e.applies = false;
+            }
+        }
+
         let default_environment = default_environment && environment;
         let max_depth = if indirect { max_depth } else { max_depth.min(1) };
         let indirect_clamp = settings.indirect_clamp.filter(|_| indirect);
@@ -673,7 +683,7 @@ impl fmt::Display for EffectPlan {
             _ => String::new(),
         };
         writeln!(f, "plan: {} integrator{depth}", self.integrator)?;
-        for e in &self.effects {
+        for e in self.effects.iter().filter(|e| e.applies) {
             let sign = if e.enabled { '+' } else { '-' };
             let forced = if e.forced { '!' } else { ' ' };
             writeln!(f, "  {sign}{forced}{:<13} {}", e.effect.name(), e.reason)?;
