@@ -580,16 +580,16 @@ fn glossy_probability(albedo: Vec3, reflectance: Vec3) -> f32 {
     (glossy / (diffuse + glossy)).clamp(0.1, 0.9)
 }
 
-fn to_upper(w: Vec3) -> Vec3 {
+pub(crate) fn to_upper(w: Vec3) -> Vec3 {
     Vec3::new(w.x, w.y, w.z.abs())
 }
 
 /// `w` mirrored to the upper hemisphere when `wo` is in the lower one.
-fn to_upper_with(w: Vec3, wo: Vec3) -> Vec3 {
+pub(crate) fn to_upper_with(w: Vec3, wo: Vec3) -> Vec3 {
     if wo.z < 0.0 { Vec3::new(w.x, w.y, -w.z) } else { w }
 }
 
-fn reflect(w: Vec3, n: Vec3) -> Vec3 {
+pub(crate) fn reflect(w: Vec3, n: Vec3) -> Vec3 {
     2.0 * w.dot(n) * n - w
 }
 

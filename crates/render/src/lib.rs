@@ -45,6 +45,7 @@ pub mod effects;
 mod framing;
 mod identity;
 mod integrator;
+pub mod layered;
 pub mod lights;
 pub mod probes;
 pub mod rays;
