@@ -9,6 +9,8 @@ use std::f32::consts::PI;
 
 use rtgi_math::{Vec2, Vec3};
 
+use crate::layered::PbrLayers;
+
 /// A direction drawn from a BSDF, with the BSDF's value there and the
 /// density it was drawn with (solid angle). `delta` marks perfectly specular
 /// directions, whose value and density are both Dirac deltas.
@@ -117,11 +119,19 @@ pub enum Bsdf {
         /// GGX width of the microfacets, in `(0, 1]`.
         alpha: f32,
     },
+    /// glTF's layered material: the metallic-roughness base with the
+    /// Fresnel of KHR_materials_ior and _specular, anisotropy and
+    /// iridescence, under sheen and clearcoat ([`PbrLayers`]). Used where a
+    /// material has any of these; the others keep [`Bsdf::MetallicRoughness`].
+    Layered(PbrLayers),
 }
 
 impl Bsdf {
     /// The BSDF's value for the pair of directions (zero for specular models).
     pub fn eval(&self, wo: Vec3, wi: Vec3) -> Vec3 {
+        if let Bsdf::Layered(layers) = self {
+            return layers.eval(wo, wi);
+        }
         if let Bsdf::RoughDielectric { ior, tint, alpha } = *self {
             return rough_dielectric(wo, wi, ior, alpha)
                 .map_or(Vec3::ZERO, |lobe| if lobe.transmitted { tint * lobe.value } else { Vec3::splat(lobe.value) });
@@ -142,7 +152,8 @@ impl Bsdf {
             | Bsdf::Dielectric { .. }
             | Bsdf::ThinDielectric { .. }
             | Bsdf::RoughDielectric { .. }
-            | Bsdf::RoughThinDielectric { .. } => Vec3::ZERO,
+            | Bsdf::RoughThinDielectric { .. }
+            | Bsdf::Layered(_) => Vec3::ZERO,
             Bsdf::Glossy { reflectance, alpha } => {
                 let wm = (wo + wi).normalize_or_zero();
                 if wm == Vec3::ZERO {
@@ -170,6 +181,9 @@ impl Bsdf {
 
     /// The density with which [`Bsdf::sample`] draws `wi` (zero for specular models).
     pub fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
+        if let Bsdf::Layered(layers) = self {
+            return layers.pdf(wo, wi);
+        }
         if let Bsdf::RoughDielectric { ior, alpha, .. } = *self {
             return rough_dielectric(wo, wi, ior, alpha).map_or(0.0, |lobe| lobe.pdf);
         }
@@ -186,7 +200,8 @@ impl Bsdf {
             | Bsdf::Dielectric { .. }
             | Bsdf::ThinDielectric { .. }
             | Bsdf::RoughDielectric { .. }
-            | Bsdf::RoughThinDielectric { .. } => 0.0,
+            | Bsdf::RoughThinDielectric { .. }
+            | Bsdf::Layered(_) => 0.0,
             Bsdf::Glossy { alpha, .. } => ggx_reflection_pdf(wo, wi, alpha),
             Bsdf::DiffuseGlossy { albedo, reflectance, alpha } => {
                 let p_glossy = glossy_probability(albedo, reflectance);
@@ -205,6 +220,7 @@ impl Bsdf {
     /// stretched back to [0, 1) for the chosen lobe.
     pub fn sample(&self, wo: Vec3, u: Vec2) -> Option<BsdfSample> {
         match *self {
+            Bsdf::Layered(layers) => return layers.sample(wo, u),
             Bsdf::Dielectric { ior, tint } => return Some(sample_dielectric(wo, ior, tint, u.x)),
             Bsdf::ThinDielectric { ior, tint } => return Some(sample_thin_dielectric(wo, ior, tint, u.x)),
             Bsdf::RoughDielectric { ior, alpha, .. } => {
@@ -265,7 +281,8 @@ impl Bsdf {
             Bsdf::Dielectric { .. }
             | Bsdf::ThinDielectric { .. }
             | Bsdf::RoughDielectric { .. }
-            | Bsdf::RoughThinDielectric { .. } => {
+            | Bsdf::RoughThinDielectric { .. }
+            | Bsdf::Layered(_) => {
                 unreachable!("sampled above")
             }
             Bsdf::Mirror { reflectance } => {
@@ -528,6 +545,7 @@ impl Bsdf {
             | Bsdf::ThinDielectric { tint, .. }
             | Bsdf::RoughDielectric { tint, .. }
             | Bsdf::RoughThinDielectric { tint, .. } => tint,
+            Bsdf::Layered(layers) => layers.nominal_albedo(),
         }
     }
 
@@ -556,6 +574,7 @@ impl Bsdf {
             Bsdf::RoughThinDielectric { ior, tint, alpha: own } => {
                 Bsdf::RoughThinDielectric { ior, tint, alpha: own.max(alpha) }
             }
+            Bsdf::Layered(layers) => Bsdf::Layered(layers.regularised(alpha)),
         }
     }
 }
@@ -670,6 +689,21 @@ mod tests {
             Bsdf::RoughThinDielectric { ior: 1.5, tint: Vec3::new(0.9, 0.8, 0.7), alpha: 0.3 },
             Bsdf::RoughDielectric { ior: 1.5, tint: Vec3::new(0.9, 0.8, 0.7), alpha: 0.3 },
             Bsdf::RoughDielectric { ior: 2.4, tint: Vec3::ONE, alpha: 0.4 },
+            Bsdf::Layered(crate::layered::PbrLayers {
+                alpha_x: 0.4,
+                alpha_y: 0.1,
+                ior: 1.7,
+                specular_factor: 0.8,
+                specular_color: Vec3::new(1.0, 0.8, 0.6),
+                iridescence: Some(crate::layered::Iridescence { factor: 0.7, ior: 1.3, thickness_nm: 350.0 }),
+                sheen: Some(crate::layered::Sheen { color: Vec3::new(0.3, 0.2, 0.4), roughness: 0.5 }),
+                clearcoat: Some(crate::layered::Clearcoat {
+                    factor: 0.8,
+                    alpha: 0.05,
+                    normal: Vec3::new(0.2, 0.0, 1.0).normalize(),
+                }),
+                ..crate::layered::PbrLayers::isotropic(Vec3::new(0.8, 0.4, 0.2), 0.3, 0.3)
+            }),
         ]
     }
 

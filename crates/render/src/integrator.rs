@@ -17,6 +17,7 @@ use crate::effects::{Effect, EffectPlan, is_glossy, transmits};
 use crate::lights::{Environment, LightSet};
 use crate::shade::closest_hit;
 use crate::shading_normal::bent_towards_view;
+use crate::surface_layers::{LayerInputs, LayerSwitches, needs_layers, pbr_layers};
 use crate::{BounceSampling, EffectSet, PathStart, RenderSettings};
 
 /// What the renderer computes for each pixel.
@@ -193,6 +194,8 @@ pub(crate) struct Transport<'a, A: Accel + ?Sized> {
     glossy: bool,
     refraction: bool,
     normal_maps: bool,
+    /// The layers of glTF's material the plan simulates.
+    layers: LayerSwitches,
     /// Normal and elongation of every triangle, for the points spawning rays.
     shapes: Vec<TriangleShape>,
     /// The alpha test of cut-outs, where the plan has them.
@@ -254,6 +257,12 @@ impl<'a, A: Accel + ?Sized> Transport<'a, A> {
             glossy: plan.has(Effect::Glossy),
             refraction: plan.has(Effect::Refraction),
             normal_maps: plan.has(Effect::NormalMaps),
+            layers: LayerSwitches {
+                sheen: plan.has(Effect::Sheen),
+                clearcoat: plan.has(Effect::Clearcoat),
+                iridescence: plan.has(Effect::Iridescence),
+                anisotropy: plan.has(Effect::Anisotropy),
+            },
             cut_outs: plan.has(Effect::Alpha).then(|| AlphaTest::new(scene)),
             shapes: scene
                 .triangles
@@ -487,6 +496,8 @@ impl<'a, A: Accel + ?Sized> Transport<'a, A> {
         let point =
             SurfacePoint::on_triangle_with_shape(&corners, hit.beta, hit.gamma, self.shapes[hit.triangle as usize]);
         let mut normal = scene.interpolate(triangle, hit.beta, hit.gamma, |v| v.normal);
+        // Before any normal map: a clear coat without a map of its own follows it.
+        let geometry_normal = normal;
         // COLOR_0 multiplies the base colour (white where a file has none).
         let vertex_color = scene.interpolate(triangle, hit.beta, hit.gamma, |v| v.color).truncate();
         let mut base_color = material.base_color * vertex_color;
@@ -529,14 +540,45 @@ impl<'a, A: Accel + ?Sized> Transport<'a, A> {
         if wo.dot(point.normal) > 0.0 {
             normal = bent_towards_view(normal, point.normal, wo);
         }
+        let mut frame = Frame::from_z(normal);
+        let layered = (compiled(S, Effect::Glossy)
+            && self.glossy
+            && material.model == SurfaceModel::MetallicRoughness
+            && needs_layers(material, self.layers))
+        .then(|| {
+            let coords = scene.texture_coords(triangle, hit.beta, hit.gamma);
+            let lookup = |id: rtgi_scene::TextureId| scene.textures[id.0 as usize].lookup(coords);
+            let geometry_normal = geometry_normal.normalize_or(normal);
+            let inputs = LayerInputs {
+                texture: compiled(S, Effect::Textures).then_some(&lookup as &dyn Fn(rtgi_scene::TextureId) -> Vec4),
+                base_color,
+                metallic,
+                roughness,
+                frame,
+                geometry_normal: if geometry_normal.dot(normal) < 0.0 { -geometry_normal } else { geometry_normal },
+                tangent: scene.interpolate(triangle, hit.beta, hit.gamma, |v| v.tangent),
+                perturb,
+            };
+            pbr_layers(material, self.layers, &inputs)
+        });
         let surface = SurfaceValues { base_color, roughness, metallic, transmission };
-        let (bsdf, weight) = self.choose_bsdf::<S>(material, &surface, u_lobe);
-        Interaction { point, frame: Frame::from_z(normal), bsdf, weight }
+        let (bsdf, weight) = self.choose_bsdf::<S>(material, &surface, u_lobe, layered.map(|(layers, _)| layers));
+        if let (Bsdf::Layered(_), Some((_, turned))) = (&bsdf, layered) {
+            // Turned about the normal towards the direction of anisotropy.
+            frame = turned;
+        }
+        Interaction { point, frame, bsdf, weight }
     }
 
     /// The material's BSDF; layered materials choose one lobe at random
     /// (by `u`), with the weight that keeps the estimate unbiased.
-    fn choose_bsdf<const S: u16>(&self, material: &Material, surface: &SurfaceValues, u: f32) -> (Bsdf, Vec3) {
+    fn choose_bsdf<const S: u16>(
+        &self,
+        material: &Material,
+        surface: &SurfaceValues,
+        u: f32,
+        layered: Option<crate::layered::PbrLayers>,
+    ) -> (Bsdf, Vec3) {
         let SurfaceValues { base_color, roughness, metallic, transmission } = *surface;
         let lambert = (Bsdf::Lambert { albedo: base_color }, Vec3::ONE);
         if !compiled(S, Effect::Glossy) {
@@ -578,6 +620,9 @@ impl<'a, A: Accel + ?Sized> Transport<'a, A> {
         }
         let u = (u - transmission) / (1.0 - transmission);
         let alpha = roughness * roughness;
+        if let Some(layers) = layered {
+            return (Bsdf::Layered(layers), Vec3::ONE);
+        }
         match material.model {
             SurfaceModel::MetallicRoughness => {
                 if alpha < MIN_ALPHA && metallic >= 1.0 {

@@ -54,6 +54,7 @@ mod regularisation;
 mod sampler;
 mod shade;
 mod shading_normal;
+mod surface_layers;
 pub mod up_axis;
 pub mod view_lighting;
 

@@ -125,6 +125,23 @@ fn every_bsdf_passes_a_furnace_under_a_white_sky() {
             },
             (0.95, 1.005),
         ),
+        // glTF's layers (KHR_materials_*): each may lose what its albedo
+        // scaling keeps from the layer below (a white sheen of roughness
+        // 0.5 returns 0.87 at normal incidence), none may gain.
+        ("sheen over white", Material { sheen: Some(sheen()), ..gltf(0.0, 0.5, 0.0) }, (0.8, 1.005)),
+        ("clearcoat over rough metal", Material { clearcoat: Some(coat()), ..gltf(1.0, 0.5, 0.0) }, (0.8, 1.005)),
+        ("iridescent dielectric", Material { iridescence: Some(film()), ior: 1.8, ..gltf(0.0, 0.3, 0.0) }, (0.9, 1.01)),
+        (
+            "every layer",
+            Material {
+                sheen: Some(sheen()),
+                clearcoat: Some(coat()),
+                iridescence: Some(film()),
+                dielectric_specular: rtgi_scene::DielectricSpecular { factor: 0.7, ..Default::default() },
+                ..gltf(0.5, 0.4, 0.0)
+            },
+            (0.75, 1.005),
+        ),
     ];
     let camera = Camera::look_at(Vec3::new(0.0, 0.5, 4.0), Vec3::ZERO, Vec3::Y, 0.6);
     for (name, material, (lowest, highest)) in cases {
@@ -143,6 +160,31 @@ fn every_bsdf_passes_a_furnace_under_a_white_sky() {
         assert!(mean >= lowest && mean <= highest, "{name}: mean {mean}, expected {lowest}..{highest}");
         // Single pixels of 32 samples are noisy; this catches gross failures.
         assert!(min > lowest - 0.35 && max < highest + 0.35, "{name}: pixels {min}..{max}");
+    }
+}
+
+fn sheen() -> rtgi_scene::Sheen {
+    rtgi_scene::Sheen { color: Vec3::ONE, color_texture: None, roughness: 0.5, roughness_texture: None }
+}
+
+fn coat() -> rtgi_scene::Clearcoat {
+    rtgi_scene::Clearcoat {
+        factor: 1.0,
+        factor_texture: None,
+        roughness: 0.2,
+        roughness_texture: None,
+        normal_texture: None,
+    }
+}
+
+fn film() -> rtgi_scene::Iridescence {
+    rtgi_scene::Iridescence {
+        factor: 1.0,
+        factor_texture: None,
+        ior: 1.3,
+        thickness_min: 100.0,
+        thickness_max: 400.0,
+        thickness_texture: None,
     }
 }
 
