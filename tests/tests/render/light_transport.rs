@@ -481,3 +481,53 @@ fn light_bsdf_and_mis_sampling_agree_on_a_glossy_floor_under_an_area_light() {
         assert!((mean - mis).abs() < 0.02 * mis, "{strategy}: {mean} against MIS {mis}");
     }
 }
+
+#[test]
+fn light_through_a_volume_is_attenuated_by_beer_lambert() {
+    // KHR_materials_volume: a unit sphere of a medium that leaves light the
+    // attenuation colour c after the attenuation distance d, of index 1 (so
+    // rays pass straight through), under a white sky. Through its centre
+    // light travels 2 units, so the centre pixels see c^(2/d); the same
+    // sphere without a volume is a thin sheet and lets the sky through.
+    let attenuation = Vec3::new(0.5, 0.25, 0.9);
+    let volume = rtgi_scene::Volume {
+        thickness: 1.0,
+        thickness_texture: None,
+        attenuation_distance: 2.0,
+        attenuation_color: attenuation,
+    };
+    let glass = |volume: Option<rtgi_scene::Volume>| Material {
+        model: SurfaceModel::MetallicRoughness,
+        base_color: Vec3::ONE,
+        roughness: 0.0,
+        transmission: 1.0,
+        ior: 1.0,
+        volume,
+        ..Material::default()
+    };
+    // A narrow view of the centre: its rays cross the sphere within 1% of its diameter.
+    let camera = Camera::look_at(Vec3::new(0.0, 0.0, 10.0), Vec3::ZERO, Vec3::Y, 0.01);
+    let settings = RenderSettings {
+        width: 4,
+        height: 4,
+        samples_per_pixel: 16,
+        max_depth: 16,
+        environment: Some(Environment::Uniform(Vec3::ONE)),
+        ..RenderSettings::default()
+    };
+    let mean = |scene: &Scene| {
+        let image = render_scene(scene, &camera, &settings);
+        image.pixels().iter().fold(Vec3::ZERO, |sum, p| sum + *p) / image.pixels().len() as f32
+    };
+    // The icosphere's faces lie a little inside the unit sphere, so the path is a little short of 2.
+    let through = mean(&sphere_scene(glass(Some(volume)), false));
+    for channel in 0..3 {
+        let expected = attenuation[channel];
+        assert!(
+            (through[channel] - expected).abs() < 0.02 * expected,
+            "channel {channel}: {through} through the medium, expected {attenuation}"
+        );
+    }
+    let sheet = mean(&sphere_scene(glass(None), false));
+    assert!((sheet - Vec3::ONE).abs().max_element() < 0.01, "a thin sheet lets the sky through: {sheet}");
+}
