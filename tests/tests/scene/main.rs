@@ -7,6 +7,7 @@ mod gltf;
 mod gltf_extensions;
 mod gltf_orientation;
 mod gltf_references;
+mod khronos_models;
 mod loader_api;
 mod loader_corpus;
 mod loader_hardening;
