@@ -9,6 +9,7 @@ mod camera_choice;
 mod cornell_reference;
 mod cutouts;
 mod determinism;
+mod khronos_models;
 mod light_transport;
 mod path_regularisation;
 mod render_identity;
