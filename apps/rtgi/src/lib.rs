@@ -72,10 +72,17 @@ pub fn main() -> ExitCode {
                 eprintln!("rtgi: {e}");
                 return ExitCode::from(interrupt::exit_status(*signal));
             }
-            // A file rtgi cannot render for want of an extension is a usage
-            // problem of the input, as a bad argument is: exit status 2.
+            // A file rtgi cannot render for want of an extension, or a
+            // variant the file does not have, is a usage problem, as a bad
+            // argument is: exit status 2.
             if e.chain().any(|cause| {
-                matches!(cause.downcast_ref(), Some(rtgi_scene::SceneError::UnsupportedGltfExtension { .. }))
+                matches!(
+                    cause.downcast_ref(),
+                    Some(
+                        rtgi_scene::SceneError::UnsupportedGltfExtension { .. }
+                            | rtgi_scene::SceneError::UnknownMaterialVariant { .. }
+                    )
+                )
             }) {
                 eprintln!("error: {}", one_line(&e));
                 return ExitCode::from(2);

@@ -590,7 +590,12 @@ impl EffectPlan {
                 decide(
                     layer,
                     true,
-                    format!("{} {} {layer}: {}", count(n, "material"), agree(n, "has"), names(&layered)),
+                    format!(
+                        "{} {} {layer}: {}",
+                        count(n, "material"),
+                        if n == 1 { "has" } else { "have" },
+                        names(&layered)
+                    ),
                 );
             }
         }

@@ -67,8 +67,20 @@ pub(crate) fn load(
             path.display()
         ));
     }
-    let variant = choose_variant(&gltf.document, files.options.gltf_variant.as_deref()).map_err(&error)?;
     scene.material_variants = gltf.document.variants().into_iter().flatten().map(|v| v.name().to_owned()).collect();
+    let variant = match files.options.gltf_variant.as_deref() {
+        None => None,
+        Some(name) => match scene.material_variants.iter().position(|v| v == name) {
+            Some(index) => Some(index as u32),
+            None => {
+                return Err(SceneError::UnknownMaterialVariant {
+                    path: path.to_owned(),
+                    variant: name.to_owned(),
+                    variants: scene.material_variants.clone(),
+                });
+            }
+        },
+    };
     let default_material = scene.materials.len() as u32;
     scene.materials.push(Material {
         name: "glTF default".into(),
@@ -470,18 +482,6 @@ fn decode_textures(
         let at = decodings.iter().position(|d| *d == (request.image, request.srgb)).expect("every request is decoded");
         let [wrap_u, wrap_v] = request.wrap;
         scene.textures.push(decoded[at].clone().with_wrap(wrap_u, wrap_v).with_uv_map(request.uv_map));
-    }
-}
-
-/// The index of the material variant `name` (KHR_materials_variants), or an
-/// error listing the file's variants.
-fn choose_variant(document: &gltf::Document, name: Option<&str>) -> Result<Option<u32>, String> {
-    let Some(name) = name else { return Ok(None) };
-    let variants: Vec<String> = document.variants().into_iter().flatten().map(|v| v.name().to_owned()).collect();
-    match variants.iter().position(|v| v == name) {
-        Some(index) => Ok(Some(index as u32)),
-        None if variants.is_empty() => Err(format!("there is no material variant '{name}': the file has none")),
-        None => Err(format!("there is no material variant '{name}' (the file's variants: {})", variants.join(", "))),
     }
 }
 

@@ -162,7 +162,7 @@ pub enum SceneError {
     /// The glTF file requires an extension rtgi does not support: the file
     /// may be valid, but rtgi cannot render it.
     #[error(
-        "{path} uses {extension}, which rtgi does not support ({lacks}); it supports: {}",
+        "{path} uses {extension}, which rtgi does not support (without it, {lacks}); it supports: {}",
         supported_gltf_extensions().collect::<Vec<_>>().join(", ")
     )]
     UnsupportedGltfExtension {
@@ -172,6 +172,20 @@ pub enum SceneError {
         extension: String,
         /// What rendering without it would lose.
         lacks: &'static str,
+    },
+    /// The material variant asked for ([`LoadOptions::gltf_variant`]) is
+    /// not one of the file's.
+    #[error(
+        "{path} has no material variant '{variant}' ({})",
+        if variants.is_empty() { "it has none".to_owned() } else { format!("its variants: {}", variants.join(", ")) }
+    )]
+    UnknownMaterialVariant {
+        /// The file.
+        path: PathBuf,
+        /// The name asked for.
+        variant: String,
+        /// The file's variants (KHR_materials_variants), in its order.
+        variants: Vec<String>,
     },
     /// The file's extension is none of `.obj`, `.gltf`, `.glb`, `.toml`.
     #[error("{path}: unsupported scene format (expected .obj, .gltf, .glb or .toml)")]

@@ -353,3 +353,30 @@ fn the_automatic_view_says_which_view_it_took_and_a_given_one_does_not() {
         assert!(json["camera"]["automatic_view"].is_null() && !stderr.contains("automatic view"), "{given:?}");
     }
 }
+
+/// A glTF file that requires an extension rtgi lacks is refused naming the
+/// extension (not blamed on the file), and a material variant the file
+/// does not have is refused listing its variants: both exit 2, as a usage
+/// error does. The info of a file lists how each extension it uses is rendered.
+#[test]
+fn gltf_extensions_rtgi_lacks_and_unknown_variants_exit_2_naming_them() {
+    let dir = scratch_dir("gltf-refusals");
+    let unlit = workspace_root().join("tests/data/khronos/UnlitTest/glTF/UnlitTest.gltf");
+    let text = std::fs::read_to_string(&unlit).unwrap().replacen(
+        "\"extensionsRequired\"",
+        "\"extensionsRequired\": [\"KHR_draco_mesh_compression\"], \"unusedRequired\"",
+        1,
+    );
+    std::fs::copy(unlit.with_file_name("UnlitTest.bin"), dir.join("UnlitTest.bin")).unwrap();
+    std::fs::write(dir.join("draco.gltf"), text).unwrap();
+    let run = rtgi(&["info", path_str(&dir.join("draco.gltf"))]);
+    assert_eq!(run.code, Some(2), "{run:?}");
+    assert!(run.stderr.contains("uses KHR_draco_mesh_compression, which rtgi does not support"), "{run:?}");
+    assert!(!run.stderr.contains("not a valid glTF"), "{run:?}");
+    let run = rtgi(&["info", path_str(&unlit), "--variant", "Dawn"]);
+    assert_eq!(run.code, Some(2), "{run:?}");
+    assert!(run.stderr.contains("has no material variant 'Dawn' (it has none)"), "{run:?}");
+    let run = rtgi(&["info", path_str(&unlit)]);
+    assert!(run.stdout.lines().any(|l| l.contains("KHR_materials_unlit") && l.contains("simulated")), "{run:?}");
+    assert!(run.stdout.contains("unlit"), "{run:?}");
+}

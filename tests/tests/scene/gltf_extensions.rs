@@ -155,8 +155,10 @@ fn a_variant_is_chosen_by_name_and_an_unknown_one_is_refused_with_the_list() {
     assert_eq!(material(None).unwrap(), "default");
     assert_eq!(material(Some("Midnight")).unwrap(), "midnight");
     assert_eq!(material(Some("Beach")).unwrap(), "beach");
-    let message = material(Some("Dawn")).unwrap_err().to_string();
-    assert!(message.contains("no material variant 'Dawn'") && message.contains("Midnight, Beach"), "{message}");
+    let error = material(Some("Dawn")).unwrap_err();
+    let message = error.to_string();
+    assert!(matches!(error, SceneError::UnknownMaterialVariant { .. }), "{message}");
+    assert!(message.contains("has no material variant 'Dawn' (its variants: Midnight, Beach)"), "{message}");
 }
 
 #[test]
