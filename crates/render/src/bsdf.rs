@@ -659,17 +659,8 @@ fn ggx_reflection_pdf(wo: Vec3, wi: Vec3, alpha: f32) -> f32 {
 /// A microfacet normal drawn from the normals visible from `wo` (Heitz,
 /// "Sampling the GGX Distribution of Visible Normals", JCGT 2018).
 fn sample_ggx_visible_normal(wo: Vec3, alpha: f32, u: Vec2) -> Vec3 {
-    let vh = Vec3::new(alpha * wo.x, alpha * wo.y, wo.z).normalize();
-    let length2 = vh.x * vh.x + vh.y * vh.y;
-    let t1 = if length2 > 0.0 { Vec3::new(-vh.y, vh.x, 0.0) / length2.sqrt() } else { Vec3::X };
-    let t2 = vh.cross(t1);
-    let r = u.x.sqrt();
-    let phi = 2.0 * PI * u.y;
-    let p1 = r * phi.cos();
-    let s = 0.5 * (1.0 + vh.z);
-    let p2 = (1.0 - s) * (1.0 - p1 * p1).max(0.0).sqrt() + s * r * phi.sin();
-    let nh = p1 * t1 + p2 * t2 + (1.0 - p1 * p1 - p2 * p2).max(0.0).sqrt() * vh;
-    Vec3::new(alpha * nh.x, alpha * nh.y, nh.z.max(0.0)).normalize()
+    // The anisotropic sampler with equal widths does the same arithmetic.
+    crate::layered::anisotropic_ggx::AnisotropicGgx::isotropic(alpha).sample_visible_normal(wo, u)
 }
 
 #[cfg(test)]

@@ -64,7 +64,7 @@
 //! neither evaluated nor chosen.
 
 mod albedo_table;
-mod anisotropic_ggx;
+pub(crate) mod anisotropic_ggx;
 #[cfg(test)]
 mod chi_square;
 mod iridescence;

@@ -16,13 +16,13 @@ use rtgi_math::{Vec2, Vec3};
 
 /// GGX widths along the frame's x and y axes; +z is the macroscopic normal.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub(super) struct AnisotropicGgx {
+pub(crate) struct AnisotropicGgx {
     pub(super) alpha_x: f32,
     pub(super) alpha_y: f32,
 }
 
 impl AnisotropicGgx {
-    pub(super) fn isotropic(alpha: f32) -> Self {
+    pub(crate) fn isotropic(alpha: f32) -> Self {
         Self { alpha_x: alpha, alpha_y: alpha }
     }
 
@@ -77,7 +77,7 @@ impl AnisotropicGgx {
     /// density G1(wo) max(0, wo·m) D(m) / cos θo: the stretched
     /// configuration's visible hemisphere, sampled as a disc warped onto
     /// it, and stretched back (Heitz 2018, listing 1).
-    pub(super) fn sample_visible_normal(&self, wo: Vec3, u: Vec2) -> Vec3 {
+    pub(crate) fn sample_visible_normal(&self, wo: Vec3, u: Vec2) -> Vec3 {
         let vh = Vec3::new(self.alpha_x * wo.x, self.alpha_y * wo.y, wo.z).normalize();
         let length2 = vh.x * vh.x + vh.y * vh.y;
         let t1 = if length2 > 0.0 { Vec3::new(-vh.y, vh.x, 0.0) / length2.sqrt() } else { Vec3::X };
