@@ -19,7 +19,7 @@ use rtgi_math::{Mat3, Mat4, Vec2, Vec3, Vec4};
 use crate::files::Files;
 use crate::gltf_accessor::read_floats;
 use crate::gltf_extensions::{ExtensionSupport, gltf_extension_support};
-use crate::gltf_material::{TextureRequests, convert_material};
+use crate::gltf_material::{TextureRequest, TextureRequests, convert_material};
 use crate::{Camera, ColorEncoding, Light, LightKind, Material, MeshBuilder, Scene, SceneError, SurfaceModel, Texture};
 
 pub(crate) fn load(
@@ -469,19 +469,30 @@ fn decode_textures(
             Texture::decode(bytes, &name, encoding)
         })
         .collect();
-    let decoded: Vec<Texture> = decoded
+    let mut decoded: Vec<Option<Texture>> = decoded
         .into_iter()
         .map(|texture| {
-            texture.unwrap_or_else(|message| {
+            Some(texture.unwrap_or_else(|message| {
                 scene.warnings.push(message.clone());
                 Texture::missing(message)
-            })
+            }))
         })
         .collect();
+    let decoding_of = |request: &TextureRequest| {
+        decodings.iter().position(|d| *d == (request.image, request.srgb)).expect("every request is decoded")
+    };
+    let mut uses_left = vec![0usize; decodings.len()];
     for request in &textures.requests {
-        let at = decodings.iter().position(|d| *d == (request.image, request.srgb)).expect("every request is decoded");
+        uses_left[decoding_of(request)] += 1;
+    }
+    for request in &textures.requests {
+        let at = decoding_of(request);
+        uses_left[at] -= 1;
+        // The last use takes the texels; earlier ones copy them.
+        let texture = if uses_left[at] == 0 { decoded[at].take() } else { decoded[at].clone() };
         let [wrap_u, wrap_v] = request.wrap;
-        scene.textures.push(decoded[at].clone().with_wrap(wrap_u, wrap_v).with_uv_map(request.uv_map));
+        let texture = texture.expect("taken only by its last use");
+        scene.textures.push(texture.with_wrap(wrap_u, wrap_v).with_uv_map(request.uv_map));
     }
 }
 

@@ -1,6 +1,6 @@
 use std::ops::{Add, Mul};
 use std::path::Path;
-use std::sync::{Arc, LazyLock, OnceLock};
+use std::sync::{LazyLock, OnceLock};
 
 use rtgi_math::{Vec2, Vec3, Vec4};
 
@@ -123,15 +123,17 @@ impl UvMap {
 /// at the coordinates its [`UvMap`] picks.
 ///
 /// Texels are kept as bytes (a quarter of the memory of floats) and decoded
-/// through a table on lookup; textures that differ only in their map or
-/// wrap modes share them.
+/// through a table on lookup. (Textures that differ only in their map or
+/// wrap modes are copies: sharing the texels through an `Arc` cost a copy
+/// of every texture while it was decoded, 47 MB more at the peak of
+/// loading DamagedHelmet, for images that are rarely used twice.)
 #[derive(Clone, PartialEq)]
 pub struct Texture {
     /// Where the texture came from, for messages.
     pub name: String,
     width: u32,
     height: u32,
-    texels: Arc<[[u8; 4]]>,
+    texels: Vec<[u8; 4]>,
     encoding: ColorEncoding,
     /// The coordinates it reads.
     uv_map: UvMap,
@@ -202,7 +204,7 @@ impl Texture {
             width,
             height,
             has_alpha: texels.iter().any(|t| t[3] < 255),
-            texels: texels.into(),
+            texels,
             encoding,
             uv_map: UvMap::IDENTITY,
             wrap: [Wrap::Repeat; 2],
@@ -217,7 +219,7 @@ impl Texture {
         self
     }
 
-    /// This texture reading the coordinates `map` picks (the texels are shared, not copied).
+    /// This texture reading the coordinates `map` picks.
     #[must_use]
     pub fn with_uv_map(mut self, map: UvMap) -> Self {
         self.uv_map = map;
