@@ -8,6 +8,9 @@ use rtgi_math::{Vec2, Vec3, Vec4};
 use rtgi_scene::{Material, Scene, TextureId};
 use rtgi_tests::workspace_root;
 
+/// Which texture of a material a row of TextureTransformMultiTest tests.
+type Slot = fn(&Material) -> Option<TextureId>;
+
 fn khronos(name: &str) -> PathBuf {
     workspace_root().join(format!("tests/data/khronos/{name}/glTF/{name}.gltf"))
 }
@@ -17,12 +20,7 @@ fn khronos(name: &str) -> PathBuf {
 /// which the tile is thinnest), through the texture's coordinate set and
 /// transform, or, with `transformed` false, at the raw TEXCOORD_0 as an
 /// importer without KHR_texture_transform would.
-fn tile_lookups(
-    scene: &Scene,
-    material: &str,
-    slot: fn(&Material) -> Option<TextureId>,
-    transformed: bool,
-) -> Vec<Vec4> {
+fn tile_lookups(scene: &Scene, material: &str, slot: Slot, transformed: bool) -> Vec<Vec4> {
     let index = scene.materials.iter().position(|m| m.name == material).unwrap_or_else(|| panic!("no {material}"));
     let texture =
         &scene.textures[slot(&scene.materials[index]).unwrap_or_else(|| panic!("{material}: no texture")).0 as usize];
@@ -76,7 +74,7 @@ fn mean_difference(x: &[Vec4], y: &[Vec4]) -> f32 {
 fn texture_transform_multi_test_tiles_match_their_sample_in_every_slot() {
     let scene = Scene::load(&khronos("TextureTransformMultiTest")).unwrap();
     assert!(scene.warnings.is_empty(), "{:?}", scene.warnings);
-    let rows: [(&str, fn(&Material) -> Option<TextureId>); 8] = [
+    let rows: [(&str, Slot); 8] = [
         ("BaseColor", |m| m.base_color_texture),
         ("Emission", |m| m.emission_texture),
         ("Normal", |m| m.normal_texture.map(|(t, _)| t)),
