@@ -1,24 +1,14 @@
 //! End-to-end tests of the commands that expose the acceleration
 //! structures: `rtgi trace`, `rtgi bench`, `rtgi bvh-boxes`, `rtgi heatmap`.
 
-use std::path::Path;
-
+use super::{RTGI, path_str, rtgi};
 use rtgi_accel::{Accel, LinearScan};
 use rtgi_math::{Ray, Rng, Vec3};
 use rtgi_render::rays::{primary_rays, uniform_sphere};
 use rtgi_scene::Scene;
-use rtgi_tests::{Run, run_cli, scratch_dir, workspace_root};
+use rtgi_tests::{Run, scratch_dir, workspace_root};
 
-const RTGI: &str = env!("CARGO_BIN_EXE_rtgi-under-test");
 const BOX: &str = "scenes/cornell-box.toml";
-
-fn rtgi(args: &[&str]) -> Run {
-    run_cli(RTGI, args)
-}
-
-fn s(p: &Path) -> &str {
-    p.to_str().expect("scratch paths are UTF-8")
-}
 
 /// Camera rays, random rays from inside the box, and a ray that must miss
 /// without trouble (an empty range). Rays with a NaN or a zero direction are
@@ -72,7 +62,8 @@ fn trace_writes_the_hits_of_every_variant_identically() {
     for accel in rtgi_accel::AccelKind::ALL {
         for any_hit in [false, true] {
             let out = dir.join(format!("{accel}-{any_hit}.bin"));
-            let mut args = vec!["trace", BOX, "--rays", s(&rays_path), "--out", s(&out), "--accel", accel.name()];
+            let mut args =
+                vec!["trace", BOX, "--rays", path_str(&rays_path), "--out", path_str(&out), "--accel", accel.name()];
             if any_hit {
                 args.push("--any-hit");
             }
@@ -108,12 +99,12 @@ fn trace_refuses_a_truncated_ray_file() {
     let rays = dir.join("short.bin");
     std::fs::write(&rays, [0u8; 33]).unwrap();
     let out = dir.join("hits.bin");
-    let run = rtgi(&["trace", BOX, "--rays", s(&rays), "--out", s(&out)]);
+    let run = rtgi(&["trace", BOX, "--rays", path_str(&rays), "--out", path_str(&out)]);
     assert!(!run.success);
     assert_eq!(run.stderr.trim().lines().count(), 1, "{}", run.stderr);
     assert!(run.stderr.contains("short.bin") && run.stderr.contains("multiple of 32"), "{}", run.stderr);
     assert!(!out.exists());
-    let missing = rtgi(&["trace", BOX, "--rays", s(&dir.join("none.bin")), "--out", s(&out)]);
+    let missing = rtgi(&["trace", BOX, "--rays", path_str(&dir.join("none.bin")), "--out", path_str(&out)]);
     assert!(!missing.success && missing.stderr.contains("none.bin"), "{missing:?}");
 }
 
@@ -121,8 +112,19 @@ fn trace_refuses_a_truncated_ray_file() {
 fn bench_measures_every_variant_and_writes_json() {
     let dir = scratch_dir("bench");
     let json = dir.join("bench.json");
-    let run =
-        rtgi(&["bench", "--width", "16", "--height", "16", "--rays", "500", "--repeats", "1", "--json", s(&json)]);
+    let run = rtgi(&[
+        "bench",
+        "--width",
+        "16",
+        "--height",
+        "16",
+        "--rays",
+        "500",
+        "--repeats",
+        "1",
+        "--json",
+        path_str(&json),
+    ]);
     assert!(run.success, "{run:?}");
     for kind in rtgi_accel::AccelKind::ALL {
         assert!(run.stdout.lines().any(|l| l.starts_with(kind.name())), "{kind} missing from\n{}", run.stdout);
@@ -147,7 +149,7 @@ fn bench_measures_every_variant_and_writes_json() {
 fn bvh_boxes_are_written_as_obj_groups() {
     let dir = scratch_dir("boxes");
     let out = dir.join("boxes.obj");
-    let run = rtgi(&["bvh-boxes", "-o", s(&out), "--levels", "0,1", "--accel", "sah"]);
+    let run = rtgi(&["bvh-boxes", "-o", path_str(&out), "--levels", "0,1", "--accel", "sah"]);
     assert!(run.success, "{run:?}");
     let obj = std::fs::read_to_string(&out).unwrap();
     assert!(obj.contains("g level_0") && obj.contains("g level_1"));
@@ -159,13 +161,13 @@ fn bvh_boxes_are_written_as_obj_groups() {
     assert_eq!(boxes.triangles.len(), 36);
     // A wide BVH: one root box and, below it, up to eight children.
     let wide = dir.join("wide.obj");
-    let run = rtgi(&["bvh-boxes", "-o", s(&wide), "--levels", "0,1", "--accel", "bvh8"]);
+    let run = rtgi(&["bvh-boxes", "-o", path_str(&wide), "--levels", "0,1", "--accel", "bvh8"]);
     assert!(run.success, "{run:?}");
     let obj = std::fs::read_to_string(&wide).unwrap();
     let level_1 = obj.split("g level_1").nth(1).expect("a level-1 group");
     let children = level_1.lines().filter(|l| l.starts_with("v ")).count() / 8;
     assert!((2..=8).contains(&children), "{children} children");
-    let linear = rtgi(&["bvh-boxes", "-o", s(&dir.join("l.obj")), "--accel", "linear"]);
+    let linear = rtgi(&["bvh-boxes", "-o", path_str(&dir.join("l.obj")), "--accel", "linear"]);
     assert!(!linear.success && linear.stderr.contains("linear"), "{linear:?}");
 }
 
@@ -173,13 +175,13 @@ fn bvh_boxes_are_written_as_obj_groups() {
 fn heatmap_counts_nodes_per_pixel() {
     let dir = scratch_dir("heatmap");
     let exr = dir.join("cost.exr");
-    let run = rtgi(&["heatmap", "-o", s(&exr), "--width", "20", "--height", "20"]);
+    let run = rtgi(&["heatmap", "-o", path_str(&exr), "--width", "20", "--height", "20"]);
     assert!(run.success, "{run:?}");
     let counts = rtgi_image::HdrImage::read_exr(&exr).unwrap();
     // Every ray tests at least the root's box; inside the closed box every camera ray hits.
     assert!(counts.pixels().iter().all(|p| p.x >= 1.0 && p.z == 1.0));
     let png = dir.join("cost.png");
-    let run = rtgi(&["heatmap", "-o", s(&png), "--width", "20", "--height", "10", "--triangles"]);
+    let run = rtgi(&["heatmap", "-o", path_str(&png), "--width", "20", "--height", "10", "--triangles"]);
     assert!(run.success, "{run:?}");
     assert_eq!(image::open(&png).unwrap().to_rgb8().dimensions(), (20, 10));
 }
@@ -194,11 +196,11 @@ fn outputs_default_to_names_after_the_input() {
         std::process::Command::new(RTGI).args(args).current_dir(&dir).output().expect("rtgi runs").into()
     };
     for (args, written) in [
-        (vec!["heatmap", s(&scene), "--width", "8", "--height", "8"], "cornell-box.heatmap.png"),
-        (vec!["bvh-boxes", s(&scene), "--levels", "0"], "cornell-box.boxes.obj"),
-        (vec!["rays", s(&scene), "--width", "4", "--height", "4"], "cornell-box.rays.bin"),
-        (vec!["trace", s(&scene), "--rays", "cornell-box.rays.bin"], "cornell-box.rays.hits.bin"),
-        (vec!["trace", s(&scene), "--rays", "cornell-box.rays.bin", "--out", "alias.bin"], "alias.bin"),
+        (vec!["heatmap", path_str(&scene), "--width", "8", "--height", "8"], "cornell-box.heatmap.png"),
+        (vec!["bvh-boxes", path_str(&scene), "--levels", "0"], "cornell-box.boxes.obj"),
+        (vec!["rays", path_str(&scene), "--width", "4", "--height", "4"], "cornell-box.rays.bin"),
+        (vec!["trace", path_str(&scene), "--rays", "cornell-box.rays.bin"], "cornell-box.rays.hits.bin"),
+        (vec!["trace", path_str(&scene), "--rays", "cornell-box.rays.bin", "--out", "alias.bin"], "alias.bin"),
     ] {
         let run = in_dir(&args);
         assert!(run.success, "{args:?}: {run:?}");
@@ -216,14 +218,14 @@ fn info_describes_scenes_as_text_and_json() {
     assert!(run.success, "{run:?}");
     assert!(run.stdout.contains("triangles   32") && run.stdout.contains("cameras     1"), "{}", run.stdout);
     let Some(lamp) = rtgi_tests::shared_scene("gltf/LightsPunctualLamp/glTF/LightsPunctualLamp.gltf") else { return };
-    let run = rtgi(&["info", s(&lamp), "--json"]);
+    let run = rtgi(&["info", path_str(&lamp), "--json"]);
     assert!(run.success, "{run:?}");
     assert_eq!(run.stdout.matches("\"intensity\"").count(), 5, "{}", run.stdout);
     assert!(run.stdout.contains("\"extensions_used\"") && run.stdout.contains("KHR_lights_punctual"));
     let Some(transmission) = rtgi_tests::shared_scene("gltf/TransmissionTest/glTF/TransmissionTest.gltf") else {
         return;
     };
-    let run = rtgi(&["info", s(&transmission)]);
+    let run = rtgi(&["info", path_str(&transmission)]);
     assert!(run.success, "{run:?}");
     // Metadata: listed, not warned about.
     assert!(!run.stderr.contains("KHR_xmp"), "{run:?}");
@@ -234,7 +236,7 @@ fn info_describes_scenes_as_text_and_json() {
 fn verify_checks_the_built_in_adversarial_scenes_and_writes_json() {
     let dir = scratch_dir("verify");
     let json = dir.join("verify.json");
-    let run = rtgi(&["verify", "--rays", "20000", "--json", s(&json)]);
+    let run = rtgi(&["verify", "--rays", "20000", "--json", path_str(&json)]);
     assert!(run.success, "{}", run.stderr);
     for kind in
         ["random", "vertex", "edge", "axis-parallel", "secondary", "silhouette", "camera", "inside", "through-edge"]

@@ -2,17 +2,8 @@
 
 use std::path::Path;
 
-use rtgi_tests::{Run, run_cli, scratch_dir, shared_scene};
-
-const RTGI: &str = env!("CARGO_BIN_EXE_rtgi-under-test");
-
-fn rtgi(args: &[&str]) -> Run {
-    run_cli(RTGI, args)
-}
-
-fn path_str(p: &Path) -> &str {
-    p.to_str().expect("scratch paths are UTF-8")
-}
+use super::{RTGI, path_str, rtgi};
+use rtgi_tests::{scratch_dir, shared_scene};
 
 fn is_red([r, g, b]: [u8; 3]) -> bool {
     r as i32 > g as i32 + 60 && r as i32 > b as i32 + 60

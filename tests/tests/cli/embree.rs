@@ -3,19 +3,8 @@
 //! differences are not failures; without it, naming it is a clean error
 //! that says how to enable it.
 
-use std::path::Path;
-
-use rtgi_tests::{Run, run_cli, scratch_dir};
-
-const RTGI: &str = env!("CARGO_BIN_EXE_rtgi-under-test");
-
-fn rtgi(args: &[&str]) -> Run {
-    run_cli(RTGI, args)
-}
-
-fn s(p: &Path) -> &str {
-    p.to_str().expect("scratch paths are UTF-8")
-}
+use super::{path_str, rtgi};
+use rtgi_tests::scratch_dir;
 
 #[cfg(feature = "embree")]
 #[test]
@@ -60,7 +49,7 @@ fn all_includes_embree_in_bench() {
 fn verify_reports_embree_as_a_peer_and_succeeds() {
     let dir = scratch_dir("verify-embree");
     let json = dir.join("verify.json");
-    let run = rtgi(&["verify", "--accel", "all", "--rays", "20000", "--json", s(&json)]);
+    let run = rtgi(&["verify", "--accel", "all", "--rays", "20000", "--json", path_str(&json)]);
     assert!(run.success, "a peer's differences must not fail the run: {run:?}");
     assert!(run.stdout.contains("embree (peer)"), "{}", run.stdout);
     assert!(run.stdout.contains("peer: differences are not failures"), "{}", run.stdout);
@@ -79,7 +68,8 @@ fn verify_reports_embree_as_a_peer_and_succeeds() {
 fn render_and_trace_run_on_embree() {
     let dir = scratch_dir("render-embree");
     let image = dir.join("box.png");
-    let run = rtgi(&["render", "--accel", "embree", "-o", s(&image), "--width", "16", "--height", "16", "--spp", "1"]);
+    let run =
+        rtgi(&["render", "--accel", "embree", "-o", path_str(&image), "--width", "16", "--height", "16", "--spp", "1"]);
     assert!(run.success && image.exists(), "{run:?}");
 }
 
@@ -95,7 +85,7 @@ fn naming_embree_without_the_feature_says_how_to_enable_it() {
     let dir = scratch_dir("no-embree");
     let out = dir.join("out.png");
     for args in [
-        vec!["render", "--accel", "embree", "-o", s(&out)],
+        vec!["render", "--accel", "embree", "-o", path_str(&out)],
         vec!["bench", "--accel", "sah,embree"],
         vec!["verify", "--accel", "embree"],
         vec!["trace", "scenes/cornell-box.toml", "--rays", "r.bin", "--out", "h.bin", "--accel", "embree"],
@@ -117,7 +107,7 @@ fn the_accel_and_scaling_experiments_measure_embree_beside_ours() {
     let dir = scratch_dir("embree-experiments");
     for knob in ["accel", "scaling"] {
         let out = dir.join(knob);
-        let run = rtgi(&["experiment", knob, "--quick", "--repeats", "1", "--out", s(&out)]);
+        let run = rtgi(&["experiment", knob, "--quick", "--repeats", "1", "--out", path_str(&out)]);
         assert!(run.success, "{run:?}");
         let json: serde_json::Value =
             serde_json::from_str(&std::fs::read_to_string(out.join(format!("{knob}.json"))).unwrap()).unwrap();

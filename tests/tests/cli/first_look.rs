@@ -5,18 +5,10 @@
 use std::path::Path;
 use std::process::Command;
 
-use rtgi_tests::{Run, run_cli, scratch_dir, workspace_root};
+use super::{RTGI, path_str, rtgi};
+use rtgi_tests::{Run, scratch_dir, workspace_root};
 
-const RTGI: &str = env!("CARGO_BIN_EXE_rtgi-under-test");
 const ROOM: &str = "tests/scenes/closed-room.toml";
-
-fn rtgi(args: &[&str]) -> Run {
-    run_cli(RTGI, args)
-}
-
-fn path_str(p: &Path) -> &str {
-    p.to_str().expect("scratch paths are UTF-8")
-}
 
 fn render_room(out: &Path, extra: &[&str]) -> Run {
     let mut args = vec!["render", ROOM, "-o", path_str(out), "--width", "32", "--height", "32", "--spp", "2"];

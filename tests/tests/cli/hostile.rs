@@ -6,23 +6,15 @@ use std::io::{BufRead, BufReader};
 use std::path::Path;
 use std::process::{Command, Stdio};
 
+use super::{RTGI, path_str, rtgi};
 use rtgi_accel::{Accel, LinearScan};
 use rtgi_image::HdrImage;
 use rtgi_math::{Ray, Rng, Vec3};
 use rtgi_render::rays::uniform_sphere;
 use rtgi_scene::Scene;
-use rtgi_tests::{Run, run_cli, run_cli_with_input, scratch_dir, workspace_root};
+use rtgi_tests::{Run, run_cli_with_input, scratch_dir, workspace_root};
 
-const RTGI: &str = env!("CARGO_BIN_EXE_rtgi-under-test");
 const BOX: &str = "scenes/cornell-box.toml";
-
-fn rtgi(args: &[&str]) -> Run {
-    run_cli(RTGI, args)
-}
-
-fn s(p: &Path) -> &str {
-    p.to_str().expect("scratch paths are UTF-8")
-}
 
 /// Each value is refused by the parser, as clap refuses (exit status 2),
 /// before the scene is read: the scene given does not exist, so any later
@@ -34,7 +26,7 @@ fn out_of_range_option_values_are_refused_with_the_allowed_range() {
     let png = dir.join("out.png");
     let missing = "no-such-scene.obj";
     let render = |extra: &[&str]| -> Vec<String> {
-        let mut args = vec!["render", missing, "-o", s(&png), "--width", "8", "--height", "8", "--spp", "1"];
+        let mut args = vec!["render", missing, "-o", path_str(&png), "--width", "8", "--height", "8", "--spp", "1"];
         args.extend_from_slice(extra);
         args.into_iter().map(str::to_owned).collect()
     };
@@ -65,12 +57,12 @@ fn out_of_range_option_values_are_refused_with_the_allowed_range() {
         (render(&["--light", "directional:0,0,0:1"]), "--light", "zero"),
         (render(&["--light", "spot:0,1,0:0,-1,0:5:30:inf"]), "--light", "non-negative"),
         (
-            owned(&["heatmap", missing, "-o", s(&heatmap), "--width", "8", "--height", "8", "--scale", "nan"]),
+            owned(&["heatmap", missing, "-o", path_str(&heatmap), "--width", "8", "--height", "8", "--scale", "nan"]),
             "--scale",
             "greater than 0",
         ),
         (
-            owned(&["heatmap", missing, "-o", s(&heatmap), "--width", "8", "--height", "8", "--scale", "-2"]),
+            owned(&["heatmap", missing, "-o", path_str(&heatmap), "--width", "8", "--height", "8", "--scale", "-2"]),
             "--scale",
             "greater than 0",
         ),
@@ -149,7 +141,7 @@ fn bench_ends_quietly_when_its_reader_goes_away() {
     // The JSON file asked for is written all the same.
     let json_dir = scratch_dir("hostile-pipe-bench");
     let json = json_dir.join("bench.json");
-    let with_json = [&args[..], &["--json", s(&json)]].concat();
+    let with_json = [&args[..], &["--json", path_str(&json)]].concat();
     assert_quiet_when_the_pipe_closes(&with_json, 0);
     let report: serde_json::Value = serde_json::from_slice(&std::fs::read(&json).unwrap()).unwrap();
     assert!(report["variants"].as_array().is_some_and(|v| v.len() == 1), "{report}");
@@ -193,8 +185,8 @@ fn scene_with_many_materials(dir: &Path, count: usize) -> std::path::PathBuf {
 fn info_ends_quietly_when_its_reader_goes_away() {
     let dir = scratch_dir("hostile-pipe-info");
     let scene = scene_with_many_materials(&dir, 4000);
-    assert_eq!(assert_quiet_when_the_pipe_closes(&["info", s(&scene)], 1), "");
-    assert_eq!(assert_quiet_when_the_pipe_closes(&["info", s(&scene), "--json"], 1), "");
+    assert_eq!(assert_quiet_when_the_pipe_closes(&["info", path_str(&scene)], 1), "");
+    assert_eq!(assert_quiet_when_the_pipe_closes(&["info", path_str(&scene), "--json"], 1), "");
 }
 
 #[test]
@@ -205,8 +197,8 @@ fn compare_ends_quietly_when_its_reader_goes_away() {
     image.write(&a, &Default::default()).unwrap();
     image.set(1, 1, Vec3::ONE);
     image.write(&b, &Default::default()).unwrap();
-    assert_eq!(assert_quiet_when_the_pipe_closes(&["compare", s(&a), s(&b)], 0), "");
-    assert_eq!(assert_quiet_when_the_pipe_closes(&["compare", s(&a), s(&b), "--json"], 0), "");
+    assert_eq!(assert_quiet_when_the_pipe_closes(&["compare", path_str(&a), path_str(&b)], 0), "");
+    assert_eq!(assert_quiet_when_the_pipe_closes(&["compare", path_str(&a), path_str(&b), "--json"], 0), "");
 }
 
 fn encode(rays: &[Ray]) -> Vec<u8> {
@@ -253,7 +245,7 @@ fn assert_refused(run: &Run, expected: &[&str], out: &Path) {
 fn trace_refuses_dev_zero_at_its_first_ray() {
     let dir = scratch_dir("hostile-zero");
     let out = dir.join("hits.bin");
-    let run = rtgi(&["trace", BOX, "--rays", "/dev/zero", "--out", s(&out)]);
+    let run = rtgi(&["trace", BOX, "--rays", "/dev/zero", "--out", path_str(&out)]);
     assert_refused(&run, &["/dev/zero", "ray 0 ", "direction is zero"], &out);
 }
 
@@ -278,7 +270,7 @@ fn trace_refuses_invalid_rays_naming_the_record() {
         let path = dir.join(format!("bad{i}.bin"));
         std::fs::write(&path, encode(&rays)).unwrap();
         let out = dir.join("hits.bin");
-        let run = rtgi(&["trace", BOX, "--rays", s(&path), "--out", s(&out)]);
+        let run = rtgi(&["trace", BOX, "--rays", path_str(&path), "--out", path_str(&out)]);
         assert_refused(&run, &[&format!("bad{i}.bin"), "ray 5 ", what], &out);
     }
 }
@@ -291,7 +283,7 @@ fn trace_refuses_a_stream_that_ends_inside_a_record() {
     let out = dir.join("hits.bin");
     let mut bytes = encode(&random_rays(2));
     bytes.extend_from_slice(&[0; 8]);
-    let run = run_cli_with_input(RTGI, &["trace", BOX, "--rays", "/dev/stdin", "--out", s(&out)], &bytes);
+    let run = run_cli_with_input(RTGI, &["trace", BOX, "--rays", "/dev/stdin", "--out", path_str(&out)], &bytes);
     assert_refused(&run, &["72 bytes", "multiple of 32"], &out);
 }
 
@@ -305,7 +297,7 @@ fn trace_streams_a_file_of_many_chunks_exactly() {
     let path = dir.join("rays.bin");
     std::fs::write(&path, encode(&rays)).unwrap();
     let out = dir.join("hits.bin");
-    let run = rtgi(&["trace", BOX, "--rays", s(&path), "--out", s(&out), "--threads", "2"]);
+    let run = rtgi(&["trace", BOX, "--rays", path_str(&path), "--out", path_str(&out), "--threads", "2"]);
     assert!(run.success, "{run:?}");
     assert!(run.stderr.contains(&format!("{} rays", rays.len())), "{}", run.stderr);
     let bytes = std::fs::read(&out).unwrap();
@@ -329,21 +321,21 @@ fn files_that_are_not_files_are_refused_cleanly() {
     let out = dir.join("hits.bin");
     let fifo = dir.join("fifo.exr");
     let made = Command::new("mkfifo").arg(&fifo).status().is_ok_and(|status| status.success());
-    let folder = s(&dir);
+    let folder = path_str(&dir);
     let cases: Vec<(Vec<&str>, &str)> = vec![
-        (vec!["compare", "/dev/null", s(&empty)], "/dev/null: cannot read: not a file"),
-        (vec!["compare", s(&empty), s(&empty)], "empty.exr"),
-        (vec!["compare", folder, s(&empty)], folder),
+        (vec!["compare", "/dev/null", path_str(&empty)], "/dev/null: cannot read: not a file"),
+        (vec!["compare", path_str(&empty), path_str(&empty)], "empty.exr"),
+        (vec!["compare", folder, path_str(&empty)], folder),
         (vec!["info", folder], folder),
         (vec!["info", "/dev/null"], "/dev/null"),
-        (vec!["trace", BOX, "--rays", folder, "--out", s(&out)], folder),
+        (vec!["trace", BOX, "--rays", folder, "--out", path_str(&out)], folder),
         // Refused before measuring, not after.
-        (vec!["experiment", "spp", "--quick", "--out", s(&empty)], "--out"),
+        (vec!["experiment", "spp", "--quick", "--out", path_str(&empty)], "--out"),
         (vec!["experiment", "spp", "--quick", "--out", folder, "--cache", "/dev/null"], "--cache /dev/null"),
     ];
     let cases = if made {
         // Refused at once, not read (which would wait for a writer forever).
-        [cases, vec![(vec!["compare", s(&fifo), s(&empty)], "not a file")]].concat()
+        [cases, vec![(vec!["compare", path_str(&fifo), path_str(&empty)], "not a file")]].concat()
     } else {
         eprintln!("mkfifo failed: skipping the FIFO case");
         cases
@@ -405,7 +397,7 @@ fn compare_refuses_images_of_absurd_size_before_allocating() {
     std::fs::write(&huge, exr_claiming(50_000)).unwrap();
     let small = dir.join("small.exr");
     HdrImage::new(4, 4).write(&small, &Default::default()).unwrap();
-    for args in [["compare", s(&huge), s(&small)], ["compare", s(&small), s(&huge)]] {
+    for args in [["compare", path_str(&huge), path_str(&small)], ["compare", path_str(&small), path_str(&huge)]] {
         let run = rtgi(&args);
         assert!(run.code == Some(1), "{args:?}: exit {:?} (134 is an abort): {}", run.code, run.stderr);
         assert_eq!(run.stderr.trim().lines().count(), 1, "{}", run.stderr);
@@ -436,7 +428,7 @@ fn trace_writes_into_a_fifo_without_replacing_it() {
     std::thread::spawn(move || {
         let _ = sender.send(std::fs::read(&reader_path).map(|b| b.len()).map_err(|e| e.to_string()));
     });
-    let run = rtgi(&["trace", BOX, "--rays", s(&path), "--out", s(&fifo)]);
+    let run = rtgi(&["trace", BOX, "--rays", path_str(&path), "--out", path_str(&fifo)]);
     assert!(run.success, "{run:?}");
     assert!(std::fs::metadata(&fifo).unwrap().file_type().is_fifo(), "the FIFO was replaced");
     // A reader still waiting means the command never opened the FIFO.

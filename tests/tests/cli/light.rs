@@ -1,21 +1,10 @@
 //! End-to-end tests of the light-transport options of `rtgi render`,
 //! `rtgi info`, `rtgi compare` and `rtgi bench-effects`.
 
-use std::path::Path;
-
+use super::{path_str, rtgi};
 use rtgi_image::{HdrImage, ToneMap};
 use rtgi_math::Vec3;
-use rtgi_tests::{Run, run_cli, scratch_dir};
-
-const RTGI: &str = env!("CARGO_BIN_EXE_rtgi-under-test");
-
-fn rtgi(args: &[&str]) -> Run {
-    run_cli(RTGI, args)
-}
-
-fn path_str(p: &Path) -> &str {
-    p.to_str().expect("scratch paths are UTF-8")
-}
+use rtgi_tests::scratch_dir;
 
 #[test]
 fn path_tracing_prints_its_plan_and_writes_aovs() {

@@ -6,17 +6,8 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
-use rtgi_tests::{Run, run_cli, scratch_dir};
-
-const RTGI: &str = env!("CARGO_BIN_EXE_rtgi-under-test");
-
-fn rtgi(args: &[&str]) -> Run {
-    run_cli(RTGI, args)
-}
-
-fn path_str(p: &Path) -> &str {
-    p.to_str().expect("scratch paths are UTF-8")
-}
+use super::{RTGI, path_str, rtgi};
+use rtgi_tests::{Run, scratch_dir};
 
 /// The built-in Cornell box, small, at many samples: a few seconds of work.
 const RENDER: &[&str] = &["render", "--width", "64", "--height", "48", "--spp", "192", "--seed", "11"];

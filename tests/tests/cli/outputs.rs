@@ -3,17 +3,8 @@
 
 use std::path::Path;
 
-use rtgi_tests::{Run, run_cli, scratch_dir};
-
-const RTGI: &str = env!("CARGO_BIN_EXE_rtgi-under-test");
-
-fn rtgi(args: &[&str]) -> Run {
-    run_cli(RTGI, args)
-}
-
-fn path_str(p: &Path) -> &str {
-    p.to_str().expect("scratch paths are UTF-8")
-}
+use super::{path_str, rtgi};
+use rtgi_tests::scratch_dir;
 
 #[test]
 fn an_output_that_is_also_an_input_is_refused_and_left_alone() {

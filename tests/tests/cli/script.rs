@@ -8,9 +8,9 @@
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
+use super::RTGI;
 use rtgi_tests::{Run, run_cli, run_cli_with_input, scratch_dir, shared_scenes, workspace_root};
 
-const RTGI: &str = env!("CARGO_BIN_EXE_rtgi-under-test");
 /// The team's Cornell box (millimetres), from the workspace root.
 const BOX: &str = "scenes/cornell-box/cornell-box.obj";
 
