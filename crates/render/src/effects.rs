@@ -356,17 +356,12 @@ impl EffectPlan {
         };
 
         let emitters = with(Material::is_emissive);
-        let emissive_triangles = scene
-            .triangles
-            .iter()
-            .filter(|t| scene.materials.get(t.material as usize).is_some_and(Material::is_emissive))
-            .count();
+        let triangles_with = |test: fn(&Material) -> bool| {
+            scene.triangles.iter().filter(|t| scene.materials.get(t.material as usize).is_some_and(test)).count()
+        };
+        let emissive_triangles = triangles_with(Material::is_emissive);
         let unlit = with(|m| m.unlit);
-        let unlit_triangles = scene
-            .triangles
-            .iter()
-            .filter(|t| scene.materials.get(t.material as usize).is_some_and(|m| m.unlit))
-            .count();
+        let unlit_triangles = triangles_with(|m| m.unlit);
         let emission = if !lighting {
             decide(Effect::Emission, false, not_lit())
         } else if emissive_triangles > 0 || unlit_triangles > 0 {

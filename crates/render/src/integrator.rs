@@ -196,6 +196,9 @@ pub(crate) struct Transport<'a, A: Accel + ?Sized> {
     normal_maps: bool,
     /// The layers of glTF's material the plan simulates.
     layers: LayerSwitches,
+    /// Per material: whether it is shaded with the layered model
+    /// ([`needs_layers`]), decided once rather than at every hit.
+    layered_materials: Vec<bool>,
     /// Normal and elongation of every triangle, for the points spawning rays.
     shapes: Vec<TriangleShape>,
     /// The alpha test of cut-outs, where the plan has them.
@@ -234,6 +237,12 @@ impl<'a, A: Accel + ?Sized> Transport<'a, A> {
         settings: &RenderSettings,
     ) -> Self {
         let environment = environment.filter(|_| plan.has(Effect::Environment));
+        let layers = LayerSwitches {
+            sheen: plan.has(Effect::Sheen),
+            clearcoat: plan.has(Effect::Clearcoat),
+            iridescence: plan.has(Effect::Iridescence),
+            anisotropy: plan.has(Effect::Anisotropy),
+        };
         Self {
             scene,
             accel,
@@ -257,12 +266,12 @@ impl<'a, A: Accel + ?Sized> Transport<'a, A> {
             glossy: plan.has(Effect::Glossy),
             refraction: plan.has(Effect::Refraction),
             normal_maps: plan.has(Effect::NormalMaps),
-            layers: LayerSwitches {
-                sheen: plan.has(Effect::Sheen),
-                clearcoat: plan.has(Effect::Clearcoat),
-                iridescence: plan.has(Effect::Iridescence),
-                anisotropy: plan.has(Effect::Anisotropy),
-            },
+            layers,
+            layered_materials: scene
+                .materials
+                .iter()
+                .map(|m| m.model == SurfaceModel::MetallicRoughness && needs_layers(m, layers))
+                .collect(),
             cut_outs: plan.has(Effect::Alpha).then(|| AlphaTest::new(scene)),
             shapes: scene
                 .triangles
@@ -543,24 +552,23 @@ impl<'a, A: Accel + ?Sized> Transport<'a, A> {
         let mut frame = Frame::from_z(normal);
         let layered = (compiled(S, Effect::Glossy)
             && self.glossy
-            && material.model == SurfaceModel::MetallicRoughness
-            && needs_layers(material, self.layers))
-        .then(|| {
-            let coords = scene.texture_coords(triangle, hit.beta, hit.gamma);
-            let lookup = |id: rtgi_scene::TextureId| scene.textures[id.0 as usize].lookup(coords);
-            let geometry_normal = geometry_normal.normalize_or(normal);
-            let inputs = LayerInputs {
-                texture: compiled(S, Effect::Textures).then_some(&lookup as &dyn Fn(rtgi_scene::TextureId) -> Vec4),
-                base_color,
-                metallic,
-                roughness,
-                frame,
-                geometry_normal: if geometry_normal.dot(normal) < 0.0 { -geometry_normal } else { geometry_normal },
-                tangent: scene.interpolate(triangle, hit.beta, hit.gamma, |v| v.tangent),
-                perturb,
-            };
-            pbr_layers(material, self.layers, &inputs)
-        });
+            && self.layered_materials[triangle.material as usize])
+            .then(|| {
+                let coords = scene.texture_coords(triangle, hit.beta, hit.gamma);
+                let lookup = |id: rtgi_scene::TextureId| scene.textures[id.0 as usize].lookup(coords);
+                let geometry_normal = geometry_normal.normalize_or(normal);
+                let inputs = LayerInputs {
+                    texture: compiled(S, Effect::Textures).then_some(&lookup as &dyn Fn(rtgi_scene::TextureId) -> Vec4),
+                    base_color,
+                    metallic,
+                    roughness,
+                    frame,
+                    geometry_normal: if geometry_normal.dot(normal) < 0.0 { -geometry_normal } else { geometry_normal },
+                    tangent: scene.interpolate(triangle, hit.beta, hit.gamma, |v| v.tangent),
+                    perturb,
+                };
+                pbr_layers(material, self.layers, &inputs)
+            });
         let surface = SurfaceValues { base_color, roughness, metallic, transmission };
         let (bsdf, weight) = self.choose_bsdf::<S>(material, &surface, u_lobe, layered.map(|(layers, _)| layers));
         if let (Bsdf::Layered(_), Some((_, turned))) = (&bsdf, layered) {

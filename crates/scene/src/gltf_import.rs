@@ -56,7 +56,7 @@ pub(crate) fn load(
         up: Some(Vec3::Y),
         ..Scene::default()
     };
-    let mut textures = TextureRequests::new(0);
+    let mut textures = TextureRequests::default();
     for material in gltf.document.materials() {
         scene.materials.push(convert_material(&material, &gltf.document, &mut textures));
     }
@@ -427,6 +427,7 @@ fn decode_textures(
     scene: &mut Scene,
     sources: &mut Vec<PathBuf>,
 ) {
+    debug_assert!(scene.textures.is_empty(), "texture ids are the requests' places");
     let images: Vec<gltf::Image<'_>> = document.images().collect();
     let mut decodings: Vec<(usize, bool)> = Vec::new();
     for request in &textures.requests {

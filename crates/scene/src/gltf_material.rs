@@ -29,19 +29,16 @@ pub(crate) struct TextureRequest {
 }
 
 /// The textures the materials ask for, in the order first asked; a
-/// request's [`TextureId`] is `first_id` plus its place here.
+/// request's [`TextureId`] is its place here (the scene's textures are
+/// these, in this order).
+#[derive(Default)]
 pub(crate) struct TextureRequests {
-    first_id: u32,
     pub requests: Vec<TextureRequest>,
     /// Texture coordinate sets beyond the two a vertex keeps, by how often they were asked for.
     pub unsupported_sets: HashMap<u32, usize>,
 }
 
 impl TextureRequests {
-    pub(crate) fn new(first_id: u32) -> Self {
-        Self { first_id, requests: Vec::new(), unsupported_sets: HashMap::new() }
-    }
-
     fn request(
         &mut self,
         texture: &gltf::Texture<'_>,
@@ -77,7 +74,7 @@ impl TextureRequests {
                 self.requests.len() - 1
             }
         };
-        TextureId(self.first_id + index as u32)
+        TextureId(index as u32)
     }
 
     /// A reference the `gltf` crate has read (`textureInfo`).
