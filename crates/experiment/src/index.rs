@@ -131,7 +131,7 @@ fn scene_slug(scene: &str) -> String {
 
 /// Each scene's Pareto plot (`pareto/SCENE.svg`) with its configurations,
 /// for the scenes whose reports measured rendered configurations.
-fn pareto_plots(reports: &[IndexedReport]) -> Vec<(String, Plot, usize)> {
+fn pareto_plots(reports: &[IndexedReport]) -> Vec<(String, Plot, Vec<pareto::Configuration>)> {
     // The analytic knob measures bias against exact answers, not render
     // error against a reference: it has no front. The direct knob renders
     // three scenes of its own, each against its own reference: a front each.
@@ -144,7 +144,7 @@ fn pareto_plots(reports: &[IndexedReport]) -> Vec<(String, Plot, usize)> {
             scenes.push(&r.report.scene);
         }
     }
-    let mut plots: Vec<(String, Plot, usize)> = scenes
+    let mut plots: Vec<(String, Plot, Vec<pareto::Configuration>)> = scenes
         .into_iter()
         .filter_map(|scene| {
             let configurations = pareto::configurations(reports.iter().map(|r| &r.report).filter(|r| r.scene == scene));
@@ -152,8 +152,7 @@ fn pareto_plots(reports: &[IndexedReport]) -> Vec<(String, Plot, usize)> {
             // its front across the knob's settings is the scene's trade-off.
             (!configurations.is_empty()).then(|| {
                 let file = format!("{PARETO_FOLDER}/{}.svg", scene_slug(scene));
-                let count = configurations.len();
-                (scene.to_owned(), pareto::plot(&file, &configurations), count)
+                (scene.to_owned(), pareto::plot(&file, &configurations), configurations)
             })
         })
         .collect();
@@ -169,9 +168,8 @@ fn pareto_plots(reports: &[IndexedReport]) -> Vec<(String, Plot, usize)> {
                 .collect();
             if !configurations.is_empty() {
                 let file = format!("{PARETO_FOLDER}/direct-knob-{}.svg", scene_slug(name));
-                let count = configurations.len();
                 let scene = format!("the direct knob's {name} scene");
-                plots.push((scene, pareto::plot(&file, &configurations), count));
+                plots.push((scene, pareto::plot(&file, &configurations), configurations));
             }
         }
     }
@@ -231,11 +229,15 @@ pub fn index_markdown(folder: &Path) -> Result<String, ExperimentError> {
             md,
             "## The trade-off on one plot, per scene\n\nEvery configuration of every knob measured on the scene \
              against the same converged reference, RMSE against time, with the Pareto front: the configurations \
-             that no other beats in both.\n"
+             that no other beats beyond the resolution of the measurement (a rank test at 95% confidence on the \
+             runs' times and the seeds' errors) in one without being beaten in the other. Biased configurations \
+             can be on it, as error at equal time is their measure; each says its bias.\n"
         );
-        for (scene, plot, count) in &paretos {
+        for (scene, plot, configurations) in &paretos {
+            let count = configurations.len();
             let on = plot.curves.last().map_or(String::new(), |front| front.label.clone());
             let _ = writeln!(md, "### {scene}: {count} configurations, {on}\n\n![{}]({})\n", plot.title, plot.file);
+            let _ = writeln!(md, "Front (fastest first): {}\n", pareto::describe_front(configurations));
         }
     }
     let mut knob = "";
@@ -303,6 +305,7 @@ fn peers_markdown(reports: &[IndexedReport]) -> String {
     const OURS: [&str; 3] = ["bvh4", "bvh8", "sbvh8"];
     let mut rows = Vec::new();
     let mut threads = 0;
+    let mut rays = None;
     for entry in reports.iter().filter(|e| e.report.knob == "accel") {
         let point = |name: &str| entry.report.series.iter().find(|s| s.name == name).and_then(|s| s.points.first());
         let Some(embree) = point("embree") else { continue };
@@ -311,15 +314,37 @@ fn peers_markdown(reports: &[IndexedReport]) -> String {
             let build = point.time.as_ref().map_or(f64::NAN, |t| t.median_ms);
             [value("camera_mrays"), value("camera_batch_mrays"), value("incoherent_mrays"), build]
         };
-        let theirs = figures(embree);
+        // The runs behind each figure, for the rank test: a ratio the
+        // measurement does not resolve is marked so.
+        let runs = |point: &Point| {
+            let timing = |key: &str| point.timings.get(key).map(|t| t.samples()).unwrap_or_default();
+            [
+                timing("camera_trace"),
+                timing("camera_batch_trace"),
+                timing("incoherent_trace"),
+                point.time.as_ref().map(|t| t.samples()).unwrap_or_default(),
+            ]
+        };
+        let (theirs, their_runs) = (figures(embree), runs(embree));
         threads = entry.report.machine.threads;
+        rays = Some((
+            embree.values.get("camera_rays_timed").copied(),
+            embree.values.get("incoherent_rays_timed").copied(),
+        ));
         let scene = scene_slug(&entry.report.scene);
         for name in OURS {
             let Some(point) = point(name) else { continue };
             let cells: Vec<String> = figures(point)
                 .iter()
                 .zip(theirs)
-                .map(|(ours, theirs)| format!("{} ({:.2}×)", format_number(*ours), ours / theirs))
+                .zip(runs(point).iter().zip(&their_runs))
+                .map(|((ours, theirs), (our_runs, their_runs))| {
+                    let resolved = !our_runs.is_empty()
+                        && !their_runs.is_empty()
+                        && crate::verdict::RankComparison::of(our_runs, their_runs).resolved();
+                    let mark = if resolved { "" } else { ", not resolved" };
+                    format!("{} ({:.2}×{mark})", format_number(*ours), ours / theirs)
+                })
                 .collect();
             rows.push(format!("| {scene} | {name} | {} |", cells.join(" | ")));
         }
@@ -329,10 +354,24 @@ fn peers_markdown(reports: &[IndexedReport]) -> String {
     if rows.is_empty() {
         return String::new();
     }
+    // docs/targets.md measures with the `peers` example's rays: this says how
+    // these differ, from the reports themselves.
+    let rays_line = match rays {
+        Some((Some(camera), Some(incoherent))) => format!(
+            "These are the experiment's rays: {} camera rays of the report's camera and image, and {} incoherent \
+             rays leaving the scene's surfaces; `docs/targets.md` uses the `peers` example's (a camera on the \
+             bounding sphere at 40° in 4×4 tiles, and 1,000,000 rays from random points of the bounding box), so \
+             the ratios of the two differ with the rays, not with the code.",
+            format_number(camera),
+            format_number(incoherent)
+        ),
+        _ => String::new(),
+    };
     let mut md = format!(
         "\nAgainst Embree (from the `accel` reports: the same rays for all, {threads} threads; in brackets, the \
          multiple of Embree's figure: `rtcIntersect1` for camera and incoherent rays, `rtcIntersect16` for \
-         the batch of camera rays, and its build):\n\n\
+         the batch of camera rays, and its build; \"not resolved\" where the rank test of the runs does not tell \
+         the two apart at 95% confidence). {rays_line}\n\n\
          | scene | structure | camera Mrays/s | camera batch Mrays/s | incoherent Mrays/s | build ms |\n\
          |---|---|---:|---:|---:|---:|\n",
     );

@@ -89,8 +89,10 @@ mod tests {
         let subset = every_nth(&rays, 3);
         assert_eq!(subset.iter().map(|r| r.origin.x).collect::<Vec<_>>(), vec![0.0, 4.0, 8.0]);
         assert_eq!(every_nth(&rays, 100).len(), 10);
-        let (median, slow, fast) =
-            mrays(2_000_000, &Timing { median_ms: 1000.0, min_ms: 500.0, max_ms: 2000.0, runs: 3 });
+        let (median, slow, fast) = mrays(
+            2_000_000,
+            &Timing { median_ms: 1000.0, min_ms: 500.0, max_ms: 2000.0, runs: 3, runs_ms: Vec::new() },
+        );
         assert_eq!((median, slow, fast), (2.0, 1.0, 4.0));
     }
 }

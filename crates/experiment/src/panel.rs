@@ -158,6 +158,8 @@ pub struct Panel {
     pub crop: Crop,
     /// The error that saturates the colour scale.
     pub scale: f64,
+    /// The time every entry was given, in ms, if the panel is an equal-time one.
+    pub budget_ms: Option<f64>,
 }
 
 impl Panel {
@@ -165,7 +167,12 @@ impl Panel {
     pub fn new(file: impl Into<String>, title: impl Into<String>, reference: HdrImage, entries: Vec<Entry>) -> Panel {
         let crop = choose_crop(&reference, &entries);
         let scale = error_scale(&reference, &entries, crop);
-        Panel { file: file.into(), title: title.into(), reference, entries, crop, scale }
+        Panel { file: file.into(), title: title.into(), reference, entries, crop, scale, budget_ms: None }
+    }
+
+    /// An entry's time over the budget, for an equal-time panel.
+    pub fn budget_share(&self, entry: &Entry) -> Option<f64> {
+        self.budget_ms.map(|budget| entry.time_ms / budget.max(1e-9))
     }
 
     /// What the panel shows, left to right, with the figures: for the report's findings.
@@ -175,9 +182,17 @@ impl Panel {
             .iter()
             .map(|e| {
                 format!(
-                    "{} ({} ms, RMSE {})",
+                    "{} ({} ms{}, RMSE {})",
                     e.label,
                     crate::report::format_ms(e.time_ms),
+                    self.budget_share(e).map_or(String::new(), |share| {
+                        let off = share - 1.0;
+                        if off.abs() <= crate::runner::EQUAL_TIME_TOLERANCE {
+                            format!(", {:+.1}% of the budget", 100.0 * off)
+                        } else {
+                            format!(", {:+.1}% of the budget: outside ±5%", 100.0 * off)
+                        }
+                    }),
                     crate::report::format_number(e.rmse)
                 )
             })

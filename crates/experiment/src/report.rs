@@ -107,12 +107,16 @@ pub struct Point {
     pub error: Option<ImageError>,
     /// Further figures of this point: nodes visited, disagreements, failure rates...
     pub values: BTreeMap<String, f64>,
+    /// Further timings of this point, by name (the tracing of each ray
+    /// batch beside a build's time...), with every run for the rank test.
+    #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
+    pub timings: BTreeMap<String, Timing>,
 }
 
 impl Point {
     /// A point at knob value `x`, labelled `label`, with nothing measured yet.
     pub fn new(x: f64, label: impl Into<String>) -> Point {
-        Point { x, label: label.into(), time: None, error: None, values: BTreeMap::new() }
+        Point { x, label: label.into(), time: None, error: None, values: BTreeMap::new(), timings: BTreeMap::new() }
     }
 
     /// The point with a further named figure.
@@ -213,6 +217,10 @@ pub struct Report {
     /// The plots: in JSON, their file names and titles.
     #[serde(with = "plot_files")]
     pub plots: Vec<Plot>,
+    /// The settings every render shares unless the knob varies them (size,
+    /// integrator, maximum depth, Russian roulette...), for knobs that render.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub renders: Option<String>,
     /// Equal-time image panels (PNG): in JSON, their file names and titles;
     /// their captions are findings.
     #[serde(with = "panel_files", default)]
@@ -229,10 +237,42 @@ mod panel_files {
     struct PanelFile {
         file: String,
         title: String,
+        /// The time each entry was given, for equal-time panels.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        budget_ms: Option<f64>,
+        #[serde(default)]
+        entries: Vec<EntryRecord>,
+    }
+
+    /// An entry's figures: what the panel's labels show.
+    #[derive(Serialize, Deserialize)]
+    struct EntryRecord {
+        label: String,
+        time_ms: f64,
+        /// Its time over the budget (1.0 = exactly the budget).
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        budget_share: Option<f64>,
+        rmse: f64,
     }
 
     pub(super) fn serialize<S: Serializer>(panels: &[Panel], serializer: S) -> Result<S::Ok, S::Error> {
-        serializer.collect_seq(panels.iter().map(|p| PanelFile { file: p.file.clone(), title: p.title.clone() }))
+        serializer.collect_seq(panels.iter().map(|p| {
+            PanelFile {
+                file: p.file.clone(),
+                title: p.title.clone(),
+                budget_ms: p.budget_ms,
+                entries: p
+                    .entries
+                    .iter()
+                    .map(|e| EntryRecord {
+                        label: e.label.clone(),
+                        time_ms: e.time_ms,
+                        budget_share: p.budget_share(e),
+                        rmse: e.rmse,
+                    })
+                    .collect(),
+            }
+        }))
     }
 
     pub(super) fn deserialize<'de, D: Deserializer<'de>>(deserializer: D) -> Result<Vec<Panel>, D::Error> {
@@ -246,6 +286,7 @@ mod panel_files {
                 entries: Vec::new(),
                 crop: Crop { x: 0, y: 0, side: 1 },
                 scale: 0.0,
+                budget_ms: f.budget_ms,
             })
             .collect())
     }
@@ -314,16 +355,17 @@ pub(crate) fn measurement_header(leading: &[&str]) -> Vec<String> {
 
 /// The table cells of a rendered measurement: time, RMSE with its range
 /// over the seeds, relative MSE, squared bias (or "not resolved"),
-/// variance, efficiency, and mean radiance over the reference's.
+/// variance, efficiency (none for a resolved bias: a biased estimator's MSE
+/// does not fall as 1/time), and mean radiance over the reference's.
 pub(crate) fn measurement_cells(point: &Point) -> [String; 7] {
-    let (time, error) = (point.time.expect("measured"), point.error.expect("measured"));
+    let (time, error) = (point.time.as_ref().expect("measured"), point.error.as_ref().expect("measured"));
     [
-        format_timing(&time),
+        format_timing(time),
         format!("{} ({}–{})", format_number(error.rmse), format_number(error.rmse_min), format_number(error.rmse_max)),
         format_number(error.relative_mse),
-        format_bias(&error),
+        format_bias(error),
         format_number(error.variance),
-        format_number(error.efficiency(time.median_ms)),
+        if error.bias_resolved() { "— (biased)".to_owned() } else { format_number(error.efficiency(time.median_ms)) },
         format!("{:.4}", error.mean / error.reference_mean.max(1e-30)),
     ]
 }
@@ -395,10 +437,11 @@ impl Report {
     pub fn provenance(&self) -> String {
         let (m, b) = (&self.machine, &self.build);
         format!(
-            "Measured {} on {} ({} cores, {} threads used, SIMD {}, {}) by rtgi {} at commit {}{}, built by {} \
-             ({} profile, opt-level {}{}).",
+            "Measured {} on {}{} ({} cores, {} threads used, SIMD {}, {}) by rtgi {} at commit {}{}, built by {} \
+             ({} profile, opt-level {}{}){}{}.",
             self.date,
             m.cpu,
+            if m.cpu_id.is_empty() { String::new() } else { format!(" ({})", m.cpu_id) },
             m.cores,
             m.threads,
             m.simd,
@@ -409,7 +452,12 @@ impl Report {
             b.rustc,
             b.profile,
             b.opt_level,
-            if b.rustflags.is_empty() { String::new() } else { format!(", RUSTFLAGS {}", b.rustflags) }
+            if b.rustflags.is_empty() { String::new() } else { format!(", RUSTFLAGS {}", b.rustflags) },
+            if b.peers.is_empty() { String::new() } else { format!(", with {}", b.peers.join(", ")) },
+            match &self.renders {
+                Some(renders) => format!("; renders: {renders}"),
+                None => String::new(),
+            }
         )
     }
 

@@ -6,7 +6,7 @@ use rtgi_image::HdrImage;
 use serde::{Deserialize, Serialize};
 
 /// Repeated timings of one measurement, in milliseconds.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Timing {
     /// Median of the runs, in milliseconds.
     pub median_ms: f64,
@@ -16,6 +16,10 @@ pub struct Timing {
     pub max_ms: f64,
     /// Number of runs.
     pub runs: usize,
+    /// Every run, in the order they were measured: what the rank test of
+    /// [`crate::verdict`] compares (a render's run `i` used seed `i`).
+    #[serde(default)]
+    pub runs_ms: Vec<f64>,
 }
 
 impl Timing {
@@ -31,13 +35,14 @@ impl Timing {
             min_ms: sorted[0],
             max_ms: sorted[sorted.len() - 1],
             runs: sorted.len(),
+            runs_ms: runs.to_vec(),
         }
     }
 
-    /// Whether this timing and `other` are told apart by the measurement:
-    /// their min–max ranges do not overlap. Within the spread, neither is faster.
-    pub fn resolved_from(&self, other: &Timing) -> bool {
-        self.max_ms < other.min_ms || other.max_ms < self.min_ms
+    /// The runs the rank test compares; a timing read from a report older
+    /// than them has only its median.
+    pub fn samples(&self) -> Vec<f64> {
+        if self.runs_ms.is_empty() { vec![self.median_ms] } else { self.runs_ms.clone() }
     }
 }
 
@@ -52,7 +57,7 @@ impl Timing {
 /// σ_R²`, which removes what the mean's own noise (`s²/n`) and the
 /// reference's noise (`σ_R²`) add to it; it can come out slightly negative
 /// when there is no bias. A bias below [`ImageError::bias_resolution`] is not resolved.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct ImageError {
     /// Root mean square error: `sqrt` of the mean squared error over the
     /// seeds (each render with its own seed).
@@ -78,6 +83,20 @@ pub struct ImageError {
     pub bias_resolution: f64,
     /// Renders (seeds) behind these figures.
     pub seeds: usize,
+    /// The standard error of the reference's mean radiance: its per-pixel
+    /// noise over the square root of the pixel count.
+    #[serde(default)]
+    pub reference_mean_noise: f64,
+    /// The MSE of each render, in seed order: what the rank test of
+    /// [`crate::verdict`] compares.
+    #[serde(default)]
+    pub seed_mse: Vec<f64>,
+    /// The relative MSE of each render, in seed order.
+    #[serde(default)]
+    pub seed_relative_mse: Vec<f64>,
+    /// The mean radiance of each render, in seed order.
+    #[serde(default)]
+    pub seed_means: Vec<f64>,
 }
 
 impl ImageError {
@@ -86,9 +105,33 @@ impl ImageError {
         self.rmse * self.rmse
     }
 
-    /// Whether the bias is told apart from the noise.
+    /// Whether the bias is told apart from the noise: its squared bias
+    /// beyond [`ImageError::bias_resolution`], or its energy beyond the
+    /// spread of the seeds' means ([`ImageError::energy_resolved`]).
     pub fn bias_resolved(&self) -> bool {
-        self.seeds > 1 && self.bias2 > self.bias_resolution
+        self.seeds > 1 && (self.bias2 > self.bias_resolution || self.energy_resolved())
+    }
+
+    /// The energy the renders gain (positive) or lose (negative) against
+    /// the reference, as a fraction of the reference's mean radiance.
+    pub fn energy_change(&self) -> f64 {
+        self.mean / self.reference_mean.max(1e-300) - 1.0
+    }
+
+    /// Whether the renders' mean radiance differs from the reference's
+    /// beyond chance: by more than the 99% two-sided Student-t interval of
+    /// the seeds' means (with the reference's noise on its mean added).
+    /// A bias spread over the image shows here long before it shows per
+    /// pixel, where each pixel's noise hides it.
+    pub fn energy_resolved(&self) -> bool {
+        let n = self.seed_means.len();
+        if n < 2 {
+            return false;
+        }
+        let mean = self.seed_means.iter().sum::<f64>() / n as f64;
+        let variance = self.seed_means.iter().map(|m| (m - mean).powi(2)).sum::<f64>() / (n - 1) as f64;
+        let half_width = student_t_99(n - 1) * (variance / n as f64).sqrt();
+        (mean - self.reference_mean).abs() > half_width + 3.0 * self.reference_mean_noise
     }
 
     /// Efficiency, `1 / (MSE · seconds)`: a configuration twice as
@@ -107,8 +150,8 @@ pub struct SeedErrors<'a> {
     sum: Vec<f64>,
     sum_squares: Vec<f64>,
     mse: Vec<f64>,
-    relative_mse: f64,
-    mean: f64,
+    relative_mse: Vec<f64>,
+    mean: Vec<f64>,
 }
 
 impl<'a> SeedErrors<'a> {
@@ -121,8 +164,8 @@ impl<'a> SeedErrors<'a> {
             sum: vec![0.0; n],
             sum_squares: vec![0.0; n],
             mse: Vec::new(),
-            relative_mse: 0.0,
-            mean: 0.0,
+            relative_mse: Vec::new(),
+            mean: Vec::new(),
         }
     }
 
@@ -130,8 +173,8 @@ impl<'a> SeedErrors<'a> {
     pub fn add(&mut self, image: &HdrImage) {
         let d = rtgi_image::compare(image, self.reference).expect("the render has the reference's size");
         self.mse.push(d.rmse * d.rmse);
-        self.relative_mse += d.relative_mse;
-        self.mean += d.mean;
+        self.relative_mse.push(d.relative_mse);
+        self.mean.push(d.mean);
         let values = image.pixels().iter().flat_map(|p| p.to_array());
         for ((sum, squares), value) in self.sum.iter_mut().zip(&mut self.sum_squares).zip(values) {
             *sum += value as f64;
@@ -177,14 +220,30 @@ impl<'a> SeedErrors<'a> {
             rmse: (self.mse.iter().sum::<f64>() / n).sqrt(),
             rmse_min: self.mse.iter().copied().fold(f64::INFINITY, f64::min).sqrt(),
             rmse_max: self.mse.iter().copied().fold(0.0, f64::max).sqrt(),
-            relative_mse: self.relative_mse / n,
-            mean: self.mean / n,
+            relative_mse: self.relative_mse.iter().sum::<f64>() / n,
+            mean: self.mean.iter().sum::<f64>() / n,
             reference_mean,
             bias2,
             variance,
             bias_resolution: if seeds > 1 { 3.0 * (scatter / pixels).sqrt() } else { f64::MAX },
             seeds,
+            reference_mean_noise: self.reference_noise_rmse / pixels.sqrt(),
+            seed_mse: self.mse.clone(),
+            seed_relative_mse: self.relative_mse.clone(),
+            seed_means: self.mean.clone(),
         }
+    }
+}
+
+/// The 99.5% quantile of Student's t with `degrees` degrees of freedom:
+/// the half-width, in standard errors, of a 99% two-sided interval.
+fn student_t_99(degrees: usize) -> f64 {
+    const TABLE: [f64; 10] = [63.657, 9.925, 5.841, 4.604, 4.032, 3.707, 3.499, 3.355, 3.250, 3.169];
+    match degrees {
+        0 => f64::INFINITY,
+        1..=10 => TABLE[degrees - 1],
+        11..=30 => 3.169 - (degrees - 10) as f64 * (3.169 - 2.750) / 20.0,
+        _ => 2.576,
     }
 }
 

@@ -1,59 +1,136 @@
-//! Comparisons that say whether the measurement tells two configurations
-//! apart: a difference inside the spread is "not resolved", never a winner.
+//! Every comparative sentence of the reports is decided here: whether the
+//! measurement tells two configurations apart at [`CONFIDENCE`], by a rank
+//! test on the repeats (times of runs, errors of seeds), never by comparing
+//! medians or ranges. A difference the test cannot resolve is written "not
+//! resolved", never as a winner.
+//!
+//! Efficiency `1 / (MSE · time)` is a figure of unbiased estimators only:
+//! the MSE of a biased one does not fall as 1/time, so its "efficiency"
+//! changes with the sample count. [`efficiency`] refuses a configuration
+//! whose bias is resolved, and [`describe_bias`] says what it is instead.
 
-use crate::report::Point;
+use crate::report::{ImageError, Point, format_number};
 use crate::stats::Timing;
 
-/// A measured figure with the range the repeats gave it.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Spread {
-    /// The figure (a median, or the figure of all repeats together).
-    pub value: f64,
-    /// The smallest value the repeats allow.
-    pub low: f64,
-    /// The largest value the repeats allow.
-    pub high: f64,
+/// `a` against `b` by the rank test of their repeats: "`a` has 1.93× the
+/// `what` of `b` (Mann–Whitney p = 0.008, …)" where resolved, else "not resolved".
+pub fn compare(what: &str, a_name: &str, a: &[f64], b_name: &str, b: &[f64]) -> String {
+    RankComparison::of(a, b).sentence(what, a_name, b_name)
 }
 
-impl Spread {
-    /// A time: median, min and max.
-    pub fn time(timing: &Timing) -> Spread {
-        Spread { value: timing.median_ms, low: timing.min_ms, high: timing.max_ms }
-    }
+/// Two timings compared by the rank test of their runs.
+pub fn compare_times(what: &str, a_name: &str, a: &Timing, b_name: &str, b: &Timing) -> String {
+    compare(what, a_name, &a.samples(), b_name, &b.samples())
+}
 
-    /// The efficiency `1 / (MSE · seconds)` of a measured render, from its
-    /// RMSE over the seeds and median time; the range takes the worst seed
-    /// with the slowest run and the best seed with the fastest.
-    pub fn efficiency(point: &Point) -> Option<Spread> {
-        let (time, error) = (point.time?, point.error?);
-        let efficiency = |rmse: f64, ms: f64| 1.0 / (rmse * rmse * ms * 1e-3).max(1e-300);
-        Some(Spread {
-            value: error.efficiency(time.median_ms),
-            low: efficiency(error.rmse_max, time.max_ms),
-            high: efficiency(error.rmse_min, time.min_ms),
-        })
-    }
+/// Whether the runs of `a` are resolved from those of `b` (either way).
+pub fn times_resolved(a: &Timing, b: &Timing) -> bool {
+    RankComparison::of(&a.samples(), &b.samples()).resolved()
+}
 
-    /// The point of `points` with the highest [`Spread::efficiency`], and that efficiency.
-    pub fn most_efficient(points: &[Point]) -> Option<(Spread, &Point)> {
-        points.iter().filter_map(|p| Some((Spread::efficiency(p)?, p))).max_by(|a, b| a.0.value.total_cmp(&b.0.value))
-    }
+/// Whether `a` is below `b` beyond the resolution, in a figure where lower
+/// is better (a time, an error): resolved by the rank test, and lower.
+pub fn resolved_lower(a: &[f64], b: &[f64]) -> bool {
+    let test = RankComparison::of(a, b);
+    test.resolved() && test.ratio < 1.0
+}
 
-    /// Whether the two ranges do not overlap.
-    pub fn resolved_from(&self, other: &Spread) -> bool {
-        self.high < other.low || other.high < self.low
+/// Which error an efficiency divides by.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ErrorMeasure {
+    /// Mean squared error of linear radiance: bright pixels dominate it.
+    Mse,
+    /// Relative MSE: every pixel counts alike, dark ones too; what a noise
+    /// target (adaptive sampling) aims at.
+    RelativeMse,
+}
+
+impl ErrorMeasure {
+    /// Its name in sentences.
+    pub fn name(self) -> &'static str {
+        match self {
+            ErrorMeasure::Mse => "efficiency 1/(MSE·time)",
+            ErrorMeasure::RelativeMse => "efficiency 1/(relative MSE·time)",
+        }
     }
 }
 
-/// `a` against `b` in one sentence: "`a` is 1.93× `b`'s efficiency" when
-/// the ranges are apart, else that the difference is not resolved.
-pub fn compare(what: &str, a_name: &str, a: &Spread, b_name: &str, b: &Spread) -> String {
-    let ratio = a.value / b.value.max(1e-300);
-    if a.resolved_from(b) {
-        format!("{a_name} has {ratio:.2}× the {what} of {b_name}")
+/// The efficiency `1 / (MSE · seconds)` of each repeat of a measured
+/// render (repeat `i` rendered seed `i`, so its time and its error pair
+/// up), or, for a configuration whose bias is resolved, why it has none.
+/// `None` for a point without both a time and an error.
+pub fn efficiency(point: &Point) -> Option<Result<Vec<f64>, String>> {
+    efficiency_by(point, ErrorMeasure::Mse)
+}
+
+/// [`efficiency`] with the error `measure` chooses.
+pub fn efficiency_by(point: &Point, measure: ErrorMeasure) -> Option<Result<Vec<f64>, String>> {
+    let (time, error) = (point.time.as_ref()?, point.error.as_ref()?);
+    if error.bias_resolved() {
+        return Some(Err(describe_bias(error)));
+    }
+    let (per_seed, overall) = match measure {
+        ErrorMeasure::Mse => (&error.seed_mse, error.mse()),
+        ErrorMeasure::RelativeMse => (&error.seed_relative_mse, error.relative_mse),
+    };
+    let times = time.samples();
+    Some(Ok(if times.len() == per_seed.len() {
+        times.iter().zip(per_seed).map(|(ms, e)| 1.0 / (e * ms * 1e-3).max(1e-300)).collect()
     } else {
-        format!("{what} of {a_name} and {b_name}: not resolved (ratio {ratio:.2}, inside the spread of the repeats)")
+        // A report older than the per-seed errors: its median alone.
+        vec![1.0 / (overall * time.median_ms * 1e-3).max(1e-300)]
+    }))
+}
+
+/// The point of `points` with the highest median efficiency among those
+/// whose bias is not resolved, with its per-repeat efficiencies.
+pub fn most_efficient(points: &[Point]) -> Option<(Vec<f64>, &Point)> {
+    most_efficient_by(points, ErrorMeasure::Mse)
+}
+
+/// [`most_efficient`] with the error `measure` chooses.
+pub fn most_efficient_by(points: &[Point], measure: ErrorMeasure) -> Option<(Vec<f64>, &Point)> {
+    points
+        .iter()
+        .filter_map(|p| Some((efficiency_by(p, measure)?.ok()?, p)))
+        .max_by(|a, b| median(&a.0).total_cmp(&median(&b.0)))
+}
+
+/// `a` against `b` by efficiency where neither has a resolved bias;
+/// otherwise what the biased ones are: a biased estimator is judged by its
+/// error at equal time and by its bias, never by 1/(MSE·time).
+pub fn compare_efficiency(a_name: &str, a: &Point, b_name: &str, b: &Point) -> String {
+    compare_efficiency_by(ErrorMeasure::Mse, a_name, a, b_name, b)
+}
+
+/// [`compare_efficiency`] with the error `measure` chooses.
+pub fn compare_efficiency_by(measure: ErrorMeasure, a_name: &str, a: &Point, b_name: &str, b: &Point) -> String {
+    match (efficiency_by(a, measure), efficiency_by(b, measure)) {
+        (Some(Ok(x)), Some(Ok(y))) => compare(measure.name(), a_name, &x, b_name, &y),
+        (Some(x), Some(y)) => {
+            let biased: Vec<String> = [(a_name, x), (b_name, y)]
+                .into_iter()
+                .filter_map(|(name, result)| result.err().map(|bias| format!("{name} is {bias}")))
+                .collect();
+            format!(
+                "{}: no efficiency is given for a biased estimator, whose error does not fall as 1/time; \
+                 compare by error at equal time",
+                biased.join("; ")
+            )
+        }
+        _ => format!("{a_name} and {b_name}: not both measured with time and error"),
     }
+}
+
+/// "biased: bias² 0.0123 (73% of its MSE), energy −4.9%": what a
+/// configuration with a resolved bias is, in place of an efficiency.
+pub fn describe_bias(error: &ImageError) -> String {
+    format!(
+        "biased: bias² {} ({:.0}% of its MSE), energy {:+.1}%",
+        format_number(error.bias2.max(0.0)),
+        100.0 * error.bias2.max(0.0) / error.mse().max(1e-300),
+        100.0 * error.energy_change()
+    )
 }
 
 /// The confidence at which a difference between repeated measurements
@@ -129,7 +206,8 @@ impl RankComparison {
     }
 }
 
-fn median(values: &[f64]) -> f64 {
+/// The median of `values` (the mean of the middle two for an even count).
+pub fn median(values: &[f64]) -> f64 {
     let mut sorted = values.to_vec();
     sorted.sort_by(f64::total_cmp);
     let middle = sorted.len() / 2;
@@ -241,14 +319,54 @@ mod tests {
         assert!((erfc(0.0) - 1.0).abs() < 1e-7 && (erfc(1.0) - 0.157_299_207).abs() < 1e-7);
     }
 
+    /// A measured point: five runs of `ms` ± 1%, five seeds of MSE `mse` ±
+    /// 1%, and a mean radiance `energy` times the reference's.
+    fn point(ms: f64, mse: f64, energy: f64) -> Point {
+        let jitter = [-1.0, -0.5, 0.0, 0.5, 1.0];
+        let mut p = Point::new(16.0, "16");
+        p.time = Some(Timing::of(&jitter.map(|j| ms * (1.0 + 0.01 * j))));
+        let seed_mse: Vec<f64> = jitter.iter().map(|j| mse * (1.0 + 0.01 * j)).collect();
+        let seed_means: Vec<f64> = jitter.iter().map(|j| energy * (1.0 + 1e-4 * j)).collect();
+        p.error = Some(ImageError {
+            rmse: mse.sqrt(),
+            rmse_min: (0.99 * mse).sqrt(),
+            rmse_max: (1.01 * mse).sqrt(),
+            relative_mse: mse,
+            mean: energy,
+            reference_mean: 1.0,
+            bias2: (energy - 1.0).powi(2),
+            variance: mse,
+            bias_resolution: 1.0,
+            seeds: 5,
+            reference_mean_noise: 0.0,
+            seed_mse,
+            seed_relative_mse: jitter.iter().map(|j| mse * (1.0 + 0.01 * j)).collect(),
+            seed_means,
+        });
+        p
+    }
+
     #[test]
-    fn overlapping_ranges_are_not_resolved() {
-        let a = Spread { value: 1.0, low: 0.9, high: 1.1 };
-        let b = Spread { value: 1.09, low: 1.05, high: 1.2 };
-        assert!(!a.resolved_from(&b));
-        assert!(compare("time", "x", &b, "y", &a).contains("not resolved"));
-        let c = Spread { value: 2.0, low: 1.8, high: 2.2 };
-        assert!(c.resolved_from(&a));
-        assert_eq!(compare("efficiency", "c", &c, "a", &a), "c has 2.00× the efficiency of a");
+    fn efficiency_is_compared_only_between_unbiased_configurations() {
+        // Half the MSE in the same time: resolved, twice the efficiency.
+        let (good, plain) = (point(100.0, 0.5, 1.0), point(100.0, 1.0, 1.0));
+        let sentence = compare_efficiency("good", &good, "plain", &plain);
+        assert!(
+            sentence.starts_with("good has 2.00× the efficiency 1/(MSE·time) of plain (Mann–Whitney"),
+            "{sentence}"
+        );
+        // Within the noise of each other: not resolved.
+        let close = point(100.5, 1.0, 1.0);
+        let sentence = compare_efficiency("close", &close, "plain", &plain);
+        assert!(sentence.contains(": not resolved (ratio"), "{sentence}");
+        // 10% of the energy lost, resolved by the seeds' means: biased, no efficiency.
+        let clamped = point(100.0, 0.3, 0.9);
+        assert!(efficiency(&clamped).unwrap().is_err());
+        let sentence = compare_efficiency("the clamp", &clamped, "no clamp", &plain);
+        assert!(sentence.starts_with("the clamp is biased: bias² 0.01"), "{sentence}");
+        assert!(sentence.contains("energy -10.0%") && !sentence.contains("× the efficiency"), "{sentence}");
+        // The most efficient skips the biased one, however low its MSE.
+        let points = [plain.clone(), clamped, good.clone()];
+        assert_eq!(most_efficient(&points).map(|(_, p)| p.time.clone()), Some(good.time.clone()));
     }
 }

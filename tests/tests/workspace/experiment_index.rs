@@ -100,3 +100,79 @@ fn reports_of_different_code_are_refused_by_name() {
     assert!(error.contains("0123456789abcdef") && error.contains("scaling/scaling.json"), "{error}");
     assert!(error.contains("different code"), "{error}");
 }
+
+/// Every report's JSON under `docs/experiments` (a knob's folder holds
+/// its report, or a folder per scene), with its path.
+fn committed_reports() -> Vec<(PathBuf, serde_json::Value)> {
+    fn walk(folder: &Path, found: &mut Vec<(PathBuf, serde_json::Value)>) {
+        for entry in std::fs::read_dir(folder).expect("a report folder").flatten() {
+            let path = entry.path();
+            if path.is_dir() {
+                walk(&path, found);
+            } else if path.extension().is_some_and(|e| e == "json") {
+                let json: serde_json::Value =
+                    serde_json::from_str(&std::fs::read_to_string(&path).unwrap()).expect("valid JSON");
+                if json.get("knob").is_some() {
+                    found.push((path, json));
+                }
+            }
+        }
+    }
+    let mut found = Vec::new();
+    walk(&docs(), &mut found);
+    assert!(found.len() >= 19, "the committed reports: {}", found.len());
+    found
+}
+
+#[test]
+fn every_equal_time_panel_entry_is_within_five_percent_of_its_budget() {
+    let mut entries = 0;
+    for (path, report) in committed_reports() {
+        for panel in report["panels"].as_array().into_iter().flatten() {
+            let Some(budget) = panel["budget_ms"].as_f64() else { continue };
+            for entry in panel["entries"].as_array().expect("the panel's entries") {
+                let share = entry["budget_share"].as_f64().expect("each entry's share of the budget");
+                let time = entry["time_ms"].as_f64().unwrap();
+                assert!((time / budget - share).abs() < 1e-9, "{}: {entry}", path.display());
+                assert!(
+                    (0.95..=1.05).contains(&share),
+                    "{}, {}: {} took {time} ms of a {budget} ms budget",
+                    path.display(),
+                    panel["file"],
+                    entry["label"]
+                );
+                entries += 1;
+            }
+        }
+    }
+    assert!(entries >= 20, "equal-time entries checked: {entries}");
+}
+
+#[test]
+fn no_biased_configuration_is_given_an_efficiency() {
+    let mut biased = 0;
+    for (path, report) in committed_reports() {
+        for series in report["series"].as_array().into_iter().flatten() {
+            for point in series["points"].as_array().into_iter().flatten() {
+                if point["values"]["biased"].as_f64() == Some(1.0) {
+                    biased += 1;
+                    assert!(point["values"].get("efficiency").is_none(), "{}: {point}", path.display());
+                }
+            }
+        }
+        // A finding names an efficiency ratio only through the verdict
+        // module, which refuses biased configurations: "biased" and "× the
+        // efficiency" never meet in one comparison.
+        for finding in report["findings"].as_array().into_iter().flatten() {
+            let finding = finding.as_str().unwrap();
+            for clause in finding.split("; ") {
+                assert!(
+                    !(clause.contains("biased:") && clause.contains("× the efficiency")),
+                    "{}: {finding}",
+                    path.display()
+                );
+            }
+        }
+    }
+    assert!(biased > 0, "the report measures biased configurations (clamps, the denoiser, shallow depths)");
+}

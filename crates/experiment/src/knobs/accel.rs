@@ -19,7 +19,7 @@ use crate::plot::{BOUND_NOTE, Corner, Curve, Plot, rate_or_bound};
 use crate::report::{Point, Report, Series, Table, format_ms, format_number};
 use crate::runner::{build_timed, time_rays};
 use crate::stats::Timing;
-use crate::verdict::{Spread, compare};
+use crate::verdict::{compare, resolved_lower};
 use crate::{ExperimentError, Options, Steps, Subject};
 
 /// Rays the linear scan answers, evenly spaced through each batch: the
@@ -59,6 +59,22 @@ fn configurations(triangles: usize, quick: bool) -> Vec<(String, AccelKind, Buil
     for &sah_bins in bins {
         let params = BuildParams { sah_bins, ..AccelKind::Sah.default_params() };
         list.push((format!("sah bins {sah_bins}"), AccelKind::Sah, params));
+    }
+    // The course's SAH: the longest axis only, at the bin borders.
+    for kind in [AccelKind::Sah, AccelKind::Bvh8] {
+        let params = BuildParams { sah_axes: rtgi_accel::SahAxes::Longest, ..kind.default_params() };
+        list.push((format!("{kind} sah axes longest"), kind, params));
+    }
+    // The SAH's traversal cost against a leaf test: low costs make deep
+    // trees of small leaves, high costs shallow trees of large ones.
+    let costs: &[f32] = if quick { &[4.0] } else { &[0.25, 0.5, 2.0, 4.0] };
+    for kind in [AccelKind::Sah, AccelKind::Bvh8] {
+        for &traversal_cost in costs {
+            let params = BuildParams { traversal_cost, ..kind.default_params() };
+            if params != kind.default_params() {
+                list.push((format!("{kind} traversal cost {traversal_cost}"), kind, params));
+            }
+        }
     }
     list
 }
@@ -133,7 +149,7 @@ pub(super) fn run(
         let (accel, build) = build_timed(&triangles, *kind, params, repeats)?;
         let bytes_per_triangle = accel.build_stats().memory_bytes as f64 / triangles.len().max(1) as f64;
         let mut point = Point::new(index as f64, name.clone());
-        point.time = Some(build);
+        point.time = Some(build.clone());
         let mut cells = vec![
             name.clone(),
             format!("{} ({}–{})", format_ms(build.median_ms), format_ms(build.min_ms), format_ms(build.max_ms)),
@@ -170,6 +186,8 @@ pub(super) fn run(
                 .with(&format!("{batch}_disagreements"), (wrong + wrong_batched) as f64)
                 .with(&format!("{batch}_rays_checked"), subset.len() as f64)
                 .with(&format!("{batch}_rays_timed"), rays.len() as f64);
+            point.timings.insert(format!("{batch}_trace"), single.clone());
+            point.timings.insert(format!("{batch}_batch_trace"), batched.clone());
             rates.push(format_number(mrays(&single)));
             rates.push(format_number(mrays(&batched)));
             nodes.push(format_number(counters.nodes_visited as f64 / counted));
@@ -226,15 +244,11 @@ pub(super) fn run(
     // The fastest on incoherent rays, and whether the runner-up is told apart from it.
     let mut by_speed: Vec<&Point> = report.series.iter().flat_map(|s| &s.points).collect();
     by_speed.sort_by(|a, b| b.values["incoherent_mrays"].total_cmp(&a.values["incoherent_mrays"]));
+    let trace_runs = |p: &Point| p.timings.get("incoherent_trace").map(Timing::samples).unwrap_or_default();
     if let [fastest, second, ..] = &by_speed[..] {
-        let spread = |p: &Point| Spread {
-            value: p.values["incoherent_mrays"],
-            low: p.values["incoherent_mrays_min"],
-            high: p.values["incoherent_mrays_max"],
-        };
         report.findings.push(format!(
             "incoherent rays, the two fastest: {}",
-            compare("throughput", &fastest.label, &spread(fastest), &second.label, &spread(second))
+            compare("trace time", &second.label, &trace_runs(second), &fastest.label, &trace_runs(fastest))
         ));
     }
     // One configuration per structure with its defaults (and the peers), whatever was skipped.
@@ -246,20 +260,42 @@ pub(super) fn run(
     // Build + N rays: where a structure that builds slower but traces
     // faster than the next cheaper one pays for its build.
     let mut by_build: Vec<&Point> = defaults.iter().map(|s| &s.points[0]).collect();
-    by_build.sort_by(|a, b| a.time.expect("measured").median_ms.total_cmp(&b.time.expect("measured").median_ms));
+    by_build.sort_by(|a, b| {
+        a.time.as_ref().expect("measured").median_ms.total_cmp(&b.time.as_ref().expect("measured").median_ms)
+    });
     for pair in by_build.windows(2) {
         let (cheap, dear) = (pair[0], pair[1]);
-        let (build_cheap, build_dear) =
-            (cheap.time.expect("measured").median_ms, dear.time.expect("measured").median_ms);
+        let (build_cheap, build_dear) = (cheap.time.as_ref().expect("measured"), dear.time.as_ref().expect("measured"));
         let (ray_cheap, ray_dear) = (cheap.values["incoherent_ms_per_ray"], dear.values["incoherent_ms_per_ray"]);
-        if ray_dear < ray_cheap {
-            let rays = (build_dear - build_cheap) / (ray_cheap - ray_dear);
+        if ray_dear >= ray_cheap {
+            continue;
+        }
+        // A break-even is a finding only where both differences it rests on
+        // are resolved: the builds' runs and the traces' runs.
+        let builds_apart = resolved_lower(&build_cheap.samples(), &build_dear.samples());
+        let traces_apart = resolved_lower(&trace_runs(dear), &trace_runs(cheap));
+        if builds_apart && traces_apart {
+            let rays = (build_dear.median_ms - build_cheap.median_ms) / (ray_cheap - ray_dear);
             report.findings.push(format!(
-                "{} builds in {} ms more than {} and pays for it from {} incoherent rays on",
+                "{} builds in {} ms more than {} and pays for it from {} incoherent rays on (both differences \
+                 resolved at {:.0}% confidence)",
                 dear.label,
-                format_ms(build_dear - build_cheap),
+                format_ms(build_dear.median_ms - build_cheap.median_ms),
                 cheap.label,
-                format_number(rays.max(0.0))
+                format_number(rays.max(0.0)),
+                100.0 * crate::verdict::CONFIDENCE
+            ));
+        } else {
+            let unresolved = match (builds_apart, traces_apart) {
+                (false, false) => "neither their build times nor their trace times are",
+                (false, true) => "their build times are not",
+                _ => "their trace times are not",
+            };
+            report.findings.push(format!(
+                "{} against {}: no break-even is claimed, as {unresolved} resolved at {:.0}% confidence",
+                dear.label,
+                cheap.label,
+                100.0 * crate::verdict::CONFIDENCE
             ));
         }
     }
@@ -267,7 +303,7 @@ pub(super) fn run(
         .iter()
         .map(|s| {
             let p = &s.points[0];
-            let build = p.time.expect("measured").median_ms;
+            let build = p.time.as_ref().expect("measured").median_ms;
             let per_ray = p.values["incoherent_ms_per_ray"];
             let ns: Vec<f64> = (0..=18).map(|k| 10f64.powf(k as f64 * 0.5)).collect();
             Curve::guide(s.name.clone(), ns.iter().map(|&n| (n, build + n * per_ray)).collect())
@@ -325,11 +361,14 @@ pub(super) fn run(
             .iter()
             .map(|s| {
                 let p = &s.points[0];
-                Curve::new(label(s), vec![(p.time.expect("measured").median_ms, p.values[&format!("{batch}_mrays")])])
-                    .with_bars(vec![Some((
-                        p.values[&format!("{batch}_mrays_min")],
-                        p.values[&format!("{batch}_mrays_max")],
-                    ))])
+                Curve::new(
+                    label(s),
+                    vec![(p.time.as_ref().expect("measured").median_ms, p.values[&format!("{batch}_mrays")])],
+                )
+                .with_bars(vec![Some((
+                    p.values[&format!("{batch}_mrays_min")],
+                    p.values[&format!("{batch}_mrays_max")],
+                ))])
             })
             .collect()
     };

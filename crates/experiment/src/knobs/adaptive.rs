@@ -12,7 +12,7 @@ use crate::plot::{Curve, Plot};
 use crate::reference::reference;
 use crate::report::{Point, Report, Series, Table, measurement_cells, measurement_header};
 use crate::runner::{add_equal_time_panel, measure, ms_per_sample, time_and_error};
-use crate::verdict::{Spread, compare};
+use crate::verdict::{ErrorMeasure, compare_efficiency_by, most_efficient_by};
 use crate::{ExperimentError, Options, Steps, Subject};
 
 /// The most samples a pixel takes under a noise target.
@@ -28,7 +28,7 @@ pub(super) fn run(
     let (counts, targets, most): (&[u32], &[f32], u32) =
         if options.quick { (&[4, 16], &[0.3], 64) } else { (&[16, 64, 256], &[0.2, 0.1, 0.05, 0.03], MOST) };
     let samplers = [PixelSampler::Stratified, PixelSampler::Sobol];
-    let base = RenderSettings { adaptive: None, ..subject.settings.clone() };
+    let base = RenderSettings { adaptive: None, ..super::at_reference_depth(subject) };
     let mut steps = Steps::new(2 + samplers.len() * counts.len() + targets.len(), progress);
     steps.next("reference");
     let reference = reference(subject, &base, options.reference_spp(), options.cache.as_deref(), progress)?;
@@ -74,30 +74,49 @@ pub(super) fn run(
     curves.push(Curve::error_against_time("noise target", &time_and_error(&series)));
     report.series.push(series);
 
-    // The most efficient of each kind, compared: does adaptive sampling win?
-    let best = |name: &str| {
-        report
-            .series
-            .iter()
-            .find(|s| s.name == name)
-            .and_then(|s| Spread::most_efficient(&s.points))
-            .map(|(spread, p)| (spread, p.label.clone()))
-    };
-    let fixed = best(&format!("{}, every pixel alike", PixelSampler::Stratified));
-    let sobol = best(&format!("{}, every pixel alike", PixelSampler::Sobol));
-    if let Some((adaptive_best, label)) = best("noise target") {
-        for (what, other) in [("stratified", fixed), ("sobol", sobol)] {
-            if let Some((other_best, other_label)) = other {
-                report.findings.push(compare(
-                    "efficiency 1/(MSE·time)",
-                    &format!("the most efficient noise target ({label})"),
-                    &adaptive_best,
-                    &format!("the most efficient fixed count, {what} ({other_label} spp)"),
-                    &other_best,
+    // A noise target stops each pixel on its own noise estimate, which
+    // correlates with its value: the stopping rule can bias the image.
+    for point in &report.series.last().expect("the noise targets").points {
+        let error = point.error.as_ref().expect("measured");
+        if error.bias_resolved() {
+            report.findings.push(format!(
+                "{}: the stopping rule is {}",
+                point.label,
+                crate::verdict::describe_bias(error)
+            ));
+        }
+    }
+    // The most efficient of each kind, compared by relative MSE (what a
+    // noise target aims at) and by MSE; first against fixed counts on the
+    // same sampler (Sobol, which adaptive rounds need), then against the
+    // default stratified sampler, which differs in the sampler too.
+    let series_of = |name: &str| report.series.iter().find(|s| s.name == name).map(|s| &s.points[..]).unwrap_or(&[]);
+    let adaptive_points = series_of("noise target");
+    let mut findings = Vec::new();
+    for measure in [ErrorMeasure::RelativeMse, ErrorMeasure::Mse] {
+        let Some((_, adaptive_best)) = most_efficient_by(adaptive_points, measure) else {
+            findings.push(format!("{}: every noise target is biased", measure.name()));
+            continue;
+        };
+        for (what, sampler) in
+            [("the same sampler", PixelSampler::Sobol), ("the default sampler", PixelSampler::Stratified)]
+        {
+            let fixed = series_of(&format!("{sampler}, every pixel alike"));
+            if let Some((_, fixed_best)) = most_efficient_by(fixed, measure) {
+                findings.push(format!(
+                    "against fixed counts on {what}: {}",
+                    compare_efficiency_by(
+                        measure,
+                        &format!("the best noise target ({})", adaptive_best.label),
+                        adaptive_best,
+                        &format!("the best fixed count, {sampler} ({} spp)", fixed_best.label),
+                        fixed_best,
+                    )
                 ));
             }
         }
     }
+    report.findings.extend(findings);
     report.plots.push(Plot::error_against_time(
         "adaptive-tradeoff.svg",
         "RMSE against render time: fixed samples per pixel and noise targets".to_owned(),
@@ -114,7 +133,7 @@ pub(super) fn run(
     let stratified_name = format!("{}, every pixel alike", PixelSampler::Stratified);
     let sobol_name = format!("{}, every pixel alike", PixelSampler::Sobol);
     if let (Some(stratified), Some(sobol)) = (at(&stratified_name), at(&sobol_name)) {
-        let budget = stratified.time.expect("measured").median_ms;
+        let budget = stratified.time.as_ref().expect("measured").median_ms;
         let tightest = *targets.last().expect("targets");
         let configurations = vec![
             (

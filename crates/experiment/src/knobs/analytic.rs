@@ -110,8 +110,8 @@ pub(super) fn run(options: &Options, mut report: Report, progress: &dyn Fn(&str)
                 let error = (bias * bias + spread * spread).sqrt() / exact;
                 let group = label.split_once(", ").map_or(label.as_str(), |(_, rest)| rest).to_owned();
                 match by_strategy.iter_mut().find(|(g, _)| *g == group) {
-                    Some((_, points)) => points.push((time, error, error, error)),
-                    None => by_strategy.push((group, vec![(time, error, error, error)])),
+                    Some((_, points)) => points.push((time.clone(), error, error, error)),
+                    None => by_strategy.push((group, vec![(time.clone(), error, error, error)])),
                 }
             }
             table.rows.push(vec![

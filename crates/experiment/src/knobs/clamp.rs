@@ -11,7 +11,7 @@ use crate::plot::{Corner, Curve, Plot};
 use crate::reference::reference;
 use crate::report::{Point, Report, Series, Table, format_number, measurement_cells, measurement_header};
 use crate::runner::{add_equal_time_panel, measure};
-use crate::verdict::{Spread, compare};
+use crate::verdict::compare_efficiency;
 use crate::{ExperimentError, Options, Steps, Subject};
 
 /// Clamps, as multiples of the reference's mean radiance (its brightest
@@ -27,7 +27,7 @@ pub(super) fn run(
     super::require_light_transport(subject, "clamp")?;
     let limits: &[f64] = if options.quick { &[0.25, 1.0, 4.0] } else { &LIMITS };
     let spp = if options.quick { 4 } else { 16 };
-    let base = RenderSettings { samples_per_pixel: spp, indirect_clamp: None, ..subject.settings.clone() };
+    let base = RenderSettings { samples_per_pixel: spp, indirect_clamp: None, ..super::at_reference_depth(subject) };
     let mut steps = Steps::new(2 + limits.len(), progress);
     steps.next("reference, unclamped");
     let reference = reference(subject, &base, options.reference_spp(), options.cache.as_deref(), progress)?;
@@ -56,7 +56,7 @@ pub(super) fn run(
         let mut row = vec![label.clone(), if limit.is_finite() { format_number(*limit) } else { "–".to_owned() }];
         row.extend(measurement_cells(point));
         table.rows.push(row);
-        let (time, error) = (point.time.expect("measured"), point.error.expect("measured"));
+        let (time, error) = (point.time.as_ref().expect("measured"), point.error.as_ref().expect("measured"));
         if limit.is_finite() {
             // A bias below what the seeds resolve is noise (it may be
             // negative): only resolved ones are drawn, above the resolution's line.
@@ -80,32 +80,55 @@ pub(super) fn run(
     let series_best = 1
         + (0..clamped.len())
             .min_by(|&a, &b| {
-                clamped[a].error.expect("measured").mse().total_cmp(&clamped[b].error.expect("measured").mse())
+                clamped[a]
+                    .error
+                    .as_ref()
+                    .expect("measured")
+                    .mse()
+                    .total_cmp(&clamped[b].error.as_ref().expect("measured").mse())
             })
             .unwrap_or(0);
-    if let Some(best) = clamped.get(series_best - 1) {
-        let e = best.error.expect("measured");
+    let none_error = none.error.as_ref().expect("measured");
+    // A clamp no sample reaches renders the very images of no clamp: the
+    // same error for every seed. It is reported as identical, not as a finding.
+    let identical = |p: &Point| {
+        let e = p.error.as_ref().expect("measured");
+        e.seed_mse == none_error.seed_mse && e.seed_means == none_error.seed_means
+    };
+    let untouched: Vec<&str> = clamped.iter().filter(|p| identical(p)).map(|p| p.label.as_str()).collect();
+    if !untouched.is_empty() {
+        report.findings.push(format!(
+            "the clamp at {} changes no sample at {spp} spp: every seed's render is identical to no clamp's",
+            untouched.join(", ")
+        ));
+    }
+    if let Some(best) = clamped.get(series_best - 1).filter(|p| !identical(p)) {
+        let e = best.error.as_ref().expect("measured");
         report.findings.push(format!(
             "at {spp} spp the clamp at {} has the least MSE: bias² {}, variance {} against the unclamped {} and {}; {}",
             best.label,
-            crate::report::format_bias(&e),
+            crate::report::format_bias(e),
             format_number(e.variance),
-            crate::report::format_bias(&none.error.expect("measured")),
-            format_number(none.error.expect("measured").variance),
-            compare(
-                "efficiency 1/(MSE·time)",
-                &format!("the clamp at {}", best.label),
-                &Spread::efficiency(best).expect("measured"),
-                "no clamp",
-                &Spread::efficiency(none).expect("measured")
-            )
+            crate::report::format_bias(none_error),
+            format_number(none_error.variance),
+            compare_efficiency(&format!("the clamp at {}", best.label), best, "no clamp", none)
         ));
     }
-    if let Some(first) = clamped.iter().rev().find(|p| p.error.expect("measured").bias_resolved()) {
+    // The unclamped render is the baseline: a bias it shares (the reference's
+    // own, or one of the settings) is not the clamp's.
+    if none_error.bias_resolved() {
         report.findings.push(format!(
-            "the clamp's bias is resolved from {} down (the mean radiance is then {:.2}% of the reference's)",
+            "without a clamp the renders are already {} against the reference: a bias of the settings, not of the clamp",
+            crate::verdict::describe_bias(none_error)
+        ));
+    } else if let Some(first) =
+        clamped.iter().rev().find(|p| !identical(p) && p.error.as_ref().expect("measured").bias_resolved())
+    {
+        let e = first.error.as_ref().expect("measured");
+        report.findings.push(format!(
+            "the clamp's bias is resolved from {} down: there it is {}",
             first.label,
-            100.0 * first.error.expect("measured").mean / first.error.expect("measured").reference_mean.max(1e-30)
+            crate::verdict::describe_bias(e)
         ));
     }
     report.series.push(series);
@@ -128,12 +151,12 @@ pub(super) fn run(
     let curves = tradeoff
         .iter()
         .map(|(label, time, error)| {
-            Curve::error_against_time(label, &[(*time, error.rmse, error.rmse_min, error.rmse_max)])
+            Curve::error_against_time(label, &[((*time).clone(), error.rmse, error.rmse_min, error.rmse_max)])
         })
         .collect();
     report.plots.push(Plot::error_against_time("clamp-tradeoff.svg", title, curves));
     // The equal-time panel: no clamp, the harshest, the best and a mild one, in the unclamped render's time.
-    let budget = points[0].2.time.expect("measured").median_ms;
+    let budget = points[0].2.time.as_ref().expect("measured").median_ms;
     let best = series_best;
     let mut chosen: Vec<usize> = vec![0, 1, best, points.len() - 1];
     chosen.dedup();

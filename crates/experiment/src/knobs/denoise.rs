@@ -12,7 +12,7 @@ use crate::plot::{Curve, Plot};
 use crate::reference::reference;
 use crate::report::{Report, Series, Table, format_ms, measurement_cells, measurement_header};
 use crate::runner::{MakeImage, equal_time, measure_with, ms_per_sample, render, render_denoised, time_and_error};
-use crate::verdict::{Spread, compare};
+use crate::verdict::{compare_efficiency, most_efficient};
 use crate::{ExperimentError, Options, Steps, Subject};
 
 /// The sample count whose denoised render sets the equal-time budget.
@@ -27,7 +27,7 @@ pub(super) fn run(
     super::require_light_transport(subject, "denoise")?;
     let counts: &[u32] = if options.quick { &[1, 4] } else { &[1, 4, 16, 64] };
     let budget_spp = if options.quick { 4 } else { BUDGET_SPP };
-    let base = RenderSettings { adaptive: None, ..subject.settings.clone() };
+    let base = RenderSettings { adaptive: None, ..super::at_reference_depth(subject) };
     let mut steps = Steps::new(2 + 2 * counts.len(), progress);
     steps.next("reference");
     let reference = reference(subject, &base, options.reference_spp(), options.cache.as_deref(), progress)?;
@@ -54,15 +54,22 @@ pub(super) fn run(
         curves.push(Curve::error_against_time(name, &time_and_error(&series)));
         report.series.push(series);
     }
-    // The most efficient of each, compared.
-    let best = |series: &Series| Spread::most_efficient(&series.points).map(|(spread, p)| (spread, p.label.clone()));
-    if let (Some((raw, raw_label)), Some((clean, clean_label))) = (best(&report.series[0]), best(&report.series[1])) {
-        report.findings.push(compare(
-            "efficiency 1/(MSE·time)",
-            &format!("the most efficient denoised render ({clean_label} spp)"),
-            &clean,
-            &format!("the most efficient mean of the samples ({raw_label} spp)"),
-            &raw,
+    // The denoiser trades noise for bias: where its bias is resolved it is
+    // judged by that bias and by its error at equal time, not by efficiency.
+    for point in &report.series[1].points {
+        let error = point.error.as_ref().expect("measured");
+        if error.bias_resolved() {
+            report.findings.push(format!("denoised at {} spp: {}", point.label, crate::verdict::describe_bias(error)));
+        }
+    }
+    if let (Some((_, raw)), Some((_, clean))) =
+        (most_efficient(&report.series[0].points), most_efficient(&report.series[1].points))
+    {
+        report.findings.push(compare_efficiency(
+            &format!("the most efficient unbiased denoised render ({} spp)", clean.label),
+            clean,
+            &format!("the most efficient mean of the samples ({} spp)", raw.label),
+            raw,
         ));
     }
     report.plots.push(Plot::error_against_time(
@@ -76,7 +83,7 @@ pub(super) fn run(
     let at = |series: &Series| series.points.iter().find(|p| p.x == budget_spp as f64).cloned();
     if let (Some(raw), Some(clean)) = (at(&report.series[0]), at(&report.series[1])) {
         steps.next("equal-time panel");
-        let budget = clean.time.expect("measured").median_ms;
+        let budget = clean.time.as_ref().expect("measured").median_ms;
         let configuration = (
             "mean of the samples".to_owned(),
             RenderSettings { samples_per_pixel: budget_spp, ..base.clone() },
@@ -90,7 +97,8 @@ pub(super) fn run(
             entries.push(Entry { label: format!("{label}, {budget_spp} spp"), image, time_ms, rmse });
         }
         let title = format!("The samples' mean and the denoised image at equal time ({} ms)", format_ms(budget));
-        let panel = Panel::new("denoise-equal-time.png", title, reference.image.clone(), entries);
+        let mut panel = Panel::new("denoise-equal-time.png", title, reference.image.clone(), entries);
+        panel.budget_ms = Some(budget);
         report.findings.push(panel.caption());
         report.panels.push(panel);
     }

@@ -8,7 +8,7 @@ use crate::plot::{Corner, Curve, Plot};
 use crate::reference::reference;
 use crate::report::{Report, Series, Table, format_bias, measurement_cells, measurement_header};
 use crate::runner::{add_equal_time_panel, measure};
-use crate::verdict::{Spread, compare};
+use crate::verdict::{compare_efficiency, compare_times};
 use crate::{ExperimentError, Options, Steps, Subject};
 
 pub(super) fn run(
@@ -47,7 +47,7 @@ pub(super) fn run(
             steps.next(&format!("{name}, depth {depth}"));
             let settings = RenderSettings { max_depth: depth, russian_roulette: roulette, ..base.clone() };
             let mut point = measure(subject, &settings, options, &reference);
-            let error = point.error.expect("measured");
+            let error = point.error.as_ref().expect("measured");
             let missing = 1.0 - error.mean / error.reference_mean.max(1e-30);
             point.x = depth as f64;
             point.label = depth.to_string();
@@ -64,11 +64,16 @@ pub(super) fn run(
             xs().zip(series.points.iter().map(|p| p.values["energy_missing"] * 100.0)).collect(),
         ));
         times.push(
-            Curve::new(name, xs().zip(series.points.iter().map(|p| p.time.expect("measured").median_ms)).collect())
-                .with_bars(series.points.iter().map(|p| p.time.map(|t| (t.min_ms, t.max_ms))).collect()),
+            Curve::new(
+                name,
+                xs().zip(series.points.iter().map(|p| p.time.as_ref().expect("measured").median_ms)).collect(),
+            )
+            .with_bars(series.points.iter().map(|p| p.time.as_ref().map(|t| (t.min_ms, t.max_ms))).collect()),
         );
-        errors
-            .push(Curve::new(name, xs().zip(series.points.iter().map(|p| p.error.expect("measured").rmse)).collect()));
+        errors.push(Curve::new(
+            name,
+            xs().zip(series.points.iter().map(|p| p.error.as_ref().expect("measured").rmse)).collect(),
+        ));
         tradeoff.push(Curve::error_against_time(name, &crate::runner::time_and_error(&series)));
         report.series.push(series);
     }
@@ -80,16 +85,16 @@ pub(super) fn run(
         }
         // The error of a shallow depth is mostly bias: energy that is
         // missing, which more samples would not bring back.
-        if let Some(first) = series.points.iter().find(|p| !p.error.expect("measured").bias_resolved()) {
+        if let Some(first) = series.points.iter().find(|p| !p.error.as_ref().expect("measured").bias_resolved()) {
             findings.push(format!("{}: the bias is not resolved from depth {} on", series.name, first.label));
         }
         if let Some(shallow) = series.points.first() {
-            let e = shallow.error.expect("measured");
+            let e = shallow.error.as_ref().expect("measured");
             findings.push(format!(
                 "{}: at depth {}, bias² {} is {:.0}% of the MSE (energy missing {:.1}%)",
                 series.name,
                 shallow.label,
-                format_bias(&e),
+                format_bias(e),
                 100.0 * e.bias2.max(0.0) / e.mse().max(1e-300),
                 shallow.values["energy_missing"] * 100.0
             ));
@@ -99,19 +104,13 @@ pub(super) fn run(
     if let [on, off] = &report.series[..]
         && let (Some(a), Some(b)) = (on.points.last(), off.points.last())
     {
-        let (ta, tb) = (Spread::time(&a.time.expect("measured")), Spread::time(&b.time.expect("measured")));
+        let (ta, tb) = (a.time.as_ref().expect("measured"), b.time.as_ref().expect("measured"));
         report.findings.push(format!(
             "at depth {}: {}, at {:.2}× its RMSE; {}",
             a.label,
-            compare("render time", "roulette on", &ta, "roulette off", &tb),
-            a.error.expect("measured").rmse / b.error.expect("measured").rmse.max(1e-30),
-            compare(
-                "efficiency 1/(MSE·time)",
-                "roulette on",
-                &Spread::efficiency(a).expect("measured"),
-                "roulette off",
-                &Spread::efficiency(b).expect("measured")
-            )
+            compare_times("render time", "roulette on", ta, "roulette off", tb),
+            a.error.as_ref().expect("measured").rmse / b.error.as_ref().expect("measured").rmse.max(1e-30),
+            compare_efficiency("roulette on", a, "roulette off", b)
         ));
     }
     let title = format!("RMSE against render time, max depth 1 to {}, {spp} spp", depths.last().expect("depths"));
@@ -157,7 +156,7 @@ pub(super) fn run(
         && let (Some(deep_on), Some(deep_off), Some(shallow_on)) =
             (on.points.last(), off.points.last(), on.points.iter().find(|p| p.x == shallow as f64))
     {
-        let budget = deep_on.time.expect("measured").median_ms;
+        let budget = deep_on.time.as_ref().expect("measured").median_ms;
         let configuration = |label: String, depth: u32, roulette: bool, point: &crate::Point| {
             let settings = RenderSettings { max_depth: depth, russian_roulette: roulette, ..base.clone() };
             (label, settings, crate::runner::ms_per_sample(point, spp))

@@ -20,7 +20,7 @@ use crate::plot::{Curve, Plot};
 use crate::reference::reference;
 use crate::report::{Report, Series, Table, format_ms, format_number, measurement_cells, measurement_header};
 use crate::runner::{add_equal_time_panel, measure};
-use crate::verdict::{Spread, compare};
+use crate::verdict::compare;
 use crate::{ExperimentError, Options, Steps, Subject};
 
 /// A scene of the experiment, as compiled in.
@@ -154,34 +154,55 @@ pub(super) fn run(
             let xy: Vec<(f64, f64)> = series
                 .points
                 .iter()
-                .map(|p| (p.time.expect("measured").median_ms, p.error.expect("measured").rmse))
+                .map(|p| (p.time.as_ref().expect("measured").median_ms, p.error.as_ref().expect("measured").rmse))
                 .collect();
             curves.push(Curve::error_against_time(strategy.to_string(), &crate::runner::time_and_error(&series)));
-            let band = |f: fn(&crate::report::ImageError) -> f64| -> Vec<(f64, f64)> {
-                series
-                    .points
-                    .iter()
-                    .map(|p| (p.time.expect("measured").median_ms, f(&p.error.expect("measured"))))
-                    .collect()
-            };
-            by_time.push((strategy, xy, band(|e| e.rmse_min), band(|e| e.rmse_max)));
+            // Each seed's error against the time, a curve per seed: read at
+            // the budget, they are the repeats the rank test compares.
+            let seeds = series.points.iter().map(|p| p.error.as_ref().expect("measured").seed_mse.len()).min();
+            let per_seed: Vec<Vec<(f64, f64)>> = (0..seeds.unwrap_or(0))
+                .map(|k| {
+                    series
+                        .points
+                        .iter()
+                        .map(|p| {
+                            let e = p.error.as_ref().expect("measured");
+                            (p.time.as_ref().expect("measured").median_ms, e.seed_mse[k].sqrt())
+                        })
+                        .collect()
+                })
+                .collect();
+            by_time.push((strategy, xy, per_seed));
             report.series.push(series);
         }
         // Equal time: the longest time every strategy reached, where each curve is read off without extrapolating.
         let budget = by_time
             .iter()
-            .filter_map(|(_, xy, _, _)| xy.iter().map(|p| p.0).reduce(f64::max))
+            .filter_map(|(_, xy, _)| xy.iter().map(|p| p.0).reduce(f64::max))
             .fold(f64::INFINITY, f64::min);
         let at_budget: Vec<(DirectStrategy, Option<f64>)> =
-            by_time.iter().map(|(strategy, xy, _, _)| (*strategy, log_log_at(xy, budget))).collect();
-        // The RMSE at the budget with the range the seeds give it.
-        let spread_at = |strategy: DirectStrategy| -> Option<Spread> {
-            let (_, xy, low, high) = by_time.iter().find(|(s, ..)| *s == strategy)?;
-            Some(Spread {
-                value: log_log_at(xy, budget)?,
-                low: log_log_at(low, budget)?,
-                high: log_log_at(high, budget)?,
-            })
+            by_time.iter().map(|(strategy, xy, _)| (*strategy, log_log_at(xy, budget))).collect();
+        // Each seed's RMSE at the budget: the repeats of the comparison.
+        let seeds_at = |strategy: DirectStrategy| -> Option<Vec<f64>> {
+            let (_, _, per_seed) = by_time.iter().find(|(s, ..)| *s == strategy)?;
+            per_seed
+                .iter()
+                .map(|curve| log_log_at(curve, budget))
+                .collect::<Option<Vec<f64>>>()
+                .filter(|v| !v.is_empty())
+        };
+        // A strategy whose error does not fall over the measured times at
+        // half the Monte Carlo rate has not converged: a ratio to it is not a
+        // stable number, as it changes with the budget.
+        let converging = |strategy: DirectStrategy| -> bool {
+            let Some((_, xy, _)) = by_time.iter().find(|(s, ..)| *s == strategy) else { return false };
+            let (first, last) = (xy.first().copied(), xy.last().copied());
+            match (first, last) {
+                (Some((t0, e0)), Some((t1, e1))) if t1 > t0 && e0 > 0.0 && e1 > 0.0 => {
+                    (e1 / e0).ln() / (t1 / t0).ln() < -0.25
+                }
+                _ => false,
+            }
         };
         let mut ranked: Vec<(DirectStrategy, f64)> = at_budget.iter().filter_map(|(s, e)| e.map(|e| (*s, e))).collect();
         ranked.sort_by(|a, b| a.1.total_cmp(&b.1));
@@ -191,11 +212,17 @@ pub(super) fn run(
         if let [(best, best_error), (second, second_error), ..] = ranked[..] {
             let others: Vec<String> = ranked[1..]
                 .iter()
-                .map(|(s, e)| format!("{s} {} ({:.2}× the error)", format_number(*e), e / best_error.max(1e-30)))
+                .map(|(s, e)| {
+                    if converging(*s) {
+                        format!("{s} {} ({:.2}× the error)", format_number(*e), e / best_error.max(1e-30))
+                    } else {
+                        format!("{s} {} (not converging over the measured times: no stable ratio)", format_number(*e))
+                    }
+                })
                 .collect();
-            let verdict = match (spread_at(best), spread_at(second)) {
-                (Some(b), Some(s)) => compare("RMSE", &second.to_string(), &s, &best.to_string(), &b),
-                _ => "not resolved".to_owned(),
+            let verdict = match (seeds_at(best), seeds_at(second)) {
+                (Some(b), Some(s)) => compare("RMSE at equal time", &second.to_string(), &s, &best.to_string(), &b),
+                _ => format!("{second} against {best}: not resolved (too few seeds)"),
             };
             report.findings.push(format!(
                 "{name} ({}): at equal time ({} ms), {best} sampling has the lowest RMSE {}; {}; {verdict}{}",
@@ -227,7 +254,7 @@ pub(super) fn run(
                 last.values.insert("rmse_at_equal_time".into(), *error);
             }
         }
-        let times = by_time.iter().flat_map(|(_, xy, _, _)| xy.iter().map(|p| p.0));
+        let times = by_time.iter().flat_map(|(_, xy, _)| xy.iter().map(|p| p.0));
         let (fastest, slowest) = times.fold((f64::INFINITY, 0.0f64), |(lo, hi), t| (lo.min(t), hi.max(t)));
         curves.push(Curve::guide("reference noise", vec![(fastest, noise), (slowest, noise)]));
         report.plots.push(Plot::error_against_time(

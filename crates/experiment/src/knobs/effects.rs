@@ -25,7 +25,7 @@ pub(super) fn run(
     progress: &dyn Fn(&str),
 ) -> Result<Report, ExperimentError> {
     let spp = if options.quick { 4 } else { 64 };
-    let base = RenderSettings { samples_per_pixel: spp, ..subject.settings.clone() };
+    let base = RenderSettings { samples_per_pixel: spp, ..super::at_reference_depth(subject) };
     let plan = EffectPlan::new(&subject.scene, &base);
     let reversals = plan.reversals(&subject.scene, &base);
     if reversals.is_empty() {
@@ -42,9 +42,10 @@ pub(super) fn run(
     // The first render also pays for waking the threads; it must not make the plan look slow.
     crate::runner::render(subject, &RenderSettings { samples_per_pixel: 1, ..base.clone() });
     let planned = measure(subject, &base, options, &reference);
-    let (planned_time, planned_error) = (planned.time.expect("measured"), planned.error.expect("measured"));
+    let (planned_time, planned_error) =
+        (planned.time.as_ref().expect("measured"), planned.error.as_ref().expect("measured"));
     let energy = |p: &Point| {
-        let e = p.error.expect("measured");
+        let e = p.error.as_ref().expect("measured");
         e.mean / e.reference_mean.max(1e-30)
     };
 
@@ -72,7 +73,7 @@ pub(super) fn run(
         .to_vec(),
         rows: vec![vec![
             "plan".to_owned(),
-            format_timing(&planned_time),
+            format_timing(planned_time),
             "1".to_owned(),
             format!(
                 "{} ({}–{})",
@@ -82,7 +83,7 @@ pub(super) fn run(
             ),
             "1".to_owned(),
             format_number(planned_error.relative_mse),
-            format_bias(&planned_error),
+            format_bias(planned_error),
             format_number(planned_error.variance),
             format_number(planned_error.efficiency(planned_time.median_ms)),
             format!("{:.4}", energy(&planned)),
@@ -103,10 +104,10 @@ pub(super) fn run(
         let label = reversal.label();
         steps.next(&label);
         let mut point = measure(subject, &reversal.settings, options, &reference);
-        let (time, error) = (point.time.expect("measured"), point.error.expect("measured"));
+        let (time, error) = (point.time.as_ref().expect("measured"), point.error.as_ref().expect("measured"));
         let time_ratio = time.median_ms / planned_time.median_ms.max(1e-9);
-        // A time whose range overlaps the plan's is not told apart from it.
-        let time_resolved = time.resolved_from(&planned_time);
+        // A time the rank test does not tell from the plan's is not resolved.
+        let time_resolved = crate::verdict::times_resolved(time, planned_time);
         let time_cell =
             |ratio: f64| if time_resolved { format!("{ratio:.3}") } else { format!("{ratio:.3} (not resolved)") };
         let rmse_ratio = error.rmse / planned_error.rmse.max(1e-30);
@@ -143,7 +144,7 @@ pub(super) fn run(
         };
         table.rows.push(vec![
             label.clone(),
-            format_timing(&time),
+            format_timing(time),
             time_cell(time_ratio),
             format!(
                 "{} ({}–{})",
@@ -153,7 +154,7 @@ pub(super) fn run(
             ),
             format!("{rmse_ratio:.4}"),
             format_number(error.relative_mse),
-            format_bias(&error),
+            format_bias(error),
             format_number(error.variance),
             format_number(error.efficiency(time.median_ms)),
             format!("{:.4}", energy(&point)),

@@ -192,7 +192,7 @@ pub(super) fn run(
                 .with(&format!("{batch}_mrays_min"), low)
                 .with(&format!("{batch}_mrays_max"), high);
             if *batch == "camera" {
-                scene_point.time = Some(timing);
+                scene_point.time = Some(timing.clone());
             }
             cells.push(format!("{:.2} ({:.2}–{:.2})", median, low, high));
         }
@@ -259,7 +259,7 @@ pub(super) fn run(
                 .with("escaping_rays", escaping as f64)
                 .with("escaped_percent", percent(leaks, escaping))
                 .with("scale", placement(exponent).0 as f64);
-            point.time = Some(timing);
+            point.time = Some(timing.clone());
             distance_table.rows.push(vec![
                 format!("2^{exponent}"),
                 intersector.name().to_owned(),

@@ -10,7 +10,7 @@ use rtgi_render::rays::{primary_rays, surface_rays};
 use crate::measure::{every_nth, time_rays};
 use crate::plot::{BOUND_NOTE, Corner, Curve, Plot, rate_or_bound};
 use crate::report::{Point, Report, Series, Table, format_number, format_timing};
-use crate::verdict::{Spread, compare};
+use crate::verdict::compare_times;
 use crate::{ExperimentError, Options, Steps, Subject};
 
 /// Rays the linear scan answers per batch, at most.
@@ -74,13 +74,7 @@ pub(super) fn run(
             accel.intersect_batch(subset, &mut answers);
             let differ = answers.iter().zip(expected).filter(|(a, e)| bits(a) != bits(e)).count();
             let name = format!("{kind}, {batch} rays");
-            let verdict = compare(
-                "trace time",
-                "the batch",
-                &Spread::time(&batched),
-                "one ray at a time",
-                &Spread::time(&single),
-            );
+            let verdict = compare_times("trace time", "the batch", &batched, "one ray at a time", &single);
             report.findings.push(format!(
                 "{name}: {verdict}; {differ} of {} batch answers differ from the linear scan's{}",
                 subset.len(),
@@ -96,7 +90,7 @@ pub(super) fn run(
             ]);
             let ns = |ms: f64| ms * 1e6 / rays.len() as f64;
             let fraction = rate_or_bound(differ as f64, subset.len() as f64);
-            for (mode, timing) in [("single", single), ("batch", batched)] {
+            for (mode, timing) in [("single", single.clone()), ("batch", batched.clone())] {
                 curves.push(
                     Curve::new(format!("{kind}, {batch}, {mode}"), vec![(ns(timing.median_ms), fraction)])
                         .with_x_bars(vec![Some((ns(timing.min_ms), ns(timing.max_ms)))]),

@@ -214,7 +214,7 @@ pub(super) fn run(options: &Options, mut report: Report, progress: &dyn Fn(&str)
                     .with("ns_per_test", per_test(timing.median_ms))
                     .with("ns_per_test_min", per_test(timing.min_ms))
                     .with("ns_per_test_max", per_test(timing.max_ms));
-            point.time = Some(timing);
+            point.time = Some(timing.clone());
             table.rows.push(vec![
                 family.name().to_owned(),
                 format_number(parameter as f64),

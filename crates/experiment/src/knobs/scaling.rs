@@ -132,7 +132,7 @@ pub(super) fn run(options: &Options, mut report: Report, progress: &dyn Fn(&str)
                 .with("build_ms", build_ms)
                 .with("bytes_per_triangle", bytes_per_triangle)
                 .with("rays_timed", rays.len() as f64);
-            point.time = Some(timing);
+            point.time = Some(timing.clone());
             table.rows.push(vec![
                 triangles.len().to_string(),
                 kind.to_string(),

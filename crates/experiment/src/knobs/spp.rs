@@ -18,7 +18,7 @@ use crate::plot::{Corner, Curve, Plot};
 use crate::reference::reference;
 use crate::report::{Report, Series, Table, format_number, measurement_cells, measurement_header};
 use crate::runner::{add_equal_time_panel, measure};
-use crate::verdict::{Spread, compare};
+use crate::verdict::compare_efficiency;
 use crate::{ExperimentError, Options, Steps, Subject};
 
 /// The count at which the samplers are compared in efficiency.
@@ -43,7 +43,7 @@ pub(super) fn run(
     }
     let mut steps = Steps::new(1 + integrands.len() * (1 + SAMPLERS.len() * counts.len()), progress);
     for (integrand, integrator, suffix) in integrands {
-        let base = RenderSettings { integrator, ..subject.settings.clone() };
+        let base = RenderSettings { integrator, ..super::at_reference_depth(subject) };
         steps.next(&format!("{integrand}: reference"));
         let reference = reference(subject, &base, options.reference_spp(), options.cache.as_deref(), progress)?;
         let noise = reference.info.noise_rmse;
@@ -74,7 +74,7 @@ pub(super) fn run(
                 table.rows.push(row);
                 series.points.push(point);
             }
-            let rmse = |p: &crate::Point| p.error.expect("measured").rmse;
+            let rmse = |p: &crate::Point| p.error.as_ref().expect("measured").rmse;
             let resolved: Vec<(f64, f64)> =
                 series.points.iter().filter(|p| rmse(p) > NOISE_MARGIN * noise).map(|p| (p.x, rmse(p))).collect();
             let offered = series.points.len();
@@ -94,11 +94,11 @@ pub(super) fn run(
             // bright edges that dominate RMSE; the variance is the part of
             // the error that samples reduce.
             let of = |f: fn(&crate::report::ImageError) -> f64| -> Vec<(f64, f64)> {
-                series.points.iter().map(|p| (p.x, f(&p.error.expect("measured")))).collect()
+                series.points.iter().map(|p| (p.x, f(p.error.as_ref().expect("measured")))).collect()
             };
             report.fit(&series.name, "relative MSE against spp", offered, &of(|e| e.relative_mse));
             report.fit(&series.name, "variance against spp", offered, &of(|e| e.variance));
-            let bars = series.points.iter().map(|p| p.error.map(|e| (e.rmse_min, e.rmse_max))).collect();
+            let bars = series.points.iter().map(|p| p.error.as_ref().map(|e| (e.rmse_min, e.rmse_max))).collect();
             error_curves
                 .push(Curve::new(&label, series.points.iter().map(|p| (p.x, rmse(p))).collect()).with_bars(bars));
             time_curves.push(Curve::error_against_time(sampler.to_string(), &crate::runner::time_and_error(&series)));
@@ -111,14 +111,14 @@ pub(super) fn run(
                 .iter()
                 .rev()
                 .find(|s| s.name == format!("{sampler}, {integrand}"))
-                .and_then(|s| s.points.iter().find(|p| p.x == COMPARED_AT).and_then(Spread::efficiency))
+                .and_then(|s| s.points.iter().find(|p| p.x == COMPARED_AT))
         };
         if let Some(uniform) = at(PixelSampler::Uniform) {
             for &sampler in &SAMPLERS[1..] {
                 if let Some(other) = at(sampler) {
                     report.findings.push(format!(
                         "{integrand}, at {COMPARED_AT} spp: {}",
-                        compare("efficiency 1/(MSE·time)", &sampler.to_string(), &other, "uniform", &uniform)
+                        compare_efficiency(&sampler.to_string(), other, "uniform", uniform)
                     ));
                 }
             }
@@ -153,7 +153,8 @@ pub(super) fn run(
                     s.points.iter().find(|p| p.x == COMPARED_AT.min(*counts.last().expect("counts") as f64))
                 })
             };
-            if let Some(budget) = at_count(PixelSampler::Stratified).and_then(|p| p.time).map(|t| t.median_ms) {
+            if let Some(budget) = at_count(PixelSampler::Stratified).and_then(|p| p.time.as_ref()).map(|t| t.median_ms)
+            {
                 let configurations: Vec<(String, RenderSettings, f64)> = SAMPLERS
                     .iter()
                     .filter_map(|&sampler| {

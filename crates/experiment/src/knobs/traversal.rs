@@ -13,7 +13,7 @@ use rtgi_render::rays::{primary_rays, surface_rays};
 use crate::measure::{every_nth, mrays, time_rays};
 use crate::plot::{BOUND_NOTE, Corner, Curve, Plot, rate_or_bound};
 use crate::report::{Point, Report, Series, Table, format_number, format_timing};
-use crate::verdict::{Spread, compare};
+use crate::verdict::compare_times;
 use crate::{ExperimentError, Options, Steps, Subject};
 
 /// Rays the linear scan answers per batch, at most (it tests every triangle).
@@ -79,7 +79,7 @@ pub(super) fn run(
         let camera = time_rays(&batches[0].1, options.repeats, trace);
         let incoherent_time = time_rays(&batches[1].1, options.repeats, trace);
         let mut point = Point::new(index as f64, name.clone());
-        point.time = Some(incoherent_time);
+        point.time = Some(incoherent_time.clone());
         let (mut wrong, mut total) = (0, 0);
         let mut by_kind = Vec::new();
         for ((batch, _), (subset, expected)) in batches.iter().zip(&checked) {
@@ -115,10 +115,10 @@ pub(super) fn run(
     for kind in [AccelKind::Sah, AccelKind::ObjectMedian] {
         let find = |t: Traversal| report.series.iter().find(|s| s.name == format!("{kind}, {t}")).map(|s| &s.points[0]);
         if let (Some(robust), Some(fast)) = (find(Traversal::Robust), find(Traversal::Fast)) {
-            let time = |p: &Point| Spread::time(&p.time.expect("measured"));
+            let time = |p: &'_ Point| p.time.clone().expect("measured");
             report.findings.push(format!(
                 "{kind}: {}; the fast slab test gives {} of {} answers that differ from the linear scan's, the robust one {}",
-                compare("incoherent trace time", "robust", &time(robust), "fast", &time(fast)),
+                compare_times("incoherent trace time", "robust", &time(robust), "fast", &time(fast)),
                 fast.values["differing"],
                 fast.values["checked"],
                 robust.values["differing"]
