@@ -46,6 +46,8 @@ fn report_scenes(knob: Knob) -> &'static [&'static str] {
     match knob {
         Knob::Spp => &[CORNELL, BUNNY, ROOM, GLOSSY],
         Knob::Depth => &[CORNELL, SPONZA],
+        Knob::BounceSampling => &[CORNELL, GLOSSY],
+        Knob::RouletteStart => &[CORNELL, ROOM],
         Knob::Clamp => &[CORNELL, ROOM, CONFERENCE],
         // Sponza has no glossy or transmitting material: regularisation leaves it bit for bit.
         Knob::FilterGlossy => &[CAUSTICS, MIRROR, CONFERENCE],

@@ -34,6 +34,8 @@ fn every_knob_writes_its_table_json_and_plots() {
     for knob in [
         "spp",
         "depth",
+        "bounce-sampling",
+        "roulette-start",
         "accel",
         "scaling",
         "traversal",
@@ -43,6 +45,8 @@ fn every_knob_writes_its_table_json_and_plots() {
         "filter-glossy",
         "adaptive",
         "denoise",
+        "threads",
+        "image-size",
         "analytic",
         "effects",
         "intersector",
@@ -91,7 +95,17 @@ fn every_knob_writes_its_table_json_and_plots() {
                         assert!(error[field].as_f64().is_some_and(f64::is_finite), "{knob}: {field} in {point}");
                     }
                     assert_eq!(error["seeds"], 2, "{point}");
-                    assert!(point["values"]["efficiency"].as_f64().is_some_and(|e| e > 0.0), "{knob}: {point}");
+                    // Each seed's error is kept for the rank test, and each run's time.
+                    assert_eq!(error["seed_mse"].as_array().map(Vec::len), Some(2), "{point}");
+                    assert_eq!(time["runs_ms"].as_array().map(Vec::len), Some(2), "{point}");
+                    // An efficiency only where the bias is not resolved.
+                    let biased = point["values"]["biased"].as_f64().expect("whether it is biased");
+                    let efficiency = point["values"]["efficiency"].as_f64();
+                    if biased == 1.0 {
+                        assert!(efficiency.is_none(), "{knob}: a biased point with an efficiency: {point}");
+                    } else {
+                        assert!(efficiency.is_some_and(|e| e > 0.0), "{knob}: {point}");
+                    }
                 }
             }
         }

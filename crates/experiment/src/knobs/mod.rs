@@ -8,17 +8,22 @@ use crate::{ExperimentError, Machine, Options, Subject};
 mod accel;
 mod adaptive;
 mod analytic;
+mod bounce_sampling;
 mod clamp;
 mod denoise;
 mod depth;
 mod direct;
 mod effects;
 mod filter_glossy;
+mod image_size;
 mod intersector;
 mod packets;
 mod precision;
+mod roulette_start;
 mod scaling;
 mod spp;
+mod sweep;
+mod threads;
 mod traversal;
 
 /// Something an experiment varies.
@@ -29,6 +34,10 @@ pub enum Knob {
     Spp,
     /// Bounces, with Russian roulette on and off.
     Depth,
+    /// Where bounce directions come from: the BSDF, the cosine or the uniform hemisphere.
+    BounceSampling,
+    /// The bounce from which Russian roulette may end paths.
+    RouletteStart,
     /// The acceleration structures and their build parameters.
     Accel,
     /// The naive O(n) search against the BVH, over triangle counts.
@@ -47,6 +56,10 @@ pub enum Knob {
     Adaptive,
     /// The edge-avoiding denoiser against the samples' mean.
     Denoise,
+    /// Worker threads: render time, and the same bits at every count.
+    Threads,
+    /// Render time against the image's pixel count.
+    ImageSize,
     /// Each estimator's bias against answers known in closed form (white furnaces).
     Analytic,
     /// Each decision of the effects planner reversed.
@@ -65,6 +78,8 @@ impl Knob {
     pub const ALL: &'static [Knob] = &[
         Knob::Spp,
         Knob::Depth,
+        Knob::BounceSampling,
+        Knob::RouletteStart,
         Knob::Accel,
         Knob::Scaling,
         Knob::Traversal,
@@ -74,6 +89,8 @@ impl Knob {
         Knob::FilterGlossy,
         Knob::Adaptive,
         Knob::Denoise,
+        Knob::Threads,
+        Knob::ImageSize,
         Knob::Analytic,
         Knob::Effects,
         Knob::Intersector,
@@ -85,6 +102,8 @@ impl Knob {
         match self {
             Knob::Spp => "spp",
             Knob::Depth => "depth",
+            Knob::BounceSampling => "bounce-sampling",
+            Knob::RouletteStart => "roulette-start",
             Knob::Accel => "accel",
             Knob::Scaling => "scaling",
             Knob::Traversal => "traversal",
@@ -94,6 +113,8 @@ impl Knob {
             Knob::FilterGlossy => "filter-glossy",
             Knob::Adaptive => "adaptive",
             Knob::Denoise => "denoise",
+            Knob::Threads => "threads",
+            Knob::ImageSize => "image-size",
             Knob::Analytic => "analytic",
             Knob::Effects => "effects",
             Knob::Intersector => "intersector",
@@ -108,6 +129,14 @@ impl Knob {
                 "how fast does the error fall with samples per pixel, for each pixel sampler, and at equal time?"
             }
             Knob::Depth => "what do bounces cost, and how much light is missing without them?",
+            Knob::BounceSampling => {
+                "which source of bounce directions (BSDF, cosine or uniform hemisphere) reaches the least error in \
+                 equal time?"
+            }
+            Knob::RouletteStart => {
+                "from which bounce should Russian roulette end paths: what does an early start save in time and cost \
+                 in noise?"
+            }
             Knob::Accel => {
                 "what does each acceleration structure cost to build and to trace, and does it change any answer?"
             }
@@ -133,6 +162,12 @@ impl Knob {
             }
             Knob::Denoise => {
                 "does the denoiser lower the error at equal time, and how much bias does it trade for the noise?"
+            }
+            Knob::Threads => {
+                "what do worker threads buy in render time, and is the image the same bits at every count?"
+            }
+            Knob::ImageSize => {
+                "does render time grow in proportion to the pixels, or does a fixed cost weigh on small images?"
             }
             Knob::Analytic => {
                 "is any estimator (sampler, direct-light strategy, roulette) biased against an answer known exactly?"
@@ -196,6 +231,22 @@ pub(crate) fn run(
         repeats: options.repeats.max(1),
         quick: options.quick,
         reference: None,
+        renders: knob.uses_scene().then(|| {
+            let settings = at_reference_depth(subject);
+            let depth = if knob == Knob::Depth { "varied".to_owned() } else { settings.max_depth.to_string() };
+            format!(
+                "{}x{} pixels, {} integrator, maximum depth {depth}, Russian roulette {} from bounce {}, {} bounce \
+                 sampling, {} sampler, {} direct light",
+                settings.width,
+                settings.height,
+                settings.integrator,
+                if settings.russian_roulette { "on" } else { "off" },
+                settings.roulette_start,
+                settings.bounce_sampling,
+                settings.sampler,
+                settings.direct_strategy
+            )
+        }),
         series: Vec::new(),
         fits: Vec::new(),
         findings: Vec::new(),
@@ -206,6 +257,10 @@ pub(crate) fn run(
     let mut report = match knob {
         Knob::Spp => spp::run(subject, options, report, progress),
         Knob::Depth => depth::run(subject, options, report, progress),
+        Knob::BounceSampling => bounce_sampling::run(subject, options, report, progress),
+        Knob::RouletteStart => roulette_start::run(subject, options, report, progress),
+        Knob::Threads => threads::run(subject, options, report, progress),
+        Knob::ImageSize => image_size::run(subject, options, report, progress),
         Knob::Accel => accel::run(subject, options, report, progress),
         Knob::Scaling => scaling::run(options, report, progress),
         Knob::Traversal => traversal::run(subject, options, report, progress),
@@ -234,4 +289,17 @@ fn require_light_transport(subject: &Subject, knob: &str) -> Result<(), Experime
         "the {knob} experiment needs an integrator that simulates light (the subject uses '{}')",
         subject.settings.integrator
     )))
+}
+
+/// The subject's settings at the depth of the references
+/// ([`crate::reference::CONVERGED_DEPTH`] for paths, with Russian roulette
+/// as the subject has it): what every knob but `depth` renders, so that the
+/// truncation of shallower paths is not a bias shared by every
+/// configuration and called theirs. The `depth` knob measures truncation itself.
+pub(crate) fn at_reference_depth(subject: &Subject) -> rtgi_render::RenderSettings {
+    let mut settings = subject.settings.clone();
+    if settings.integrator == rtgi_render::Integrator::Path {
+        settings.max_depth = settings.max_depth.max(crate::reference::CONVERGED_DEPTH);
+    }
+    settings
 }

@@ -1,0 +1,57 @@
+//! `roulette-start`: the bounce from which Russian roulette may end paths
+//! (`--roulette-start`), and roulette off. Roulette is unbiased wherever it
+//! starts: an early start saves the time of long paths and pays in noise.
+//! Renders run to the references' depth, so that without roulette every
+//! path runs that far.
+
+use rtgi_render::RenderSettings;
+
+use super::sweep::{Setting, measure_settings};
+use crate::reference::reference;
+use crate::report::Report;
+use crate::{ExperimentError, Options, Steps, Subject};
+
+/// The bounces roulette starts at: the first, the default (the second) and later ones.
+const STARTS: [u32; 5] = [1, 2, 3, 5, 8];
+
+pub(super) fn run(
+    subject: &Subject,
+    options: &Options,
+    mut report: Report,
+    progress: &dyn Fn(&str),
+) -> Result<Report, ExperimentError> {
+    super::require_light_transport(subject, "roulette-start")?;
+    let counts: &[u32] = if options.quick { &[4] } else { &[4, 16] };
+    let base = RenderSettings { adaptive: None, ..super::at_reference_depth(subject) };
+    let starts: &[u32] = if options.quick { &[1, 2] } else { &STARTS };
+    let mut settings: Vec<Setting> = starts
+        .iter()
+        .map(|&roulette_start| Setting {
+            label: format!("roulette from bounce {roulette_start}"),
+            settings: RenderSettings { russian_roulette: true, roulette_start, ..base.clone() },
+        })
+        .collect();
+    settings.push(Setting {
+        label: "roulette off".to_owned(),
+        settings: RenderSettings { russian_roulette: false, ..base.clone() },
+    });
+    let default = starts.iter().position(|&s| s == rtgi_render::ROULETTE_START).unwrap_or(0);
+    let mut steps = Steps::new(1 + settings.len() * counts.len(), progress);
+    steps.next("reference");
+    let reference = reference(subject, &base, options.reference_spp(), options.cache.as_deref(), progress)?;
+    measure_settings(
+        subject,
+        options,
+        &mut report,
+        &mut steps,
+        &reference,
+        &settings,
+        default,
+        counts,
+        *counts.last().expect("counts"),
+        "roulette-start-tradeoff.svg",
+        "roulette start",
+    );
+    report.reference = Some(reference.info);
+    Ok(report)
+}
