@@ -43,6 +43,12 @@ fn traceable(ray: &Ray) -> bool {
         && ray.direction.abs().max_element() <= EMBREE_LARGEST
 }
 
+/// The build quality of every scene: Embree's default, the one its own
+/// benchmarks of static scenes use.
+const BUILD_QUALITY: sys::RTCBuildQuality = sys::RTCBuildQuality::MEDIUM;
+/// [`BUILD_QUALITY`] in words, for the records of comparisons.
+const BUILD_QUALITY_NAME: &str = "medium";
+
 /// Rays per packet of the batch queries (`rtcIntersect16`, `rtcOccluded16`).
 const PACKET: usize = 16;
 
@@ -193,6 +199,35 @@ impl EmbreeBackend {
         Ok(backend)
     }
 
+    /// The Embree library this backend calls and how it builds: "Embree
+    /// 3.13.5, build quality medium": what a comparison with it must record.
+    ///
+    /// # Errors
+    /// If Embree cannot create a device (an unsupported CPU).
+    pub fn library() -> Result<String, EmbreeError> {
+        let config = CString::new("threads=1").expect("no NUL byte");
+        // SAFETY: `config` is a NUL-terminated string that outlives the call.
+        let device = unsafe { sys::rtcNewDevice(config.as_ptr()) };
+        if device.is_null() {
+            // SAFETY: with a null device, Embree returns the error of the
+            // last failed device creation on this thread.
+            return Err(EmbreeError::new("create a device", unsafe { sys::rtcGetDeviceError(std::ptr::null_mut()) }));
+        }
+        // SAFETY: `device` is the valid handle just created; the properties
+        // are plain integers; the device is released once, here.
+        let [major, minor, patch] = unsafe {
+            let version = [
+                sys::RTCDeviceProperty::VERSION_MAJOR,
+                sys::RTCDeviceProperty::VERSION_MINOR,
+                sys::RTCDeviceProperty::VERSION_PATCH,
+            ]
+            .map(|property| sys::rtcGetDeviceProperty(device, property));
+            sys::rtcReleaseDevice(device);
+            version
+        };
+        Ok(format!("Embree {major}.{minor}.{patch}, build quality {BUILD_QUALITY_NAME}"))
+    }
+
     /// Creates, fills and commits the scene: one triangle geometry whose
     /// primitive `i` is `kept[i]` (three vertices of its own, no sharing).
     fn commit(&mut self, kept: &[[Vec3; 3]]) -> Result<(), EmbreeError> {
@@ -217,7 +252,7 @@ impl EmbreeBackend {
         // Embree's default build quality, set to say so.
         unsafe {
             sys::rtcSetSceneFlags(self.scene, sys::RTCSceneFlags::CONTEXT_FILTER_FUNCTION);
-            sys::rtcSetSceneBuildQuality(self.scene, sys::RTCBuildQuality::MEDIUM);
+            sys::rtcSetSceneBuildQuality(self.scene, BUILD_QUALITY);
         }
         if !kept.is_empty() {
             self.attach_triangles(kept)?;

@@ -114,6 +114,20 @@ pub mod verify;
 mod wide;
 
 pub use bvh::{Bvh, BvhNode, PrimitiveBvh, SplitMethod, Traversal};
+
+/// The peer libraries this build can measure beside our structures, each
+/// with its version and how it builds ("Embree 3.13.5, build quality
+/// medium"), or why it cannot run; empty without the `embree` feature.
+pub fn peer_libraries() -> Vec<String> {
+    #[cfg(feature = "embree")]
+    {
+        vec![EmbreeBackend::library().unwrap_or_else(|e| format!("Embree, unavailable: {e}"))]
+    }
+    #[cfg(not(feature = "embree"))]
+    {
+        Vec::new()
+    }
+}
 pub use contract::is_hittable;
 pub use counters::{Counter, NoCounter, TraversalCounters};
 #[cfg(feature = "embree")]

@@ -7,6 +7,11 @@ use serde::{Deserialize, Serialize};
 pub struct Machine {
     /// The CPU's model name, as the operating system reports it.
     pub cpu: String,
+    /// The CPU's identity beyond its name, which a virtual machine often
+    /// makes generic ("Intel Xeon Processor"): vendor, family, model and
+    /// stepping, microcode and cache, as `/proc/cpuinfo` gives them.
+    #[serde(default)]
+    pub cpu_id: String,
     /// Logical cores the operating system offers this process.
     pub cores: usize,
     /// Worker threads the experiment used.
@@ -22,6 +27,7 @@ impl Machine {
     pub fn this(threads: usize) -> Machine {
         Machine {
             cpu: cpu_model().unwrap_or_else(|| std::env::consts::ARCH.to_owned()),
+            cpu_id: cpu_id().unwrap_or_default(),
             cores: std::thread::available_parallelism().map_or(1, |n| n.get()),
             threads,
             simd: rtgi_accel::simd::active_simd_level().name().to_owned(),
@@ -35,6 +41,28 @@ impl Machine {
         let cpu = cpu.split(" @ ").next().unwrap_or(&cpu).split_whitespace().collect::<Vec<_>>().join(" ");
         format!("{cpu}, {} thread{}", self.threads, if self.threads == 1 { "" } else { "s" })
     }
+}
+
+/// "GenuineIntel family 6 model 106 stepping 6, microcode 0x1, cache 16384 KB"
+/// from the first processor of `/proc/cpuinfo` (Linux); `None` elsewhere.
+fn cpu_id() -> Option<String> {
+    let info = std::fs::read_to_string("/proc/cpuinfo").ok()?;
+    let field = |name: &str| {
+        info.lines()
+            .find(|line| line.split(':').next().is_some_and(|key| key.trim() == name))
+            .and_then(|line| line.split_once(':'))
+            .map(|(_, value)| value.trim().to_owned())
+            .unwrap_or_else(|| "?".to_owned())
+    };
+    Some(format!(
+        "{} family {} model {} stepping {}, microcode {}, cache {}",
+        field("vendor_id"),
+        field("cpu family"),
+        field("model"),
+        field("stepping"),
+        field("microcode"),
+        field("cache size")
+    ))
 }
 
 /// The model name from `/proc/cpuinfo` (Linux); `None` elsewhere.

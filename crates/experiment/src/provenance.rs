@@ -25,6 +25,10 @@ pub struct Build {
     pub rustflags: String,
     /// The target features the code was compiled for (SIMD beyond them is chosen at run time).
     pub target_features: String,
+    /// The peer libraries built in, with their versions and build quality
+    /// (`rtgi_accel::peer_libraries`).
+    #[serde(default)]
+    pub peers: Vec<String>,
 }
 
 impl Build {
@@ -40,6 +44,7 @@ impl Build {
             opt_level: env!("RTGI_BUILD_OPT_LEVEL").to_owned(),
             rustflags: env!("RTGI_BUILD_RUSTFLAGS").to_owned(),
             target_features: env!("RTGI_BUILD_TARGET_FEATURES").to_owned(),
+            peers: rtgi_accel::peer_libraries(),
         }
     }
 
