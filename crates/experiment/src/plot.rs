@@ -191,6 +191,12 @@ fn wrap(text: &str, width: usize) -> Vec<String> {
     lines
 }
 
+/// `text` broken at spaces into lines of at most `width` characters, for
+/// other drawings' titles (the equal-time panels').
+pub(crate) fn wrap_text(text: &str, width: usize) -> Vec<String> {
+    wrap(text, width)
+}
+
 /// A tick's label: as [`format_number`] writes it, but `2e-5` rather than
 /// `2.000e-5` for small and large values.
 fn format_tick(v: f64) -> String {
