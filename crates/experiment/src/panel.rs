@@ -239,7 +239,7 @@ impl Panel {
                 let errors = errors(&e.image, &self.reference);
                 let above = (crop.y..crop.y + crop.side)
                     .flat_map(|y| (crop.x..crop.x + crop.side).map(move |x| (y * width + x) as usize))
-                    .filter(|&i| !(errors[i] as f64 <= self.scale))
+                    .filter(|&i| errors[i].is_nan() || errors[i] as f64 > self.scale)
                     .count();
                 above as f64 / (crop.side * crop.side).max(1) as f64
             })
