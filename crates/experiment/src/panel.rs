@@ -2,11 +2,14 @@
 //! same time, beside a false-colour map of each one's error against the
 //! reference, so that what the numbers say can be seen.
 //!
-//! The panel is a PNG, and an SVG that shows that PNG with its labels
-//! (configuration, time, RMSE) and the error scale's colour bar: text in
-//! the PNG itself would need a font, which no dependency of ours carries,
-//! while an SVG's text is drawn by the viewer. The caption, with the same
-//! figures, is a finding, so the JSON holds it too.
+//! The panel is a PNG that carries its labels (the title above; under each
+//! column its configuration, time, RMSE and, where its error clips, how
+//! much; the error scale's colour bar with its range), rasterised with an
+//! 8×8 bitmap font, so that it reads alone; and an SVG that shows the
+//! unlabelled tiles with the same labels as text the viewer draws. The
+//! error scale is one per panel: the labels and the caption say which
+//! entries clip on it. The caption, with the same figures, is a finding, so
+//! the JSON holds it too.
 
 use std::path::Path;
 
@@ -70,6 +73,63 @@ fn wrapped(label: &str, width: usize) -> Vec<String> {
         }
     }
     lines.iter().map(|line| line.trim_end().to_owned()).collect()
+}
+
+/// Text drawn into the PNG: black on white.
+const INK: Vec3 = Vec3::ZERO;
+/// An entry whose error exceeds the panel's scale in more than this
+/// fraction of its crop's pixels is said to clip (the scale is a median of
+/// the entries' 99th percentiles, so about 1% is the norm).
+const CLIP_NOTE: f64 = 0.01;
+
+/// The 8×8 glyph of `c`: ASCII from the font, a few other characters as
+/// their nearest ASCII, anything else as `?`.
+fn glyph(c: char) -> [u8; 8] {
+    let c = match c {
+        '×' => 'x',
+        '≤' => '<',
+        '–' | '—' | '−' => '-',
+        '²' => '2',
+        'µ' => 'u',
+        c => c,
+    };
+    let index = if c.is_ascii() { c as usize } else { '?' as usize };
+    font8x8::legacy::BASIC_LEGACY[index]
+}
+
+/// Width in pixels of `text` at `scale` (8 pixels a character, times the scale).
+fn text_width(text: &str, scale: u32) -> u32 {
+    text.chars().count() as u32 * 8 * scale
+}
+
+/// Draws `text` into `pixels` (an image `width` wide) with its top left at
+/// `(x, y)`, each font pixel `scale` pixels square; what falls outside is cut.
+fn draw_text(pixels: &mut [Vec3], width: u32, (x, y): (u32, u32), text: &str, scale: u32) {
+    let height = pixels.len() as u32 / width.max(1);
+    for (i, c) in text.chars().enumerate() {
+        let left = x + i as u32 * 8 * scale;
+        for (row, bits) in glyph(c).iter().enumerate() {
+            for col in 0..8u32 {
+                // Bit 0 is the glyph's leftmost pixel.
+                if bits & (1 << col) == 0 {
+                    continue;
+                }
+                for dy in 0..scale {
+                    for dx in 0..scale {
+                        let (px, py) = (left + col * scale + dx, y + row as u32 * scale + dy);
+                        if px < width && py < height {
+                            pixels[(py * width + px) as usize] = INK;
+                        }
+                    }
+                }
+            }
+        }
+    }
+}
+
+/// Draws `text` centred on column `centre`.
+fn draw_centred(pixels: &mut [Vec3], width: u32, (centre, y): (u32, u32), text: &str, scale: u32) {
+    draw_text(pixels, width, (centre.saturating_sub(text_width(text, scale) / 2), y), text, scale);
 }
 
 /// The absolute error of each pixel (mean over channels).
@@ -175,14 +235,41 @@ impl Panel {
         self.budget_ms.map(|budget| entry.time_ms / budget.max(1e-9))
     }
 
+    /// Per entry, the fraction of its crop's pixels whose error is above
+    /// the panel's one error scale (drawn saturated: they clip).
+    pub fn clipped(&self) -> Vec<f64> {
+        let crop = self.crop;
+        let width = self.reference.width();
+        self.entries
+            .iter()
+            .map(|e| {
+                let errors = errors(&e.image, &self.reference);
+                let above = (crop.y..crop.y + crop.side)
+                    .flat_map(|y| (crop.x..crop.x + crop.side).map(move |x| (y * width + x) as usize))
+                    .filter(|&i| errors[i].is_nan() || errors[i] as f64 > self.scale)
+                    .count();
+                above as f64 / (crop.side * crop.side).max(1) as f64
+            })
+            .collect()
+    }
+
+    /// The note on an entry that clips: `clips 12%` (of its crop's pixels), or none.
+    fn clip_note(fraction: f64) -> Option<String> {
+        (fraction > CLIP_NOTE).then(|| format!("clips {:.0}%", 100.0 * fraction))
+    }
+
     /// What the panel shows, left to right, with the figures: for the report's findings.
     pub fn caption(&self) -> String {
         let entries: Vec<String> = self
             .entries
             .iter()
-            .map(|e| {
+            .zip(self.clipped())
+            .map(|(e, clipped)| {
+                let clips = Self::clip_note(clipped)
+                    .map(|_| format!(", {:.0}% of its crop above the scale", 100.0 * clipped))
+                    .unwrap_or_default();
                 format!(
-                    "{} ({} ms{}, RMSE {})",
+                    "{} ({} ms{}, RMSE {}{clips})",
                     e.label,
                     crate::report::format_ms(e.time_ms),
                     self.budget_share(e).map_or(String::new(), |share| {
@@ -197,9 +284,21 @@ impl Panel {
                 )
             })
             .collect();
+        let clipping: Vec<&str> = self
+            .entries
+            .iter()
+            .zip(self.clipped())
+            .filter(|(_, c)| Self::clip_note(*c).is_some())
+            .map(|(e, _)| e.label.as_str())
+            .collect();
+        let clipping = if clipping.is_empty() {
+            "no entry clips on it".to_owned()
+        } else {
+            format!("clipping on it: {}", clipping.join(", "))
+        };
         format!(
             "{} ({}): top, the reference then {}; below, each one's absolute error, black 0 to pale yellow {} \
-             (inferno scale); crop {}×{} at ({}, {})",
+             (inferno scale, one error scale per panel; {clipping}); crop {}×{} at ({}, {})",
             self.title,
             self.file,
             entries.join(", "),
@@ -211,10 +310,10 @@ impl Panel {
         )
     }
 
-    /// Writes the PNG to `path`: the reference's crop and each entry's in
+    /// The tiles without labels: the reference's crop and each entry's in
     /// the top row, tone-mapped alike (ACES at the reference's automatic
     /// exposure), and each entry's error map below (`heat_colour`, one scale for all).
-    pub fn write(&self, path: &Path) -> Result<(), ExperimentError> {
+    fn tiles(&self) -> HdrImage {
         let (reference, crop) = (&self.reference, self.crop);
         let tone = ToneMap { exposure: auto_exposure(reference), operator: ToneOperator::Aces };
         let tile = crop.side * ZOOM;
@@ -239,33 +338,102 @@ impl Panel {
             let scale = self.scale as f32;
             put(column, 1, &|x, y| heat_colour(errors[(y * reference.width() + x) as usize] / scale));
         }
-        let panel = HdrImage::from_pixels(width, height, pixels).expect("the sizes agree");
-        panel
-            .write(path, &ToneMap::default())
-            .map_err(|e| ExperimentError::Image { path: path.to_owned(), message: e.to_string() })?;
-        self.write_labelled(path, width, height)
+        HdrImage::from_pixels(width, height, pixels).expect("the sizes agree")
     }
 
-    /// Writes the SVG beside the PNG at `png`: the PNG (embedded, so the
-    /// SVG stands alone), the title above it, under each column its label,
+    /// Each column's labels: the configuration (wrapped to `chars` a line),
+    /// its time, its RMSE and, where its error clips on the panel's scale, how much.
+    fn column_labels(&self, chars: usize) -> Vec<Vec<String>> {
+        std::iter::once(vec!["reference".to_owned()])
+            .chain(self.entries.iter().zip(self.clipped()).map(|(e, clipped)| {
+                let mut lines = wrapped(&e.label, chars.max(1));
+                lines.push(format!("{} ms", crate::report::format_ms(e.time_ms)));
+                lines.push(format!("RMSE {}", crate::report::format_number(e.rmse)));
+                lines.extend(Self::clip_note(clipped));
+                lines
+            }))
+            .collect()
+    }
+
+    /// `tiles` with the labels drawn in: the title in a band above, each
+    /// column's labels under it, and the colour bar of the error scale with
+    /// its range at the foot; with the row at which the tiles start.
+    fn labelled(&self, tiles: &HdrImage) -> (HdrImage, u32) {
+        let (width, tiles_height) = (tiles.width(), tiles.height());
+        let tile = self.crop.side * ZOOM;
+        // Twice the font's size where the tiles leave room for 12 characters, else its own.
+        let scale = if tile >= 12 * 16 { 2 } else { 1 };
+        let line = 8 * scale + 4;
+        let title_scale = if text_width(&self.title, 2) + 2 * GAP <= width { 2 } else { 1 };
+        let title = crate::plot::wrap_text(&self.title, ((width - 2 * GAP) / (8 * title_scale)).max(1) as usize);
+        let title_band = 6 + title.len() as u32 * (8 * title_scale + 4) + 4;
+        let columns = self.column_labels((tile / (8 * scale)) as usize);
+        let label_lines = columns.iter().map(Vec::len).max().unwrap_or(1) as u32;
+        let label_band = 4 + label_lines * line + 4;
+        let bar_band = 12 + line + 6;
+        let height = title_band + tiles_height + label_band + bar_band;
+        let mut pixels = vec![Vec3::ONE; (width * height) as usize];
+        for y in 0..tiles_height {
+            let row = (y * width) as usize;
+            let to = ((title_band + y) * width) as usize;
+            pixels[to..to + width as usize].copy_from_slice(&tiles.pixels()[row..row + width as usize]);
+        }
+        for (i, text) in title.iter().enumerate() {
+            draw_centred(&mut pixels, width, (width / 2, 6 + i as u32 * (8 * title_scale + 4)), text, title_scale);
+        }
+        let label_top = title_band + tiles_height + 4;
+        for (column, lines) in columns.iter().enumerate() {
+            let centre = GAP + column as u32 * (tile + GAP) + tile / 2;
+            for (i, text) in lines.iter().enumerate() {
+                draw_centred(&mut pixels, width, (centre, label_top + i as u32 * line), text, scale);
+            }
+        }
+        // The colour bar across the middle half, 0 at its left end, the scale at its right.
+        let (bar_left, bar_width, bar_top) = (width / 4, (width / 2).max(1), title_band + tiles_height + label_band);
+        for x in bar_left..bar_left + bar_width {
+            let colour = heat_colour((x - bar_left) as f32 / bar_width as f32);
+            for y in bar_top..bar_top + 8 {
+                pixels[(y * width + x) as usize] = colour;
+            }
+        }
+        let top = format!("{}+", crate::report::format_number(self.scale));
+        draw_text(&mut pixels, width, (bar_left, bar_top + 10), "0", scale);
+        let right = (bar_left + bar_width).saturating_sub(text_width(&top, scale));
+        draw_text(&mut pixels, width, (right, bar_top + 10), &top, scale);
+        (HdrImage::from_pixels(width, height, pixels).expect("the sizes agree"), title_band)
+    }
+
+    /// Writes the PNG to `path`, with its labels drawn in ([`Panel::labelled`]),
+    /// and the SVG beside it, which shows the tiles with its labels as text.
+    pub fn write(&self, path: &Path) -> Result<(), ExperimentError> {
+        let image_error = |message: String| ExperimentError::Image { path: path.to_owned(), message };
+        let tiles = self.tiles();
+        let (panel, _) = self.labelled(&tiles);
+        panel.write(path, &ToneMap::default()).map_err(|e| image_error(e.to_string()))?;
+        let mut png = Vec::new();
+        image::ImageEncoder::write_image(
+            image::codecs::png::PngEncoder::new(&mut png),
+            &tiles.to_srgb8(&ToneMap::default()),
+            tiles.width(),
+            tiles.height(),
+            image::ExtendedColorType::Rgb8,
+        )
+        .map_err(|e| image_error(e.to_string()))?;
+        self.write_labelled(path, &png, tiles.width(), tiles.height())
+    }
+
+    /// Writes the SVG beside the PNG at `png`: the unlabelled tiles (a PNG,
+    /// embedded, so the SVG stands alone), the title above them, under each column its label,
     /// time and RMSE, and at the foot the error scale as a colour bar.
-    fn write_labelled(&self, png: &Path, width: u32, height: u32) -> Result<(), ExperimentError> {
+    fn write_labelled(&self, png: &Path, tiles: &[u8], width: u32, height: u32) -> Result<(), ExperimentError> {
         use base64::Engine;
         use std::fmt::Write;
-        let bytes = std::fs::read(png).map_err(|source| ExperimentError::Write { path: png.to_owned(), source })?;
-        let encoded = base64::engine::general_purpose::STANDARD.encode(bytes);
+        let encoded = base64::engine::general_purpose::STANDARD.encode(tiles);
         // Small crops are shown larger, so that each column is wide enough for its label.
         let scale = MIN_LABELLED_TILE.div_ceil(self.crop.side * ZOOM).max(1);
         let (width, height) = (width * scale, height * scale);
         let (tile, gap) = (self.crop.side * ZOOM * scale, GAP * scale);
-        let columns: Vec<Vec<String>> = std::iter::once(vec!["reference".to_owned()])
-            .chain(self.entries.iter().map(|e| {
-                let mut lines = wrapped(&e.label, (tile as f32 / LABEL_CHAR_WIDTH) as usize);
-                lines.push(format!("{} ms", crate::report::format_ms(e.time_ms)));
-                lines.push(format!("RMSE {}", crate::report::format_number(e.rmse)));
-                lines
-            }))
-            .collect();
+        let columns = self.column_labels((tile as f32 / LABEL_CHAR_WIDTH) as usize);
         let label_lines = columns.iter().map(Vec::len).max().unwrap_or(1) as u32;
         let label_band = 8 + LABEL_LINE * label_lines + 8;
         let total_height = TITLE_BAND + height + label_band + BAR_BAND;
@@ -342,6 +510,39 @@ mod tests {
         assert_eq!(wrapped("a, b, c", 1), ["a,", "b,", "c"]);
     }
 
+    /// How many of the rows `rows` of `png` are dark (text) pixels.
+    fn dark_pixels(png: &image::RgbImage, rows: std::ops::Range<u32>) -> usize {
+        rows.flat_map(|y| (0..png.width()).map(move |x| (x, y)))
+            .filter(|&(x, y)| png.get_pixel(x, y).0.iter().all(|&c| c < 60))
+            .count()
+    }
+
+    #[test]
+    fn the_png_carries_its_labels() {
+        let reference = flat(0.5);
+        let entries = vec![
+            Entry { label: "a".into(), image: flat(0.6), time_ms: 1.0, rmse: 0.1 },
+            Entry { label: "b".into(), image: flat(0.7), time_ms: 2.0, rmse: 0.2 },
+        ];
+        let panel = Panel::new("labels.png", "TITLE", reference, entries);
+        let tiles = panel.tiles();
+        let (labelled, top) = panel.labelled(&tiles);
+        let bytes = labelled.to_srgb8(&ToneMap::default());
+        let png = image::RgbImage::from_raw(labelled.width(), labelled.height(), bytes).unwrap();
+        // The title band and the label band under the tiles have text in them; the tiles are where they were.
+        assert!(dark_pixels(&png, 0..top) > 40, "title");
+        let below = top + tiles.height();
+        assert!(dark_pixels(&png, below..png.height()) > 200, "labels");
+        assert_eq!(labelled.get(GAP + 1, top + GAP + 1), tiles.get(GAP + 1, GAP + 1));
+        // The glyphs are the font's: "T" is a bar across the top of its cell.
+        let mut pixels = vec![Vec3::ONE; 8 * 8];
+        draw_text(&mut pixels, 8, (0, 0), "T", 1);
+        let row = |y: usize| (0..8).filter(|&x| pixels[y * 8 + x] == INK).count();
+        assert!(row(0) >= 6 && row(4) <= 2, "{}", (0..8).map(row).map(|n| n.to_string()).collect::<String>());
+        // And an empty title band when there is nothing to say is still white.
+        assert_eq!(dark_pixels(&png, 0..2), 0);
+    }
+
     fn flat(value: f32) -> HdrImage {
         HdrImage::from_pixels(16, 16, vec![Vec3::splat(value); 256]).unwrap()
     }
@@ -374,17 +575,30 @@ mod tests {
             svg.contains("data:image/png;base64,") && svg.contains(">noisy<") && svg.contains(">RMSE 0.1<"),
             "{svg}"
         );
-        assert!(panel.caption().contains("noisy (1.00 ms, RMSE 0.1)"), "{}", panel.caption());
+        assert!(panel.caption().contains("noisy (1.00 ms, RMSE 0.1, "), "{}", panel.caption());
         let png = image::open(&path).unwrap().to_rgb8();
         let tile = crop.side * ZOOM;
-        assert_eq!((png.width(), png.height()), (3 * tile + 4 * GAP, 2 * tile + 3 * GAP));
+        let tiles = panel.tiles();
+        assert_eq!((tiles.width(), tiles.height()), (3 * tile + 4 * GAP, 2 * tile + 3 * GAP));
+        let (labelled, top) = panel.labelled(&tiles);
+        assert_eq!((png.width(), png.height()), (labelled.width(), labelled.height()));
+        assert!(top > 0 && png.height() > top + tiles.height());
         // The exact entry's error map is the scale's zero everywhere; the noisy one's is bright where it errs.
         let zero = heat_colour(0.0).to_array().map(|c| (rtgi_image::linear_to_srgb(c) * 255.0 + 0.5) as u8);
-        let exact_error = png.get_pixel(2 * GAP + tile + 1, 2 * GAP + tile + 1).0;
+        let exact_error = png.get_pixel(2 * GAP + tile + 1, top + 2 * GAP + tile + 1).0;
         assert_eq!(exact_error, zero);
         let (ex, ey) = ((12 - crop.x) * ZOOM + 1, (11 - crop.y) * ZOOM + 1);
-        let noisy_error = png.get_pixel(3 * GAP + 2 * tile + ex, 2 * GAP + tile + ey).0;
+        let noisy_error = png.get_pixel(3 * GAP + 2 * tile + ex, top + 2 * GAP + tile + ey).0;
         assert!(noisy_error.iter().map(|&c| c as u32).sum::<u32>() > 500, "{noisy_error:?}");
+        // The noisy entry clips on the one scale (its 4×4 error block is 1.5, the scale 0.75), and says so.
+        let clipped = panel.clipped();
+        assert_eq!(clipped[0], 0.0);
+        assert!((clipped[1] - 16.0 / 64.0).abs() < 1e-9, "{clipped:?}");
+        assert!(
+            panel.caption().contains("25% of its crop above the scale")
+                && panel.caption().contains("clipping on it: noisy")
+        );
+        assert!(svg.contains(">clips 25%<"), "{svg}");
         let _ = std::fs::remove_dir_all(&dir);
     }
 }

@@ -166,7 +166,7 @@ pub fn plot(file: &str, configurations: &[Configuration]) -> Plot {
         file: file.to_owned(),
         title: "Every configuration measured on the scene: RMSE against render time".to_owned(),
         x_label: "render time (ms, median; bars: min–max)".to_owned(),
-        y_label: "RMSE of linear radiance (bars: seeds' min–max)".to_owned(),
+        y_label: "RMSE of linear radiance (radiance; bars: seeds' min–max)".to_owned(),
         log_x: true,
         log_y: true,
         curves,

@@ -15,7 +15,7 @@ use rtgi_math::Ray;
 use rtgi_render::rays::{primary_rays, surface_rays};
 
 use crate::measure::every_nth;
-use crate::plot::{BOUND_NOTE, Corner, Curve, Plot, rate_or_bound};
+use crate::plot::{BOUND_NOTE, Corner, Curve, Plot, is_bound, rate_or_bound};
 use crate::report::{Point, Report, Series, Table, format_ms, format_number};
 use crate::runner::{build_timed, time_rays};
 use crate::stats::Timing;
@@ -312,8 +312,8 @@ pub(super) fn run(
     report.plots.push(Plot {
         file: "accel-total.svg".into(),
         title: "Build plus trace time against the rays traced (incoherent, one at a time)".into(),
-        x_label: "incoherent rays traced".into(),
-        y_label: "build + rays × measured time per ray (ms)".into(),
+        x_label: "incoherent rays traced (count)".into(),
+        y_label: "total time: build + rays × measured time per ray (ms)".into(),
         log_x: true,
         log_y: true,
         curves: totals,
@@ -330,7 +330,9 @@ pub(super) fn run(
             let wrong = p.values["camera_disagreements"] + p.values["incoherent_disagreements"];
             let ns = p.values["incoherent_ms_per_ray"] * 1e6;
             let spread = (1e3 / p.values["incoherent_mrays_max"], 1e3 / p.values["incoherent_mrays_min"]);
-            Curve::new(s.name.clone(), vec![(ns, rate_or_bound(wrong, checked_of(p)))]).with_x_bars(vec![Some(spread)])
+            Curve::new(s.name.clone(), vec![(ns, rate_or_bound(wrong, checked_of(p)))])
+                .with_x_bars(vec![Some(spread)])
+                .with_bounds(vec![is_bound(wrong)])
         })
         .collect();
     let exact = defaults.iter().filter(|s| {
@@ -347,7 +349,7 @@ pub(super) fn run(
             defaults.len()
         ),
         x_label: "time per incoherent ray (ns, all threads; bars min–max)".into(),
-        y_label: format!("fraction differing in any bit ({BOUND_NOTE})"),
+        y_label: format!("answers differing in any bit (fraction of those checked; {BOUND_NOTE})"),
         log_x: true,
         log_y: true,
         curves: errors,
@@ -414,7 +416,7 @@ pub(super) fn run(
     report.plots.push(Plot {
         file: "accel-leaf-size.svg".into(),
         title: "Incoherent ray throughput against leaf size".into(),
-        x_label: "most triangles per leaf".into(),
+        x_label: "leaf size limit (triangles)".into(),
         y_label: "incoherent rays (Mrays/s)".into(),
         log_x: true,
         log_y: false,

@@ -155,7 +155,7 @@ pub(super) fn run(options: &Options, mut report: Report, progress: &dyn Fn(&str)
                 "{name}: relative error of one render's mean against the exact answer, against render time;                  a point per pixel sampler"
             ),
             x_label: "render time (ms, median over the seeds; bars min–max)".into(),
-            y_label: "RMS error of one render's mean / exact".into(),
+            y_label: "RMS error of one render's mean (fraction of the exact answer)".into(),
             log_x: true,
             log_y: true,
             curves: error_curves,
@@ -178,7 +178,7 @@ pub(super) fn run(options: &Options, mut report: Report, progress: &dyn Fn(&str)
                 standard errors off, is in the table)"
             .into(),
         x_label: "render time (ms, median over the seeds); each point an estimator of the table".into(),
-        y_label: "bias / standard error".into(),
+        y_label: "bias (standard errors)".into(),
         log_x: true,
         log_y: false,
         curves: curves.into_iter().map(|c| Curve { markers_only: !c.guide, ..c }).collect(),

@@ -135,8 +135,8 @@ pub(super) fn run(
     report.plots.push(Plot {
         file: "clamp-bias-variance.svg".into(),
         title: format!("Squared bias and variance against the clamp, {spp} spp"),
-        x_label: "clamp (radiance of the brightest channel)".into(),
-        y_label: "per pixel and channel".into(),
+        x_label: "clamp threshold (radiance, of the brightest channel)".into(),
+        y_label: "squared bias and variance per pixel and channel (radiance²)".into(),
         log_x: true,
         log_y: true,
         curves: vec![

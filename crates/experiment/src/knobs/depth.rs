@@ -74,7 +74,12 @@ pub(super) fn run(
             name,
             xs().zip(series.points.iter().map(|p| p.error.as_ref().expect("measured").rmse)).collect(),
         ));
-        tradeoff.push(Curve::error_against_time(name, &crate::runner::time_and_error(&series)));
+        // Each point says its depth: the tradeoff's points are not in the order of either axis.
+        let depths = series.points.iter().filter(|p| p.time.is_some() && p.error.is_some());
+        tradeoff.push(
+            Curve::error_against_time(name, &crate::runner::time_and_error(&series))
+                .with_point_labels(depths.map(|p| format!("depth {}", p.label)).collect()),
+        );
         report.series.push(series);
     }
     let mut findings = Vec::new();
@@ -118,7 +123,7 @@ pub(super) fn run(
     report.plots.push(Plot {
         file: "depth-energy.svg".into(),
         title: "Energy missing against max depth".into(),
-        x_label: "max bounces".into(),
+        x_label: "max depth (bounces)".into(),
         y_label: "energy missing (% of the reference's mean)".into(),
         log_x: true,
         log_y: false,
@@ -129,7 +134,7 @@ pub(super) fn run(
     report.plots.push(Plot {
         file: "depth-time.svg".into(),
         title: format!("Render time against max depth, {spp} spp"),
-        x_label: "max bounces".into(),
+        x_label: "max depth (bounces)".into(),
         y_label: "render time (ms)".into(),
         log_x: true,
         log_y: false,
@@ -140,8 +145,8 @@ pub(super) fn run(
     report.plots.push(Plot {
         file: "depth-error.svg".into(),
         title: format!("RMSE against max depth, {spp} spp"),
-        x_label: "max bounces".into(),
-        y_label: "RMSE of linear radiance".into(),
+        x_label: "max depth (bounces)".into(),
+        y_label: "RMSE of linear radiance (radiance)".into(),
         log_x: true,
         log_y: true,
         curves: errors,

@@ -222,8 +222,8 @@ pub(super) fn run(
     report.plots.push(Plot {
         file: "effects.svg".into(),
         title: format!("Each decision of the plan reversed, {spp} spp"),
-        x_label: "render time / the plan's (median)".into(),
-        y_label: "RMSE / the plan's".into(),
+        x_label: "render time relative to the plan's (ratio of medians)".into(),
+        y_label: "RMSE relative to the plan's (ratio)".into(),
         // Log on both axes, so that twice and half the plan's are equally far from it.
         log_x: true,
         log_y: true,

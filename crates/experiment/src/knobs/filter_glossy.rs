@@ -154,7 +154,7 @@ pub(super) fn run(
         file: "filter-glossy-bias-variance.svg".into(),
         title: format!("Squared bias and variance against the filter-glossy threshold, {spp} spp, raw"),
         x_label: "filter-glossy threshold (bounce density)".into(),
-        y_label: "per pixel and channel".into(),
+        y_label: "squared bias and variance per pixel and channel (radiance²)".into(),
         log_x: true,
         log_y: true,
         curves: vec![

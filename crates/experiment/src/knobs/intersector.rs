@@ -20,7 +20,7 @@ use rtgi_accel::{Accel, AccelKind, BuildParams, Intersector};
 use rtgi_math::{Ray, Vec3};
 use rtgi_render::rays::{primary_rays, surface_rays};
 
-use crate::plot::{BOUND_NOTE, Corner, Curve, Plot, rate_or_bound};
+use crate::plot::{BOUND_NOTE, Corner, Curve, Plot, is_bound, rate_or_bound};
 use crate::report::{Point, Report, Series, Table, format_number};
 use crate::runner::time_rays;
 use crate::stats::Timing;
@@ -355,6 +355,7 @@ fn plots(report: &mut Report) {
             let ns = |mrays: f64| 1e3 / mrays.max(1e-12);
             Curve::new(name.clone(), vec![(ns(v["incoherent_mrays"]), lost)])
                 .with_x_bars(vec![Some((ns(v["incoherent_mrays_max"]), ns(v["incoherent_mrays_min"])))])
+                .with_bounds(vec![is_bound(v["shared_edge_leaks"] + v["closed_mesh_leaks"])])
         })
         .collect();
     let by_distance = |count: &str, trials: &str| -> Vec<Curve> {
@@ -362,6 +363,7 @@ fn plots(report: &mut Report) {
             .map(|(name, _, points)| {
                 let rates = points.iter().map(|p| (p.x, 100.0 * rate_or_bound(p.values[count], p.values[trials])));
                 Curve::new(name.clone(), rates.collect())
+                    .with_bounds(points.iter().map(|p| is_bound(p.values[count])).collect())
             })
             .collect()
     };
@@ -370,7 +372,9 @@ fn plots(report: &mut Report) {
         file: "intersector-speed.svg".into(),
         title: "Rays lost at shared edges and vertices against time per incoherent ray".into(),
         x_label: "time per incoherent ray (ns, one at a time on all threads; bars min–max)".into(),
-        y_label: format!("rays through shared edges and from inside closed meshes that escape ({BOUND_NOTE})"),
+        y_label: format!(
+            "rays that escape through shared edges and from inside closed meshes (fraction of those traced; {BOUND_NOTE})"
+        ),
         log_x: true,
         log_y: true,
         curves: speed,

@@ -8,7 +8,7 @@ use rtgi_math::Ray;
 use rtgi_render::rays::{primary_rays, surface_rays};
 
 use crate::measure::{every_nth, time_rays};
-use crate::plot::{BOUND_NOTE, Corner, Curve, Plot, rate_or_bound};
+use crate::plot::{BOUND_NOTE, Corner, Curve, Plot, is_bound, rate_or_bound};
 use crate::report::{Point, Report, Series, Table, format_number, format_timing};
 use crate::verdict::compare_times;
 use crate::{ExperimentError, Options, Steps, Subject};
@@ -93,7 +93,8 @@ pub(super) fn run(
             for (mode, timing) in [("single", single.clone()), ("batch", batched.clone())] {
                 curves.push(
                     Curve::new(format!("{kind}, {batch}, {mode}"), vec![(ns(timing.median_ms), fraction)])
-                        .with_x_bars(vec![Some((ns(timing.min_ms), ns(timing.max_ms)))]),
+                        .with_x_bars(vec![Some((ns(timing.min_ms), ns(timing.max_ms)))])
+                        .with_bounds(vec![is_bound(differ as f64)]),
                 );
             }
             let mut single_point = Point::new(0.0, "one at a time").with("differing", 0.0);
@@ -109,7 +110,9 @@ pub(super) fn run(
         title: "Batch (packets) against one ray at a time: answers differing from the linear scan against time per ray"
             .into(),
         x_label: "time per ray (ns, all threads; bars min–max)".into(),
-        y_label: format!("fraction of batch answers differing in any bit ({BOUND_NOTE})"),
+        y_label: format!(
+            "batch answers differing from the linear scan's in any bit (fraction of the batch; {BOUND_NOTE})"
+        ),
         log_x: true,
         log_y: true,
         curves,

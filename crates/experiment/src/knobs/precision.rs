@@ -56,8 +56,8 @@ impl Family {
 
     fn parameter_name(self) -> &'static str {
         match self {
-            Family::Far => "distance from the origin",
-            Family::Needle | Family::Sliver => "elongation (longest edge / height)",
+            Family::Far => "distance from the origin (world units)",
+            Family::Needle | Family::Sliver => "elongation (ratio: longest edge / height)",
         }
     }
 
@@ -290,12 +290,17 @@ fn plots(report: &mut Report) {
     let mut plots = Vec::new();
     for (family, file) in [(Family::Far, "far"), (Family::Sliver, "sliver"), (Family::Needle, "needle")] {
         for (value, max, what, y_label) in [
-            ("t_relative_error_median", "t_relative_error_max", "t", "relative error of t (median, bar to max)"),
+            (
+                "t_relative_error_median",
+                "t_relative_error_max",
+                "t",
+                "relative error of t (fraction of t; median, bar to max)",
+            ),
             (
                 "barycentric_error_median",
                 "barycentric_error_max",
                 "barycentrics",
-                "absolute error of beta, gamma (median, bar to max)",
+                "absolute error of beta, gamma (barycentric units; median, bar to max)",
             ),
         ] {
             plots.push(Plot {
@@ -318,7 +323,7 @@ fn plots(report: &mut Report) {
         file: "precision-time.svg".into(),
         title: "Time of one triangle test on the far triangles".into(),
         x_label: Family::Far.parameter_name().into(),
-        y_label: "ns per triangle test (median, min and max)".into(),
+        y_label: "time per triangle test (ns; median, min and max)".into(),
         log_x: true,
         log_y: false,
         curves: Intersector::ALL
@@ -339,8 +344,8 @@ fn plots(report: &mut Report) {
     plots.push(Plot {
         file: "precision-error-time.svg".into(),
         title: "Largest relative error of t against time per triangle test, per family of hard triangles".into(),
-        x_label: "ns per triangle test (median over the family; bars min–max)".into(),
-        y_label: "largest relative error of t".into(),
+        x_label: "time per triangle test (ns, median over the family; bars min–max)".into(),
+        y_label: "largest relative error of t (fraction of t)".into(),
         log_x: true,
         log_y: true,
         curves: Intersector::ALL

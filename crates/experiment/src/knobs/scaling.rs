@@ -12,7 +12,7 @@ use std::time::Instant;
 use rtgi_accel::{AccelKind, BuildParams};
 use rtgi_math::{Ray, Rng, Vec3, uniform_sphere};
 
-use crate::plot::{BOUND_NOTE, Corner, Curve, Plot, rate_or_bound};
+use crate::plot::{BOUND_NOTE, Corner, Curve, Plot, is_bound, rate_or_bound};
 use crate::report::{Point, Report, Series, Table, format_ms, format_number};
 use crate::{ExperimentError, Options, Steps};
 
@@ -172,7 +172,8 @@ pub(super) fn run(options: &Options, mut report: Report, progress: &dyn Fn(&str)
             .map(|p| (p.values["ns_per_ray"], rate_or_bound(p.values["differing"], p.values["checked"])))
             .collect();
         let x_bars = s.points.iter().map(|p| Some((p.values["ns_per_ray_min"], p.values["ns_per_ray_max"]))).collect();
-        error_curves.push(Curve::new(s.name.clone(), against_time).with_x_bars(x_bars));
+        let bounds = s.points.iter().map(|p| is_bound(p.values["differing"])).collect();
+        error_curves.push(Curve::new(s.name.clone(), against_time).with_x_bars(x_bars).with_bounds(bounds));
     }
     for s in series.iter().skip(1) {
         let sum = |key: &str| s.points.iter().map(|p| p.values[key]).sum::<f64>();
@@ -189,7 +190,7 @@ pub(super) fn run(options: &Options, mut report: Report, progress: &dyn Fn(&str)
         file: "scaling-error-time.svg".into(),
         title: "Answers differing from the linear scan against time per ray, one point per mesh size".into(),
         x_label: "time per closest-hit ray (ns, median; bars min–max)".into(),
-        y_label: format!("fraction differing in any bit ({BOUND_NOTE})"),
+        y_label: format!("answers differing in any bit (fraction of those checked; {BOUND_NOTE})"),
         log_x: true,
         log_y: true,
         curves: error_curves,
@@ -225,7 +226,7 @@ pub(super) fn run(options: &Options, mut report: Report, progress: &dyn Fn(&str)
     report.plots.push(Plot {
         file: "scaling.svg".into(),
         title: "Time per ray against triangle count".into(),
-        x_label: "triangles".into(),
+        x_label: "mesh size (triangles)".into(),
         y_label: "time per closest-hit ray (ns)".into(),
         log_x: true,
         log_y: true,

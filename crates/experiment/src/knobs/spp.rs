@@ -81,7 +81,10 @@ pub(super) fn run(
             let quantity =
                 format!("RMSE against spp (counts whose error is above {NOISE_MARGIN}× the reference's noise)");
             let label = match report.fit(&series.name, &quantity, offered, &resolved) {
-                Some(fit) => format!("{sampler} (slope {:.2} ± {:.2})", fit.law.exponent, fit.law.standard_error),
+                Some(fit) => format!(
+                    "{sampler} (slope {})",
+                    crate::plot::with_standard_error(fit.law.exponent, Some(fit.law.standard_error))
+                ),
                 None => {
                     report.findings.push(format!(
                         "{integrand}, {sampler}: too few counts above the reference's noise to fit a slope"
@@ -132,8 +135,8 @@ pub(super) fn run(
         report.plots.push(Plot {
             file: format!("spp{suffix}-error.svg"),
             title: format!("RMSE against spp, {integrand}"),
-            x_label: "samples per pixel".into(),
-            y_label: "RMSE of linear radiance".into(),
+            x_label: "samples per pixel (count)".into(),
+            y_label: "RMSE of linear radiance (radiance)".into(),
             log_x: true,
             log_y: true,
             curves: error_curves,

@@ -11,7 +11,7 @@ use rtgi_math::Ray;
 use rtgi_render::rays::{primary_rays, surface_rays};
 
 use crate::measure::{every_nth, mrays, time_rays};
-use crate::plot::{BOUND_NOTE, Corner, Curve, Plot, rate_or_bound};
+use crate::plot::{BOUND_NOTE, Corner, Curve, Plot, is_bound, rate_or_bound};
 use crate::report::{Point, Report, Series, Table, format_number, format_timing};
 use crate::verdict::compare_times;
 use crate::{ExperimentError, Options, Steps, Subject};
@@ -108,7 +108,8 @@ pub(super) fn run(
         let ns = |ms: f64| ms * 1e6 / batches[1].1.len() as f64;
         curves.push(
             Curve::new(&name, vec![(ns(incoherent_time.median_ms), rate_or_bound(wrong as f64, total as f64))])
-                .with_x_bars(vec![Some((ns(incoherent_time.min_ms), ns(incoherent_time.max_ms)))]),
+                .with_x_bars(vec![Some((ns(incoherent_time.min_ms), ns(incoherent_time.max_ms)))])
+                .with_bounds(vec![is_bound(wrong as f64)]),
         );
         report.series.push(Series { name, points: vec![point] });
     }
@@ -133,7 +134,7 @@ pub(super) fn run(
             report.series.len()
         ),
         x_label: "time per incoherent ray (ns, all threads; bars min–max)".into(),
-        y_label: format!("fraction of checked answers differing in any bit ({BOUND_NOTE})"),
+        y_label: format!("answers differing in any bit (fraction of those checked; {BOUND_NOTE})"),
         log_x: true,
         log_y: true,
         curves,
