@@ -310,13 +310,19 @@ impl Panel {
         )
     }
 
+    /// How many panel pixels a pixel of the crop takes: [`ZOOM`], or more
+    /// for a small crop, so that each column is wide enough for its label.
+    fn zoom(&self) -> u32 {
+        ZOOM * MIN_LABELLED_TILE.div_ceil(self.crop.side * ZOOM).max(1)
+    }
+
     /// The tiles without labels: the reference's crop and each entry's in
     /// the top row, tone-mapped alike (ACES at the reference's automatic
     /// exposure), and each entry's error map below (`heat_colour`, one scale for all).
     fn tiles(&self) -> HdrImage {
-        let (reference, crop) = (&self.reference, self.crop);
+        let (reference, crop, zoom) = (&self.reference, self.crop, self.zoom());
         let tone = ToneMap { exposure: auto_exposure(reference), operator: ToneOperator::Aces };
-        let tile = crop.side * ZOOM;
+        let tile = crop.side * zoom;
         let columns = 1 + self.entries.len() as u32;
         let (width, height) = (columns * tile + (columns + 1) * GAP, 2 * tile + 3 * GAP);
         let mut pixels = vec![Vec3::ONE; (width * height) as usize];
@@ -324,7 +330,7 @@ impl Panel {
             let (left, top) = (GAP + column * (tile + GAP), GAP + row * (tile + GAP));
             for ty in 0..tile {
                 for tx in 0..tile {
-                    let (x, y) = (crop.x + tx / ZOOM, crop.y + ty / ZOOM);
+                    let (x, y) = (crop.x + tx / zoom, crop.y + ty / zoom);
                     pixels[((top + ty) * width + left + tx) as usize] = value(x, y);
                 }
             }
@@ -360,7 +366,7 @@ impl Panel {
     /// its range at the foot; with the row at which the tiles start.
     fn labelled(&self, tiles: &HdrImage) -> (HdrImage, u32) {
         let (width, tiles_height) = (tiles.width(), tiles.height());
-        let tile = self.crop.side * ZOOM;
+        let tile = self.crop.side * self.zoom();
         // Twice the font's size where the tiles leave room for 12 characters, else its own.
         let scale = if tile >= 12 * 16 { 2 } else { 1 };
         let line = 8 * scale + 4;
@@ -430,9 +436,9 @@ impl Panel {
         use std::fmt::Write;
         let encoded = base64::engine::general_purpose::STANDARD.encode(tiles);
         // Small crops are shown larger, so that each column is wide enough for its label.
-        let scale = MIN_LABELLED_TILE.div_ceil(self.crop.side * ZOOM).max(1);
+        let scale = MIN_LABELLED_TILE.div_ceil(self.crop.side * self.zoom()).max(1);
         let (width, height) = (width * scale, height * scale);
-        let (tile, gap) = (self.crop.side * ZOOM * scale, GAP * scale);
+        let (tile, gap) = (self.crop.side * self.zoom() * scale, GAP * scale);
         let columns = self.column_labels((tile as f32 / LABEL_CHAR_WIDTH) as usize);
         let label_lines = columns.iter().map(Vec::len).max().unwrap_or(1) as u32;
         let label_band = 8 + LABEL_LINE * label_lines + 8;
@@ -577,7 +583,7 @@ mod tests {
         );
         assert!(panel.caption().contains("noisy (1.00 ms, RMSE 0.1, "), "{}", panel.caption());
         let png = image::open(&path).unwrap().to_rgb8();
-        let tile = crop.side * ZOOM;
+        let tile = crop.side * panel.zoom();
         let tiles = panel.tiles();
         assert_eq!((tiles.width(), tiles.height()), (3 * tile + 4 * GAP, 2 * tile + 3 * GAP));
         let (labelled, top) = panel.labelled(&tiles);
@@ -587,7 +593,7 @@ mod tests {
         let zero = heat_colour(0.0).to_array().map(|c| (rtgi_image::linear_to_srgb(c) * 255.0 + 0.5) as u8);
         let exact_error = png.get_pixel(2 * GAP + tile + 1, top + 2 * GAP + tile + 1).0;
         assert_eq!(exact_error, zero);
-        let (ex, ey) = ((12 - crop.x) * ZOOM + 1, (11 - crop.y) * ZOOM + 1);
+        let (ex, ey) = ((12 - crop.x) * panel.zoom() + 1, (11 - crop.y) * panel.zoom() + 1);
         let noisy_error = png.get_pixel(3 * GAP + 2 * tile + ex, top + 2 * GAP + tile + ey).0;
         assert!(noisy_error.iter().map(|&c| c as u32).sum::<u32>() > 500, "{noisy_error:?}");
         // The noisy entry clips on the one scale (its 4×4 error block is 1.5, the scale 0.75), and says so.

@@ -57,10 +57,11 @@ pub(super) fn run(
     let time_points: Vec<(f64, f64)> =
         series.points.iter().map(|p| (p.x, p.time.as_ref().expect("timed").median_ms)).collect();
     if let Some(fit) = report.fit("render", "render time against pixels", time_points.len(), &time_points) {
+        // Two points fit any line: their slope has no standard error.
+        let standard_error = (fit.law.points > 2).then_some(fit.law.standard_error);
         report.findings.push(format!(
-            "render time ∝ pixels^{:.3} ± {:.3} over {} sizes (1 is in proportion to the pixels)",
-            fit.law.exponent,
-            fit.law.standard_error,
+            "render time ∝ pixels^{} over {} sizes (1 is in proportion to the pixels)",
+            crate::plot::with_standard_error(fit.law.exponent, standard_error),
             time_points.len()
         ));
     }
