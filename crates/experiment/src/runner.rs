@@ -76,7 +76,7 @@ const MAX_PANEL_SPP: f64 = 65_536.0;
 /// How far an equal-time entry's time may be from the budget, as a fraction of it.
 pub(crate) const EQUAL_TIME_TOLERANCE: f64 = 0.05;
 /// Renders an equal-time entry may take to meet the budget within the tolerance.
-const EQUAL_TIME_ATTEMPTS: usize = 6;
+const EQUAL_TIME_ATTEMPTS: usize = 8;
 
 /// Renders each configuration once (seed 0) with as many samples per pixel
 /// as fit `budget_ms`: the entries of an equal-time panel. The count starts
@@ -126,21 +126,25 @@ pub(crate) fn equal_time(
             let render_at =
                 |spp: u32| render(subject, &RenderSettings { samples_per_pixel: spp, seed: 0, ..settings.clone() });
             let mut spp = (budget_ms / ms_per_sample.max(1e-9)).round().clamp(1.0, MAX_PANEL_SPP) as u32;
-            let (image, time_ms) = render_at(spp);
-            let mut best = (image, time_ms, spp);
-            let mut last_ms = time_ms;
-            for _ in 1..EQUAL_TIME_ATTEMPTS {
-                if off(best.1) <= EQUAL_TIME_TOLERANCE {
+            // The first render after another configuration's pays for cold
+            // caches and sleeping threads: one untimed, shorter, first.
+            let _ = render_at((spp / 4).max(1));
+            let (mut total_ms, mut total_spp) = (0.0, 0.0);
+            let mut best: Option<(HdrImage, f64, u32)> = None;
+            for _ in 0..EQUAL_TIME_ATTEMPTS {
+                let (image, time_ms) = render_at(spp);
+                (total_ms, total_spp) = (total_ms + time_ms, total_spp + spp as f64);
+                if best.as_ref().is_none_or(|b| off(time_ms) < off(b.1)) {
+                    best = Some((image, time_ms, spp));
+                }
+                if best.as_ref().is_some_and(|b| off(b.1) <= EQUAL_TIME_TOLERANCE) {
                     break;
                 }
-                let next = (spp as f64 * budget_ms / last_ms.max(1e-9)).round().clamp(1.0, MAX_PANEL_SPP) as u32;
-                spp = next;
-                let (image, time_ms) = render_at(spp);
-                last_ms = time_ms;
-                if off(time_ms) < off(best.1) {
-                    best = (image, time_ms, spp);
-                }
+                // The time per sample pooled over every render so far, so
+                // that one run's noise moves the next count less.
+                spp = (budget_ms * total_spp / total_ms.max(1e-9)).round().clamp(1.0, MAX_PANEL_SPP) as u32;
             }
+            let best = best.expect("at least one attempt");
             let (image, time_ms, spp) = best;
             entry(image, time_ms, format!("{label}, {spp} spp"))
         })
