@@ -102,53 +102,106 @@ pub(crate) fn equal_time(
             };
             let off = |time_ms: f64| (time_ms / budget_ms - 1.0).abs();
             if let Some(sampling) = settings.adaptive {
-                // Adaptive sampling bounded by the budget itself: the round
-                // that would overrun is cut to what fits. A render that meets
-                // its noise target early ends early, and says so by its time.
-                let bounded = RenderSettings {
+                // Adaptive sampling bounded by a time: the round that would
+                // overrun is cut to what fits, as predicted from the rounds
+                // so far, so the render can overrun by a little. The bound
+                // is corrected from each render's own time until the render
+                // meets the budget. One that meets its noise target early
+                // ends early, and says so by its time.
+                let bounded = |seconds: f64| RenderSettings {
                     samples_per_pixel: MAX_PANEL_SPP as u32,
                     seed: 0,
-                    adaptive: Some(rtgi_render::AdaptiveSampling { seconds: Some(budget_ms * 1e-3), ..sampling }),
+                    adaptive: Some(rtgi_render::AdaptiveSampling { seconds: Some(seconds), ..sampling }),
                     ..settings.clone()
                 };
-                let mut best = render(subject, &bounded);
-                for _ in 1..EQUAL_TIME_ATTEMPTS {
-                    if off(best.1) <= EQUAL_TIME_TOLERANCE || best.1 < budget_ms {
+                let mut seconds = budget_ms * 1e-3;
+                let mut best: Option<(HdrImage, f64, f64)> = None;
+                for _ in 0..EQUAL_TIME_ATTEMPTS {
+                    let (image, time_ms) = render(subject, &bounded(seconds));
+                    let next = seconds * budget_ms / time_ms.max(1e-9);
+                    if best.as_ref().is_none_or(|b| off(time_ms) < off(b.1)) {
+                        best = Some((image, time_ms, seconds));
+                    }
+                    if best.as_ref().is_some_and(|b| off(b.1) <= EQUAL_TIME_TOLERANCE) {
                         break;
                     }
-                    let again = render(subject, &bounded);
-                    if off(again.1) < off(best.1) {
-                        best = again;
-                    }
+                    seconds = next;
                 }
-                return entry(best.0, best.1, format!("{label}, --time {:.3} s", budget_ms * 1e-3));
+                let (image, time_ms, seconds) = best.expect("at least one attempt");
+                return entry(image, time_ms, format!("{label}, --time {seconds:.3} s"));
             }
             let render_at =
                 |spp: u32| render(subject, &RenderSettings { samples_per_pixel: spp, seed: 0, ..settings.clone() });
-            let mut spp = (budget_ms / ms_per_sample.max(1e-9)).round().clamp(1.0, MAX_PANEL_SPP) as u32;
+            let first = (budget_ms / ms_per_sample.max(1e-9)).round().clamp(1.0, MAX_PANEL_SPP) as u32;
             // The first render after another configuration's pays for cold
             // caches and sleeping threads: one untimed, shorter, first.
-            let _ = render_at((spp / 4).max(1));
-            let (mut total_ms, mut total_spp) = (0.0, 0.0);
-            let mut best: Option<(HdrImage, f64, u32)> = None;
-            for _ in 0..EQUAL_TIME_ATTEMPTS {
-                let (image, time_ms) = render_at(spp);
-                (total_ms, total_spp) = (total_ms + time_ms, total_spp + spp as f64);
-                if best.as_ref().is_none_or(|b| off(time_ms) < off(b.1)) {
-                    best = Some((image, time_ms, spp));
-                }
-                if best.as_ref().is_some_and(|b| off(b.1) <= EQUAL_TIME_TOLERANCE) {
-                    break;
-                }
-                // The time per sample pooled over every render so far, so
-                // that one run's noise moves the next count less.
-                spp = (budget_ms * total_spp / total_ms.max(1e-9)).round().clamp(1.0, MAX_PANEL_SPP) as u32;
-            }
-            let best = best.expect("at least one attempt");
-            let (image, time_ms, spp) = best;
+            let _ = render_at((first / 4).max(1));
+            let (image, time_ms, spp) = calibrate(budget_ms, first, EQUAL_TIME_ATTEMPTS, render_at);
             entry(image, time_ms, format!("{label}, {spp} spp"))
         })
         .collect()
+}
+
+/// Finds the count of samples whose run takes `budget_ms`: runs `run` at
+/// `first`, then at counts from the median time per sample of the runs so
+/// far (a median, so that one slow run moves the estimate little), until a
+/// run is within [`EQUAL_TIME_TOLERANCE`] of the budget or `attempts` runs
+/// were made. A count already run twice outside the window is not run a
+/// third time: the next count towards the budget is. Returns the run
+/// closest to the budget, its time and its count.
+pub(crate) fn calibrate<T>(
+    budget_ms: f64,
+    first: u32,
+    attempts: usize,
+    mut run: impl FnMut(u32) -> (T, f64),
+) -> (T, f64, u32) {
+    let off = |ms: f64| (ms / budget_ms - 1.0).abs();
+    let mut tried: Vec<(u32, f64)> = Vec::new();
+    let mut best: Option<(T, f64, u32)> = None;
+    let mut count = first.clamp(1, MAX_PANEL_SPP as u32);
+    for _ in 0..attempts.max(1) {
+        let (result, ms) = run(count);
+        tried.push((count, ms));
+        if best.as_ref().is_none_or(|b| off(ms) < off(b.1)) {
+            best = Some((result, ms, count));
+        }
+        if off(ms) <= EQUAL_TIME_TOLERANCE {
+            break;
+        }
+        let mut next = (next_count(&tried, budget_ms)).round().clamp(1.0, MAX_PANEL_SPP) as u32;
+        let runs_of = |n: u32| tried.iter().filter(|t| t.0 == n).map(|t| t.1).collect::<Vec<f64>>();
+        let at_next = runs_of(next);
+        if at_next.len() >= 2 {
+            // Twice outside the window: step towards the budget instead.
+            let mean = at_next.iter().sum::<f64>() / at_next.len() as f64;
+            next = if mean < budget_ms { next + 1 } else { next.saturating_sub(1).max(1) };
+        }
+        count = next;
+    }
+    best.expect("at least one run")
+}
+
+/// The count the runs `tried` (count, ms) say takes `budget_ms`: from the
+/// line through them (a render has a fixed cost beside its samples) where
+/// they span two counts or more and it rises, else from the median time per
+/// sample (a median, so that one slow run moves the estimate little).
+fn next_count(tried: &[(u32, f64)], budget_ms: f64) -> f64 {
+    let n = tried.len() as f64;
+    let (mean_x, mean_y) =
+        (tried.iter().map(|t| t.0 as f64).sum::<f64>() / n, tried.iter().map(|t| t.1).sum::<f64>() / n);
+    let sxx: f64 = tried.iter().map(|t| (t.0 as f64 - mean_x).powi(2)).sum();
+    let sxy: f64 = tried.iter().map(|t| (t.0 as f64 - mean_x) * (t.1 - mean_y)).sum();
+    if sxx > 0.0 && sxy > 0.0 {
+        let slope = sxy / sxx;
+        let fixed = mean_y - slope * mean_x;
+        let count = (budget_ms - fixed) / slope;
+        if count.is_finite() && count > 0.0 {
+            return count;
+        }
+    }
+    let mut rates: Vec<f64> = tried.iter().map(|&(n, ms)| ms / n as f64).collect();
+    rates.sort_by(f64::total_cmp);
+    budget_ms / rates[rates.len() / 2].max(1e-12)
 }
 
 /// Renders the configurations at equal time ([`equal_time`]) and adds their
@@ -203,3 +256,35 @@ pub(crate) fn build_timed(
 }
 
 pub(crate) use crate::measure::time_rays;
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A clock of `fixed + per_sample · n` ms with a noise of ±`noise` and,
+    /// every fifth run, a slow outlier of +25%.
+    fn noisy_clock(fixed: f64, per_sample: f64, noise: f64) -> impl FnMut(u32) -> ((), f64) {
+        let mut run = 0u32;
+        move |n| {
+            run += 1;
+            let jitter = (run.wrapping_mul(2_654_435_761) % 1000) as f64 / 1000.0 * 2.0 - 1.0;
+            let outlier = if run.is_multiple_of(5) { 1.25 } else { 1.0 };
+            ((), (fixed + per_sample * n as f64) * (1.0 + noise * jitter) * outlier)
+        }
+    }
+
+    #[test]
+    fn calibration_meets_the_budget_through_noise_and_outliers() {
+        for (fixed, per_sample, first) in [(0.0, 6.5, 20), (30.0, 4.0, 10), (5.0, 0.7, 400), (0.0, 7.0, 11)] {
+            let (_, ms, count) = calibrate(100.0, first, EQUAL_TIME_ATTEMPTS, noisy_clock(fixed, per_sample, 0.03));
+            assert!((ms / 100.0 - 1.0).abs() <= EQUAL_TIME_TOLERANCE, "{fixed} + {per_sample}·n: {count} took {ms}");
+        }
+    }
+
+    #[test]
+    fn where_no_count_fits_the_closest_is_kept() {
+        // 30 ms a sample: 3 samples take 90 ms, 4 take 120; neither is within 5% of 100.
+        let (_, ms, count) = calibrate(100.0, 1, EQUAL_TIME_ATTEMPTS, |n| ((), 30.0 * n as f64));
+        assert_eq!((count, ms), (3, 90.0));
+    }
+}

@@ -125,12 +125,21 @@ pub fn compare_efficiency_by(measure: ErrorMeasure, a_name: &str, a: &Point, b_n
 /// "biased: bias² 0.0123 (73% of its MSE), energy −4.9%": what a
 /// configuration with a resolved bias is, in place of an efficiency.
 pub fn describe_bias(error: &ImageError) -> String {
-    format!(
-        "biased: bias² {} ({:.0}% of its MSE), energy {:+.1}%",
-        format_number(error.bias2.max(0.0)),
-        100.0 * error.bias2.max(0.0) / error.mse().max(1e-300),
-        100.0 * error.energy_change()
-    )
+    if error.bias2 > error.bias_resolution {
+        format!(
+            "biased: bias² {} ({:.0}% of its MSE), energy {:+.1}%",
+            format_number(error.bias2),
+            100.0 * error.bias2 / error.mse().max(1e-300),
+            100.0 * error.energy_change()
+        )
+    } else {
+        // Resolved by the seeds' mean energy alone: too small per pixel to
+        // stand out of each pixel's noise.
+        format!(
+            "biased: energy {:+.1}%, resolved by the seeds' means (per pixel, bias² is within the noise)",
+            100.0 * error.energy_change()
+        )
+    }
 }
 
 /// The confidence at which a difference between repeated measurements
@@ -193,17 +202,25 @@ impl RankComparison {
         let (ratio, p, (n, m)) = (self.ratio, self.p_value, self.counts);
         if self.resolved() {
             format!(
-                "{a_name} has {ratio:.2}× the {what} of {b_name} (Mann–Whitney p = {p:.3}, {n} and {m} measurements)"
+                "{a_name} has {}× the {what} of {b_name} (Mann–Whitney p = {p:.3}, {n} and {m} measurements)",
+                format_ratio(ratio)
             )
         } else {
             format!(
-                "{what} of {a_name} and {b_name}: not resolved (ratio {ratio:.2}, Mann–Whitney p = {p:.2} with {n} and \
+                "{what} of {a_name} and {b_name}: not resolved (ratio {}, Mann–Whitney p = {p:.2} with {n} and \
                  {m} measurements; {:.0}% confidence asks for p below {:.2})",
+                format_ratio(ratio),
                 100.0 * CONFIDENCE,
                 1.0 - CONFIDENCE
             )
         }
     }
+}
+
+/// A ratio with two decimals, or three significant digits below 0.1 (a
+/// ratio of 0.004 is not "0.00×").
+fn format_ratio(ratio: f64) -> String {
+    if ratio >= 0.1 || ratio == 0.0 || !ratio.is_finite() { format!("{ratio:.2}") } else { format!("{ratio:.2e}") }
 }
 
 /// The median of `values` (the mean of the middle two for an even count).
@@ -336,7 +353,7 @@ mod tests {
             reference_mean: 1.0,
             bias2: (energy - 1.0).powi(2),
             variance: mse,
-            bias_resolution: 1.0,
+            bias_resolution: 1e-3,
             seeds: 5,
             reference_mean_noise: 0.0,
             seed_mse,
@@ -365,6 +382,12 @@ mod tests {
         let sentence = compare_efficiency("the clamp", &clamped, "no clamp", &plain);
         assert!(sentence.starts_with("the clamp is biased: bias² 0.01"), "{sentence}");
         assert!(sentence.contains("energy -10.0%") && !sentence.contains("× the efficiency"), "{sentence}");
+        // A ratio far below one keeps its digits.
+        assert!(
+            RankComparison::of(&[1.0, 1.01, 1.02, 1.03, 1.04], &[500.0, 501.0, 502.0, 503.0, 504.0])
+                .sentence("time", "a", "b")
+                .starts_with("a has 2.03e-3× the time of b")
+        );
         // The most efficient skips the biased one, however low its MSE.
         let points = [plain.clone(), clamped, good.clone()];
         assert_eq!(most_efficient(&points).map(|(_, p)| p.time.clone()), Some(good.time.clone()));
