@@ -365,9 +365,15 @@ pub(crate) fn measurement_cells(point: &Point) -> [String; 7] {
         format_number(error.relative_mse),
         format_bias(error),
         format_number(error.variance),
-        if error.bias_resolved() { "— (biased)".to_owned() } else { format_number(error.efficiency(time.median_ms)) },
+        format_efficiency(error, time),
         format!("{:.4}", error.mean / error.reference_mean.max(1e-30)),
     ]
+}
+
+/// The efficiency `1/(MSE·s)` for a table cell, or "— (biased)" where the
+/// bias is resolved: a biased estimator has none.
+pub fn format_efficiency(error: &ImageError, time: &Timing) -> String {
+    if error.bias_resolved() { "— (biased)".to_owned() } else { format_number(error.efficiency(time.median_ms)) }
 }
 
 /// The squared bias, or that it is below what the seeds resolve.

@@ -85,7 +85,7 @@ pub(super) fn run(
             format_number(planned_error.relative_mse),
             format_bias(planned_error),
             format_number(planned_error.variance),
-            format_number(planned_error.efficiency(planned_time.median_ms)),
+            crate::report::format_efficiency(planned_error, planned_time),
             format!("{:.4}", energy(&planned)),
             "as planned".to_owned(),
         ]],
@@ -156,7 +156,7 @@ pub(super) fn run(
             format_number(error.relative_mse),
             format_bias(error),
             format_number(error.variance),
-            format_number(error.efficiency(time.median_ms)),
+            crate::report::format_efficiency(error, time),
             format!("{:.4}", energy(&point)),
             verdict,
         ]);
