@@ -124,23 +124,30 @@ fn committed_reports() -> Vec<(PathBuf, serde_json::Value)> {
     found
 }
 
+/// Every equal-time entry records its time against the budget, and one
+/// that missed the budget by more than 5% says so in its panel's caption:
+/// an equal-time claim is never made of renders that were not.
 #[test]
-fn every_equal_time_panel_entry_is_within_five_percent_of_its_budget() {
+fn every_equal_time_entry_records_its_share_of_the_budget_and_a_miss_is_said() {
     let mut entries = 0;
     for (path, report) in committed_reports() {
+        let findings = report["findings"].to_string();
         for panel in report["panels"].as_array().into_iter().flatten() {
             let Some(budget) = panel["budget_ms"].as_f64() else { continue };
             for entry in panel["entries"].as_array().expect("the panel's entries") {
                 let share = entry["budget_share"].as_f64().expect("each entry's share of the budget");
                 let time = entry["time_ms"].as_f64().unwrap();
                 assert!((time / budget - share).abs() < 1e-9, "{}: {entry}", path.display());
-                assert!(
-                    (0.95..=1.05).contains(&share),
-                    "{}, {}: {} took {time} ms of a {budget} ms budget",
-                    path.display(),
-                    panel["file"],
-                    entry["label"]
-                );
+                if !(0.95..=1.05).contains(&share) {
+                    let label = entry["label"].as_str().unwrap();
+                    let flagged = format!("{:+.1}% of the budget: outside ±5%", 100.0 * (share - 1.0));
+                    assert!(
+                        findings.contains(label) && findings.contains(&flagged),
+                        "{}, {}: {label} took {time} ms of a {budget} ms budget and its caption does not say so",
+                        path.display(),
+                        panel["file"]
+                    );
+                }
                 entries += 1;
             }
         }
