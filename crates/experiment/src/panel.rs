@@ -361,14 +361,28 @@ impl Panel {
             .collect()
     }
 
+    /// The font's scale for the labels under columns `tile` pixels wide:
+    /// twice its size where every label line fits its column so (a label
+    /// breaks only after commas), else its own size.
+    fn label_scale(&self, tile: u32) -> u32 {
+        let fits = |scale: u32| {
+            tile >= 12 * 8 * scale
+                && self
+                    .column_labels((tile / (8 * scale)) as usize)
+                    .iter()
+                    .flatten()
+                    .all(|text| text_width(text, scale) <= tile)
+        };
+        if fits(2) { 2 } else { 1 }
+    }
+
     /// `tiles` with the labels drawn in: the title in a band above, each
     /// column's labels under it, and the colour bar of the error scale with
     /// its range at the foot; with the row at which the tiles start.
     fn labelled(&self, tiles: &HdrImage) -> (HdrImage, u32) {
         let (width, tiles_height) = (tiles.width(), tiles.height());
         let tile = self.crop.side * self.zoom();
-        // Twice the font's size where the tiles leave room for 12 characters, else its own.
-        let scale = if tile >= 12 * 16 { 2 } else { 1 };
+        let scale = self.label_scale(tile);
         let line = 8 * scale + 4;
         let title_scale = if text_width(&self.title, 2) + 2 * GAP <= width { 2 } else { 1 };
         let title = crate::plot::wrap_text(&self.title, ((width - 2 * GAP) / (8 * title_scale)).max(1) as usize);
@@ -606,5 +620,15 @@ mod tests {
         );
         assert!(svg.contains(">clips 25%<"), "{svg}");
         let _ = std::fs::remove_dir_all(&dir);
+    }
+
+    #[test]
+    fn labels_too_wide_for_their_column_at_twice_the_size_are_drawn_at_the_font_s_own() {
+        let entries = |label: &str| vec![Entry { label: label.into(), image: flat(0.6), time_ms: 1.0, rmse: 0.1 }];
+        let short = Panel::new("a.png", "t", flat(0.5), entries("none, 16 spp"));
+        let long = Panel::new("b.png", "t", flat(0.5), entries("clamp 0.25× mean, 16 spp"));
+        let tile = short.crop.side * short.zoom();
+        // 192 pixels hold 12 characters at twice the size: "clamp 0.25× mean," has 17.
+        assert_eq!((tile, short.label_scale(tile), long.label_scale(tile)), (192, 2, 1));
     }
 }
