@@ -423,7 +423,7 @@ impl Panel {
         (HdrImage::from_pixels(width, height, pixels).expect("the sizes agree"), title_band)
     }
 
-    /// Writes the PNG to `path`, with its labels drawn in ([`Panel::labelled`]),
+    /// Writes the PNG to `path`, with its labels drawn in (`Panel::labelled`),
     /// and the SVG beside it, which shows the tiles with its labels as text.
     pub fn write(&self, path: &Path) -> Result<(), ExperimentError> {
         let image_error = |message: String| ExperimentError::Image { path: path.to_owned(), message };
