@@ -31,6 +31,7 @@ use rtgi_scene::{Camera, Scene};
 
 pub mod analytic;
 pub mod exact;
+pub mod format;
 mod index;
 mod knobs;
 pub mod machine;

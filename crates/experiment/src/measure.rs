@@ -1,5 +1,5 @@
 //! Measuring, written once for the experiments and `rtgi bench`: timing
-//! with warm-up and repeats (median, min and max), ray throughput on a
+//! with warm-up and repeats (median, min and max), timed renders, ray throughput on a
 //! thread pool, evenly spaced ray subsets, and traversal counters summed
 //! over a batch.
 
@@ -9,6 +9,10 @@ use rayon::prelude::*;
 use rtgi_accel::{Accel, TraversalCounters};
 use rtgi_math::Ray;
 
+use rtgi_image::HdrImage;
+use rtgi_render::RenderSettings;
+
+use crate::Subject;
 use crate::stats::Timing;
 
 /// Rays a thread takes at a time.
@@ -69,6 +73,24 @@ pub fn count(accel: &dyn Accel, rays: &[Ray]) -> (TraversalCounters, u64) {
                 (a, h + g)
             },
         )
+}
+
+/// Renders `subject` with `settings` on the subject's structure; returns the image and the time in ms.
+pub(crate) fn render_timed(subject: &Subject, settings: &RenderSettings) -> (HdrImage, f64) {
+    let start = Instant::now();
+    let (image, _) = rtgi_render::render(&subject.scene, subject.accel.as_ref(), &subject.camera, settings, &|_| {});
+    (image, start.elapsed().as_secs_f64() * 1e3)
+}
+
+/// Renders `subject` with `settings` and denoises the image as `rtgi
+/// render` does for PNG output (`rtgi_render::render_denoised`); returns
+/// the image and the time of the render, its guides and the filter in ms.
+pub(crate) fn render_denoised(subject: &Subject, settings: &RenderSettings) -> (HdrImage, f64) {
+    let start = Instant::now();
+    let denoise = rtgi_render::DenoiseSettings::for_samples(settings.samples_per_pixel);
+    let (clean, _) =
+        rtgi_render::render_denoised(&subject.scene, subject.accel.as_ref(), &subject.camera, settings, &denoise);
+    (clean, start.elapsed().as_secs_f64() * 1e3)
 }
 
 #[cfg(test)]

@@ -42,6 +42,9 @@ pub struct Crop {
     pub side: u32,
 }
 
+/// How far an equal-time entry's time may be from the budget, as a fraction of it.
+pub(crate) const EQUAL_TIME_TOLERANCE: f64 = 0.05;
+
 /// Each tile is the crop enlarged this many times, pixel for pixel.
 const ZOOM: u32 = 3;
 /// White between tiles, in panel pixels.
@@ -271,16 +274,16 @@ impl Panel {
                 format!(
                     "{} ({} ms{}, RMSE {}{clips})",
                     e.label,
-                    crate::report::format_ms(e.time_ms),
+                    crate::format::format_ms(e.time_ms),
                     self.budget_share(e).map_or(String::new(), |share| {
                         let off = share - 1.0;
-                        if off.abs() <= crate::runner::EQUAL_TIME_TOLERANCE {
+                        if off.abs() <= EQUAL_TIME_TOLERANCE {
                             format!(", {:+.1}% of the budget", 100.0 * off)
                         } else {
                             format!(", {:+.1}% of the budget: outside ±5%", 100.0 * off)
                         }
                     }),
-                    crate::report::format_number(e.rmse)
+                    crate::format::format_number(e.rmse)
                 )
             })
             .collect();
@@ -302,7 +305,7 @@ impl Panel {
             self.title,
             self.file,
             entries.join(", "),
-            crate::report::format_number(self.scale),
+            crate::format::format_number(self.scale),
             self.crop.side,
             self.crop.side,
             self.crop.x,
@@ -353,8 +356,8 @@ impl Panel {
         std::iter::once(vec!["reference".to_owned()])
             .chain(self.entries.iter().zip(self.clipped()).map(|(e, clipped)| {
                 let mut lines = wrapped(&e.label, chars.max(1));
-                lines.push(format!("{} ms", crate::report::format_ms(e.time_ms)));
-                lines.push(format!("RMSE {}", crate::report::format_number(e.rmse)));
+                lines.push(format!("{} ms", crate::format::format_ms(e.time_ms)));
+                lines.push(format!("RMSE {}", crate::format::format_number(e.rmse)));
                 lines.extend(Self::clip_note(clipped));
                 lines
             }))
@@ -416,7 +419,7 @@ impl Panel {
                 pixels[(y * width + x) as usize] = colour;
             }
         }
-        let top = format!("{}+", crate::report::format_number(self.scale));
+        let top = format!("{}+", crate::format::format_number(self.scale));
         draw_text(&mut pixels, width, (bar_left, bar_top + 10), "0", scale);
         let right = (bar_left + bar_width).saturating_sub(text_width(&top, scale));
         draw_text(&mut pixels, width, (right, bar_top + 10), &top, scale);
@@ -508,7 +511,7 @@ impl Panel {
             r#"<text x="{}" y="{}" font-size="12">{} and above</text>"#,
             bar_left + bar_width + 6,
             bar_top + 11,
-            crate::report::format_number(self.scale)
+            crate::format::format_number(self.scale)
         );
         let _ = writeln!(svg, "</svg>");
         let path = png.with_file_name(labelled_file(&png.file_name().unwrap_or_default().to_string_lossy()));

@@ -6,8 +6,8 @@ use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
 
 use crate::ExperimentError;
+use crate::format::format_number;
 use crate::machine::Machine;
-use crate::report::format_number;
 
 /// One line of a plot.
 #[derive(Clone, Debug, PartialEq)]

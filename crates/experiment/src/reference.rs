@@ -149,7 +149,8 @@ fn estimator(settings: &RenderSettings) -> String {
 
 /// Two renders of `settings` with `seeds`: their average and its noise (half their RMSE difference).
 fn halves(subject: &Subject, settings: &RenderSettings, seeds: [u64; 2]) -> (HdrImage, f64, [HdrImage; 2]) {
-    let [a, b] = seeds.map(|seed| crate::runner::render(subject, &RenderSettings { seed, ..settings.clone() }).0);
+    let [a, b] =
+        seeds.map(|seed| crate::measure::render_timed(subject, &RenderSettings { seed, ..settings.clone() }).0);
     let noise = rtgi_image::compare(&a, &b).expect("same size").rmse / 2.0;
     let pixels = a.pixels().iter().zip(b.pixels()).map(|(x, y)| (*x + *y) * 0.5).collect();
     (HdrImage::from_pixels(settings.width, settings.height, pixels).expect("sizes agree"), noise, [a, b])

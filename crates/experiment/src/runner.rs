@@ -1,37 +1,16 @@
 //! Renders and times them: what every knob that renders shares.
 
-use std::time::Instant;
-
 use rtgi_accel::{Accel, AccelKind};
 use rtgi_image::HdrImage;
 use rtgi_render::RenderSettings;
 
+use crate::panel::EQUAL_TIME_TOLERANCE;
 use crate::reference::Reference;
 use crate::report::Point;
 use crate::stats::{SeedErrors, Timing};
 use crate::{Options, Subject};
 
-/// Renders `subject` with `settings` on the subject's structure; returns the image and the time in ms.
-pub(crate) fn render(subject: &Subject, settings: &RenderSettings) -> (HdrImage, f64) {
-    render_with(subject, subject.accel.as_ref(), settings)
-}
-
-pub(crate) fn render_with(subject: &Subject, accel: &dyn Accel, settings: &RenderSettings) -> (HdrImage, f64) {
-    let start = Instant::now();
-    let (image, _) = rtgi_render::render(&subject.scene, accel, &subject.camera, settings, &|_| {});
-    (image, start.elapsed().as_secs_f64() * 1e3)
-}
-
-/// Renders `subject` with `settings` and denoises the image as `rtgi
-/// render` does for PNG output (`rtgi_render::render_denoised`); returns
-/// the image and the time of the render, its guides and the filter in ms.
-pub(crate) fn render_denoised(subject: &Subject, settings: &RenderSettings) -> (HdrImage, f64) {
-    let start = Instant::now();
-    let denoise = rtgi_render::DenoiseSettings::for_samples(settings.samples_per_pixel);
-    let (clean, _) =
-        rtgi_render::render_denoised(&subject.scene, subject.accel.as_ref(), &subject.camera, settings, &denoise);
-    (clean, start.elapsed().as_secs_f64() * 1e3)
-}
+pub(crate) use crate::measure::{render_denoised, render_timed as render};
 
 /// Renders `options.repeats` times with seeds 0, 1, 2... and measures the
 /// time and the error against `reference`: RMSE, relative MSE, the split
@@ -73,8 +52,6 @@ pub(crate) fn measure_with(
 
 /// The most samples per pixel an equal-time entry renders.
 const MAX_PANEL_SPP: f64 = 65_536.0;
-/// How far an equal-time entry's time may be from the budget, as a fraction of it.
-pub(crate) const EQUAL_TIME_TOLERANCE: f64 = 0.05;
 /// Renders an equal-time entry may take to meet the budget within the tolerance.
 const EQUAL_TIME_ATTEMPTS: usize = 8;
 

@@ -9,7 +9,8 @@
 //! changes with the sample count. [`efficiency`] refuses a configuration
 //! whose bias is resolved, and [`describe_bias`] says what it is instead.
 
-use crate::report::{ImageError, Point, format_number};
+use crate::format::format_number;
+use crate::report::{ImageError, Point};
 use crate::stats::Timing;
 
 /// `a` against `b` by the rank test of their repeats: "`a` has 1.93× the

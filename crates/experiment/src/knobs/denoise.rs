@@ -97,7 +97,7 @@ pub(super) fn run(
         let off = |ms: f64| (ms / budget - 1.0).abs();
         let mut best = render_denoised(subject, &settings);
         for _ in 1..6 {
-            if off(best.1) <= crate::runner::EQUAL_TIME_TOLERANCE {
+            if off(best.1) <= crate::panel::EQUAL_TIME_TOLERANCE {
                 break;
             }
             let again = render_denoised(subject, &settings);
