@@ -8,6 +8,7 @@ mod deploy;
 mod experiment;
 mod experiment_index;
 mod gltf_extensions_doc;
+mod import_cycles;
 mod noop_build;
 mod release_profiles_doc;
 mod slurm_cluster;
