@@ -155,6 +155,28 @@ impl Phrasing {
     }
 }
 
+/// A render that cannot be prepared, in the words of the command line:
+/// the library names its fields, the app its options.
+pub(crate) fn recipe_error(error: recipe::RecipeError, phrasing: Phrasing) -> anyhow::Error {
+    use recipe::RecipeError;
+    if phrasing == Phrasing::Script {
+        return error.into();
+    }
+    match error {
+        RecipeError::CameraIndex { index, count } => {
+            anyhow::anyhow!("--camera {index}: the scene has {count} camera(s), numbered from 0")
+        }
+        RecipeError::FieldOfView(fov) => {
+            anyhow::anyhow!("--fov {fov}: the field of view must be between 0 and 180 degrees")
+        }
+        RecipeError::DegenerateCamera => anyhow::anyhow!(
+            "the camera is degenerate: it must look somewhere other than its own position (--at, --look), and not \
+             along --up"
+        ),
+        other => other.into(),
+    }
+}
+
 /// Says which of several file cameras was used, and warns that a camera
 /// from the file or the options seems to be inside geometry.
 pub(crate) fn report_camera(chosen: &ChosenCamera, phrasing: Phrasing) {
@@ -188,14 +210,15 @@ pub(crate) fn report_camera(chosen: &ChosenCamera, phrasing: Phrasing) {
 /// options applied on top ([`rtgi_render::recipe::choose_camera`]); warns
 /// when a given camera seems buried.
 pub(crate) fn choose_camera(scene: &Scene, accel: &dyn Accel, options: &CameraArgs, aspect: f32) -> Result<Camera> {
-    let chosen = recipe::choose_camera(scene, accel, &options.choice(), aspect)?;
+    let chosen = recipe::choose_camera(scene, accel, &options.choice(), aspect)
+        .map_err(|e| recipe_error(e, Phrasing::Options))?;
     report_camera(&chosen, Phrasing::Options);
     Ok(chosen.camera)
 }
 
 /// Applies the lighting options ([`rtgi_render::recipe::apply_lighting`]).
 pub(crate) fn apply_lighting(args: &LightingArgs, scene: &mut Scene, settings: &mut RenderSettings) -> Result<()> {
-    Ok(recipe::apply_lighting(&args.lighting(), scene, settings)?)
+    recipe::apply_lighting(&args.lighting(), scene, settings).map_err(|e| recipe_error(e, Phrasing::Options))
 }
 
 /// The structure a render traces: built for it, or built before by a
@@ -241,7 +264,7 @@ pub(crate) fn prepare_view(
     camera: &CameraArgs,
     phrasing: Phrasing,
 ) -> Result<Prepared> {
-    let prepared = recipe::prepare(scene, accel, settings, &camera.choice())?;
+    let prepared = recipe::prepare(scene, accel, settings, &camera.choice()).map_err(|e| recipe_error(e, phrasing))?;
     report_camera(&prepared.camera, phrasing);
     Ok(prepared)
 }

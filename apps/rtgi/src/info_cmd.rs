@@ -184,7 +184,8 @@ pub(crate) fn run(args: &InfoArgs) -> Result<()> {
     // render` prints them; the scene's own lights are listed above.
     let accel = AccelKind::Bvh8.build(&scene.triangle_positions(), &AccelKind::Bvh8.default_params());
     let mut info = info;
-    rtgi_render::recipe::prepare(&mut scene, accel.as_ref(), &mut settings, &args.camera.choice())?;
+    rtgi_render::recipe::prepare(&mut scene, accel.as_ref(), &mut settings, &args.camera.choice())
+        .map_err(|e| crate::common::recipe_error(e, crate::common::Phrasing::Options))?;
     info.plan = EffectPlan::new(&scene, &settings);
     if args.json {
         outln!("{}", serde_json::to_string_pretty(&info)?)?;

@@ -22,11 +22,13 @@ use crate::{
     frame_scene_explained, room_light, sky_visibility,
 };
 
-/// Why a render cannot be prepared; the messages name the option.
+/// Why a render cannot be prepared; the messages name the field of
+/// [`CameraChoice`] or of the settings (a front end names its own option
+/// for it: `rtgi render` says `--camera`, `--fov`, `--up`).
 #[derive(Debug, thiserror::Error)]
 pub enum RecipeError {
-    /// `--camera N` beyond the file's cameras.
-    #[error("--camera {index}: the scene has {count} camera(s), numbered from 0")]
+    /// A file camera beyond the file's cameras.
+    #[error("camera {index}: the scene has {count} camera(s), numbered from 0")]
     CameraIndex {
         /// The index asked for.
         index: usize,
@@ -34,10 +36,12 @@ pub enum RecipeError {
         count: usize,
     },
     /// A field of view outside (0°, 180°).
-    #[error("--fov {0}: the field of view must be between 0 and 180 degrees")]
+    #[error("field of view {0}: it must be between 0 and 180 degrees")]
     FieldOfView(f32),
     /// A camera that looks at its own position or along its up vector.
-    #[error("the camera is degenerate: it must look somewhere other than its own position, and not along --up")]
+    #[error(
+        "the camera is degenerate: it must look somewhere other than its own position, and not along its up direction"
+    )]
     DegenerateCamera,
     /// The environment map could not be read.
     #[error(transparent)]
