@@ -9,6 +9,7 @@ mod experiment;
 mod experiment_index;
 mod gltf_extensions_doc;
 mod import_cycles;
+mod library_errors;
 mod noop_build;
 mod release_profiles_doc;
 mod slurm_cluster;
