@@ -120,5 +120,12 @@ fn the_accel_and_scaling_experiments_measure_embree_beside_ours() {
     }
     let accel = std::fs::read_to_string(dir.join("accel/accel.md")).unwrap();
     assert!(accel.contains("embree (a peer, outside the exactness contract)"), "{accel}");
-    assert!(accel.contains("accel-total.svg") && accel.contains("pays for it from"), "{accel}");
+    // Each structure that builds slower and traces faster than the next
+    // cheaper one gets a break-even, or the verdict that one run each
+    // cannot resolve the differences it would rest on.
+    assert!(
+        accel.contains("accel-total.svg")
+            && (accel.contains("pays for it from") || accel.contains("no break-even is claimed")),
+        "{accel}"
+    );
 }
