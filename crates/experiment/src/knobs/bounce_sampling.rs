@@ -5,15 +5,14 @@
 
 use rtgi_render::{BounceSampling, RenderSettings};
 
-use super::sweep::{Setting, measure_settings};
-use crate::reference::reference;
+use super::sweep::{Setting, Sweep, measure_settings};
 use crate::report::Report;
-use crate::{ExperimentError, Options, Steps, Subject};
+use crate::{ExperimentError, Options, Subject};
 
 pub(super) fn run(
     subject: &Subject,
     options: &Options,
-    mut report: Report,
+    report: Report,
     progress: &dyn Fn(&str),
 ) -> Result<Report, ExperimentError> {
     super::require_light_transport(subject, "bounce-sampling")?;
@@ -27,23 +26,15 @@ pub(super) fn run(
         })
         .collect();
     let default = BounceSampling::ALL.iter().position(|&b| b == BounceSampling::default()).unwrap_or(0);
-    let mut steps = Steps::new(1 + settings.len() * counts.len(), progress);
-    steps.next("reference");
-    let reference = reference(subject, &base, options.reference_spp(), options.cache.as_deref(), progress)?;
     let compared_at = counts[counts.len() / 2];
-    measure_settings(
-        subject,
-        options,
-        &mut report,
-        &mut steps,
-        &reference,
-        &settings,
+    let sweep = Sweep {
+        base,
+        settings,
         default,
         counts,
         compared_at,
-        "bounce-sampling-tradeoff.svg",
-        "bounce sampling",
-    );
-    report.reference = Some(reference.info);
-    Ok(report)
+        file: "bounce-sampling-tradeoff.svg",
+        what: "bounce sampling",
+    };
+    measure_settings(subject, options, report, progress, sweep)
 }

@@ -6,10 +6,9 @@
 
 use rtgi_render::RenderSettings;
 
-use super::sweep::{Setting, measure_settings};
-use crate::reference::reference;
+use super::sweep::{Setting, Sweep, measure_settings};
 use crate::report::Report;
-use crate::{ExperimentError, Options, Steps, Subject};
+use crate::{ExperimentError, Options, Subject};
 
 /// The bounces roulette starts at: the first, the default (the second) and later ones.
 const STARTS: [u32; 5] = [1, 2, 3, 5, 8];
@@ -17,7 +16,7 @@ const STARTS: [u32; 5] = [1, 2, 3, 5, 8];
 pub(super) fn run(
     subject: &Subject,
     options: &Options,
-    mut report: Report,
+    report: Report,
     progress: &dyn Fn(&str),
 ) -> Result<Report, ExperimentError> {
     super::require_light_transport(subject, "roulette-start")?;
@@ -36,22 +35,15 @@ pub(super) fn run(
         settings: RenderSettings { russian_roulette: false, ..base.clone() },
     });
     let default = starts.iter().position(|&s| s == rtgi_render::ROULETTE_START).unwrap_or(0);
-    let mut steps = Steps::new(1 + settings.len() * counts.len(), progress);
-    steps.next("reference");
-    let reference = reference(subject, &base, options.reference_spp(), options.cache.as_deref(), progress)?;
-    measure_settings(
-        subject,
-        options,
-        &mut report,
-        &mut steps,
-        &reference,
-        &settings,
+    let compared_at = *counts.last().expect("counts");
+    let sweep = Sweep {
+        base,
+        settings,
         default,
         counts,
-        *counts.last().expect("counts"),
-        "roulette-start-tradeoff.svg",
-        "roulette start",
-    );
-    report.reference = Some(reference.info);
-    Ok(report)
+        compared_at,
+        file: "roulette-start-tradeoff.svg",
+        what: "roulette start",
+    };
+    measure_settings(subject, options, report, progress, sweep)
 }
