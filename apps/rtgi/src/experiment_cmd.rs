@@ -218,9 +218,7 @@ fn prepare(args: &ExperimentArgs, scene: Option<&Path>, pool: &rayon::ThreadPool
 
 #[cfg(test)]
 mod tests {
-    use clap::Parser;
-
-    use crate::cli::{Cli, Command};
+    use crate::cli::{Command, parse};
 
     /// The experiment renders what `rtgi render` renders with the same
     /// options: the same bytes, on the built-in box and on a closed room
@@ -240,15 +238,15 @@ mod tests {
             experiment_args.extend(scene);
             render_args.extend(options);
             experiment_args.extend(options);
-            let Command::Render(render) = Cli::try_parse_from(&render_args).unwrap().command else { unreachable!() };
-            let Command::Experiment(experiment) = Cli::try_parse_from(&experiment_args).unwrap().command else {
-                unreachable!()
-            };
+            let Command::Render(render) = parse(&render_args).unwrap().command else { unreachable!() };
+            let Command::Experiment(experiment) = parse(&experiment_args).unwrap().command else { unreachable!() };
             let pool = experiment.threads.pool().unwrap();
             let subject = super::prepare(&experiment, scene.map(std::path::Path::new), &pool).unwrap();
             let settings = rtgi_render::RenderSettings { samples_per_pixel: 4, seed: 3, ..subject.settings.clone() };
             let ours = pool.install(|| rtgi_experiment::render(&subject, &settings));
-            let (rendered, _) = crate::render_cmd::render_image(&render).unwrap().image.expect("an image");
+            let request = render.request().unwrap();
+            let rendered = rtgi_job::render(&request, &rtgi_job::Unobserved, &rtgi_job::CancelToken::new()).unwrap();
+            let (rendered, _) = rendered.image.expect("an image");
             let _ = std::fs::remove_dir_all(&dir);
             assert!(ours.pixels() == rendered.pixels(), "{scene:?}: the experiment renders another image");
             if scene.is_some() {

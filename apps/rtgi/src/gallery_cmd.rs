@@ -4,12 +4,14 @@
 use std::path::PathBuf;
 
 use anyhow::{Context, Result};
-use clap::{Args, Parser};
+use clap::Args;
 use rtgi_image::{HdrImage, ToneMap};
+use rtgi_job::{ImageSize, RenderRequest, SceneSource, check_output};
 
-use crate::cli::{Cli, Command};
+use crate::options::{load_options, threads_from_environment};
 use crate::output::outln;
-use crate::render_cmd::{check_output, render_image};
+use crate::phrasing::{Phrasing, job_error};
+use crate::render_cmd::{Printer, finish, render};
 
 /// `rtgi gallery`: scenes side by side, each as a first `rtgi render` shows it.
 #[derive(Debug, Args)]
@@ -39,27 +41,22 @@ pub(crate) struct GalleryArgs {
 const GAP: u32 = 4;
 
 pub(crate) fn run(args: &GalleryArgs) -> Result<()> {
-    check_output(&args.output)?;
+    check_output(&args.output).map_err(|e| job_error(e, Phrasing::Options))?;
     let scratch = std::env::temp_dir().join(format!("rtgi-gallery-{}", std::process::id()));
     std::fs::create_dir_all(&scratch).with_context(|| format!("{}: cannot create", scratch.display()))?;
     let mut pictures = Vec::new();
     for (index, scene) in args.scenes.iter().enumerate() {
         outln!("== {}", scene.display())?;
-        // Exactly what a user would type, so the sheet shows the real defaults.
+        // What `rtgi render SCENE -o PICTURE --width W --height H` renders,
+        // so the sheet shows the real defaults.
         let picture = scratch.join(format!("{index}.png"));
-        let command = [
-            "rtgi".into(),
-            "render".into(),
-            scene.clone().into_os_string(),
-            "-o".into(),
-            picture.clone().into_os_string(),
-            "--width".into(),
-            args.width.to_string().into(),
-            "--height".into(),
-            args.height.to_string().into(),
-        ];
-        let Command::Render(render) = Cli::try_parse_from(command)?.command else { unreachable!("a render command") };
-        pictures.push(render_image(&render)?.image);
+        let source = SceneSource::File { path: scene.clone(), options: load_options() };
+        let mut request = RenderRequest::new(source, picture);
+        request.size = ImageSize::exactly(args.width, args.height);
+        request.threads = threads_from_environment()?;
+        let rendered = render(&request, None, &Printer::new(&request, true, Phrasing::Options))?;
+        finish(&rendered)?;
+        pictures.push(rendered.image);
     }
     let _ = std::fs::remove_dir_all(&scratch);
 

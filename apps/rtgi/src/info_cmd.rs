@@ -185,7 +185,7 @@ pub(crate) fn run(args: &InfoArgs) -> Result<()> {
     let accel = AccelKind::Bvh8.build(&scene.triangle_positions(), &AccelKind::Bvh8.default_params());
     let mut info = info;
     rtgi_render::recipe::prepare(&mut scene, accel.as_ref(), &mut settings, &args.camera.choice())
-        .map_err(|e| crate::common::recipe_error(e, crate::common::Phrasing::Options))?;
+        .map_err(|e| crate::phrasing::recipe_error(e, crate::phrasing::Phrasing::Options))?;
     info.plan = EffectPlan::new(&scene, &settings);
     if args.json {
         outln!("{}", serde_json::to_string_pretty(&info)?)?;

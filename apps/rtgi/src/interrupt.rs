@@ -12,7 +12,10 @@
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::time::{Duration, Instant};
 
+use std::sync::OnceLock;
+
 use anyhow::{Context, Result};
+use rtgi_job::CancelToken;
 use signal_hook::consts::{SIGINT, SIGTERM};
 use signal_hook::iterator::Signals;
 
@@ -27,9 +30,18 @@ pub(crate) fn exit_status(signal: i32) -> u8 {
     (128 + signal) as u8
 }
 
-/// Installs the handlers; from then on [`requested`] tells whether a stop was asked for.
-pub(crate) fn install() -> Result<()> {
+/// The render's cancellation, which the signal thread sets.
+static TOKEN: OnceLock<CancelToken> = OnceLock::new();
+
+/// Installs the handlers (once) and returns the token they cancel: from
+/// then on a first SIGINT or SIGTERM asks the render to stop, naming itself.
+pub(crate) fn install() -> Result<CancelToken> {
+    if let Some(token) = TOKEN.get() {
+        return Ok(token.clone());
+    }
+    let token = TOKEN.get_or_init(CancelToken::new).clone();
     let mut signals = Signals::new([SIGINT, SIGTERM]).context("cannot install the signal handlers")?;
+    let cancel = token.clone();
     // The handlers only note the signal; this thread decides what it means.
     std::thread::Builder::new()
         .name("signals".into())
@@ -40,6 +52,7 @@ pub(crate) fn install() -> Result<()> {
                     None => {
                         SIGNAL.store(signal as usize, Ordering::SeqCst);
                         REQUESTED.store(true, Ordering::SeqCst);
+                        cancel.cancel(name(signal));
                         first = Some(Instant::now());
                     }
                     Some(at) if at.elapsed() < SAME_REQUEST => {}
@@ -48,7 +61,7 @@ pub(crate) fn install() -> Result<()> {
             }
         })
         .context("cannot start the signal thread")?;
-    Ok(())
+    Ok(token)
 }
 
 /// Whether a SIGINT or SIGTERM has arrived.
@@ -69,3 +82,16 @@ pub(crate) fn name(signal: i32) -> &'static str {
         _ => "a signal",
     }
 }
+
+/// A render stopped by a signal, after writing what it had: the command
+/// ends with the signal's exit status (130 for SIGINT, 143 for SIGTERM).
+#[derive(Debug)]
+pub(crate) struct StoppedBySignal(pub(crate) i32);
+
+impl std::fmt::Display for StoppedBySignal {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "stopped by {}", name(self.0))
+    }
+}
+
+impl std::error::Error for StoppedBySignal {}

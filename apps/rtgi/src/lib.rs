@@ -5,37 +5,35 @@
 
 mod bench_cmd;
 mod cli;
+mod command_line;
 mod common;
 mod debug_cmd;
-mod default_scene;
 mod effects_cmd;
 mod experiment_cmd;
 mod gallery_cmd;
 mod info_cmd;
 mod interrupt;
 mod merge_cmd;
+mod options;
 mod output;
+mod phrasing;
 mod progress;
 mod rays_cmd;
 mod render_cmd;
-mod render_job;
-mod render_summary;
 mod script;
 mod trace_cmd;
 mod verify_cmd;
 
 use std::process::ExitCode;
 
-use clap::Parser;
-
 /// Runs the command line with the process's arguments; returns the exit code.
 pub fn main() -> ExitCode {
-    let cli = match cli::Cli::try_parse() {
+    let cli = match cli::parse(std::env::args_os()) {
         Ok(cli) => cli,
         Err(e) => return cli::report_parse_error(e),
     };
-    let _ = common::ALLOW_OUTSIDE_SCENE.set(cli.allow_outside_scene);
-    let _ = common::GLTF_VARIANT.set(cli.variant.clone());
+    let _ = options::ALLOW_OUTSIDE_SCENE.set(cli.allow_outside_scene);
+    let _ = options::GLTF_VARIANT.set(cli.variant.clone());
     // Rayon's global pool runs whatever no command's own pool runs (loading
     // a scene, the passes of a render): it gets the same count, so that
     // `--threads N` bounds every thread that works, not only the pool's.
@@ -68,7 +66,7 @@ pub fn main() -> ExitCode {
         // it has all it wanted, so this is not a failure to report.
         Err(e) if output::is_closed(&e) => ExitCode::SUCCESS,
         Err(e) => {
-            if let Some(render_job::StoppedBySignal(signal)) = e.downcast_ref() {
+            if let Some(interrupt::StoppedBySignal(signal)) = e.downcast_ref() {
                 eprintln!("rtgi: {e}");
                 return ExitCode::from(interrupt::exit_status(*signal));
             }
@@ -87,9 +85,9 @@ pub fn main() -> ExitCode {
                 eprintln!("error: {}", one_line(&e));
                 return ExitCode::from(2);
             }
-            if e.downcast_ref::<render_job::ResumeOfAnotherRender>().is_some() {
+            if e.downcast_ref::<phrasing::ResumeOfAnotherRender>().is_some() {
                 eprintln!("error: {}", one_line(&e));
-                return ExitCode::from(render_job::ResumeOfAnotherRender::EXIT_STATUS);
+                return ExitCode::from(phrasing::ResumeOfAnotherRender::EXIT_STATUS);
             }
             eprintln!("error: {}", one_line(&e));
             ExitCode::FAILURE

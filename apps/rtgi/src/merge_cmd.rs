@@ -6,9 +6,9 @@ use anyhow::{Context, Result, bail};
 use clap::Args;
 use rtgi_render::{Accumulation, MergeFilesError};
 
-use crate::cli::ToneArgs;
+use crate::options::ToneArgs;
 use crate::output::outln;
-use crate::render_cmd::{check_output, is_accumulation, tone_map};
+use rtgi_job::{check_output, is_accumulation};
 
 /// `rtgi merge`: accumulations (.accum) of one render into its image.
 #[derive(Debug, Args)]
@@ -31,7 +31,7 @@ pub(crate) struct MergeArgs {
 }
 
 pub(crate) fn run(args: &MergeArgs) -> Result<()> {
-    check_output(&args.output)?;
+    check_output(&args.output).map_err(|e| crate::phrasing::job_error(e, crate::phrasing::Phrasing::Options))?;
     for part in &args.parts {
         if crate::common::same_file(part, &args.output) {
             bail!("-o {}: is also one of the parts; write the result to a new file", args.output.display());
@@ -91,7 +91,7 @@ pub(crate) fn run(args: &MergeArgs) -> Result<()> {
             rtgi_math::parse_choice::<rtgi_render::Integrator>(name)
                 .is_ok_and(|integrator| integrator.simulates_light())
         });
-        let tone_map = tone_map(&args.tone, simulates_light, &image);
+        let tone_map = rtgi_render::recipe::tone_map(args.tone.exposure, args.tone.tonemap, simulates_light, &image);
         image.write(&args.output, &tone_map).context("cannot write the merged image")?;
     }
     outln!("parts       {}", args.parts.len())?;

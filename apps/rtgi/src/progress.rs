@@ -40,6 +40,7 @@ pub(crate) struct Progress {
     /// Say, once every pixel has its first sample, how long the whole
     /// render will take (the course framework's "Will take around").
     forecast: std::sync::atomic::AtomicBool,
+    finished: std::sync::atomic::AtomicBool,
 }
 
 impl Progress {
@@ -68,6 +69,7 @@ impl Progress {
             last_line,
             line_every: line_every(),
             forecast: std::sync::atomic::AtomicBool::new(false),
+            finished: std::sync::atomic::AtomicBool::new(false),
         }
     }
 
@@ -125,9 +127,15 @@ impl Progress {
     }
 
     pub(crate) fn finish(&self) {
+        self.finished.store(true, Ordering::Relaxed);
         if let Some(bar) = &self.bar {
             bar.finish_and_clear();
         }
+    }
+
+    /// Whether [`Progress::finish`] was called.
+    pub(crate) fn finished(&self) -> bool {
+        self.finished.load(Ordering::Relaxed)
     }
 }
 

@@ -7,8 +7,8 @@ use clap::{Args, ValueEnum};
 use rtgi_math::Ray;
 use rtgi_render::rays::{box_rays, primary_rays, surface_rays};
 
-use crate::cli::{AccelArgs, CameraArgs, OutputArgs, SeedArgs};
 use crate::common::{LoadedScene, choose_camera, load_scene, refuse_inputs_as_outputs, write_atomically};
+use crate::options::{AccelArgs, CameraArgs, OutputArgs, SeedArgs};
 use crate::output::outln;
 use crate::trace_cmd::RAY_BYTES;
 
@@ -44,10 +44,10 @@ pub(crate) struct RaysArgs {
     pub(crate) count: u32,
 
     /// Image width and height of camera rays
-    #[arg(long, default_value_t = 512, value_parser = clap::value_parser!(u32).range(1..=crate::cli::MAX_IMAGE_SIDE as i64))]
+    #[arg(long, default_value_t = 512, value_parser = clap::value_parser!(u32).range(1..=rtgi_job::MAX_IMAGE_SIDE as i64))]
     pub(crate) width: u32,
 
-    #[arg(long, default_value_t = 512, value_parser = clap::value_parser!(u32).range(1..=crate::cli::MAX_IMAGE_SIDE as i64))]
+    #[arg(long, default_value_t = 512, value_parser = clap::value_parser!(u32).range(1..=rtgi_job::MAX_IMAGE_SIDE as i64))]
     pub(crate) height: u32,
 
     #[command(flatten)]

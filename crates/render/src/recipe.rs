@@ -248,7 +248,8 @@ pub struct Lighting {
     pub direct_strategy: DirectStrategy,
     /// The indirect-light clamp, if any.
     pub indirect_clamp: Option<f32>,
-    /// Path regularisation ([`RenderSettings::filter_glossy`]), if any.
+    /// Path regularisation ([`RenderSettings::filter_glossy`]), if any; a
+    /// threshold of 0 is none.
     pub filter_glossy: Option<crate::FilterGlossy>,
     /// The environment (a colour or a map's file), if any.
     pub environment: Option<EnvironmentSpec>,
@@ -273,7 +274,8 @@ pub fn apply_lighting(
     settings.bounce_sampling = lighting.bounce_sampling;
     settings.direct_strategy = lighting.direct_strategy;
     settings.indirect_clamp = lighting.indirect_clamp;
-    settings.filter_glossy = lighting.filter_glossy;
+    // A threshold of 0 widens nothing: it is no regularisation.
+    settings.filter_glossy = lighting.filter_glossy.filter(|filter| filter.threshold > 0.0);
     settings.effects = lighting.effects.clone();
     settings.environment = lighting
         .environment

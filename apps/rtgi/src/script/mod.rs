@@ -17,7 +17,7 @@ use std::path::PathBuf;
 use anyhow::{Result, bail};
 use clap::Args;
 
-use crate::cli::{SeedArgs, ThreadArgs};
+use crate::options::{SeedArgs, ThreadArgs};
 use session::{Flow, Session, SessionOptions};
 
 /// Options of `rtgi script` and `rtgi repl`.

@@ -10,7 +10,7 @@ use rtgi_math::{Mat4, Vec3};
 use rtgi_render::BounceSampling;
 
 use super::brdf::CourseBrdf;
-use crate::cli::MAX_IMAGE_SIDE as MAX_SIDE;
+use rtgi_job::MAX_IMAGE_SIDE as MAX_SIDE;
 
 /// One line of a script.
 #[derive(Clone, Debug, PartialEq)]

@@ -9,19 +9,25 @@ use std::collections::{BTreeSet, HashMap, HashSet};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-use anyhow::{Context, Result, anyhow, bail};
-use clap::Parser;
+use anyhow::{Result, anyhow, bail};
 use rtgi_accel::{Accel, AccelKind, BuildParams, SahAxes};
 use rtgi_math::{Mat3, Mat4, Vec3};
-use rtgi_render::{BounceSampling, ROULETTE_START};
+use rtgi_render::BounceSampling;
 use rtgi_scene::{ColorEncoding, Scene, Texture, TextureId};
 
 use super::brdf::{CourseBrdf, course_roughness, our_roughness};
 use super::parse::{Algo, BvhCommand, Command, CourseSplit, DirectSampling, MaterialCommand, PathSetting, Tracer};
-use crate::cli::{Cli, Command as CliCommand};
+use rtgi_image::ToneOperator;
+use rtgi_job::{Denoise, Given, ImageSize, RenderRequest, SceneSource, Structure, Tone};
+use rtgi_render::recipe::CameraChoice;
+use rtgi_render::{DirectStrategy, EnvironmentSpec, Integrator};
+
+use crate::command_line::{CommandLine, shell_words};
 use crate::common::{LoadedScene, load_scene};
+use crate::options::load_options;
 use crate::output::outln;
-use crate::render_cmd::{Given, render_given};
+use crate::phrasing::Phrasing;
+use crate::render_cmd::{Printer, finish, render};
 
 /// The course framework's camera defaults.
 const COURSE_FOV_DEGREES: f32 = 65.0;
@@ -726,132 +732,127 @@ impl Session {
         if algo.algo == Algo::Local && self.point_lights.is_empty() {
             bail!("algo local shades with a point light: add one (pointlight pos X Y Z col R G B)");
         }
-        let arguments = self.render_arguments(&algo, &tracer);
-        let cli = Cli::try_parse_from(std::iter::once("rtgi".to_owned()).chain(arguments.iter().cloned()))
-            .with_context(|| format!("the arguments made for rtgi {}", arguments.join(" ")))?;
-        let CliCommand::Render(args) = cli.command else { unreachable!("the arguments start with 'render'") };
+        let request = self.render_request(&algo, &tracer)?;
+        let words = request.to_command_line();
         if self.edits.is_empty() {
-            outln!("the same as  rtgi {}", shell_words(&arguments))?;
+            outln!("the same as  rtgi {}", shell_words(&words))?;
         } else {
             let edits: Vec<&str> = self.edits.iter().copied().collect();
-            outln!(
-                "like         rtgi {} (with {}, which no option expresses)",
-                shell_words(&arguments),
-                edits.join(", ")
-            )?;
+            outln!("like         rtgi {} (with {}, which no option expresses)", shell_words(&words), edits.join(", "))?;
         }
         let name = self.loaded.iter().map(|p| p.display().to_string()).collect::<Vec<_>>().join(" + ");
-        let given = Given { scene: LoadedScene { scene: self.scene.clone(), name, load_ms: 0.0 }, accel };
+        let scene = LoadedScene { scene: self.scene.clone(), name, load_ms: 0.0 };
         let started = Instant::now();
-        let rendered = render_given(&args, Some(given))?;
+        let printer = Printer::new(&request, true, Phrasing::Script);
+        let rendered = render(&request, Some(Given { scene: &scene, accel }), &printer)?;
+        finish(&rendered)?;
         let took = started.elapsed().as_secs_f64();
         eprintln!("Took {}", crate::progress::short_duration(took));
         self.runs.push(RunRecord {
             output: self.outfile.clone(),
             algo: algo.algo,
             tracer: tracer.name,
-            seconds: rendered.seconds,
-            rays: rendered.rays,
+            seconds: rendered.outcome.render.ms * 1e-3,
+            rays: rendered.outcome.render.rays,
         });
         Ok(())
     }
 
-    /// The `rtgi render` arguments that render what `run` renders.
-    fn render_arguments(&self, algo: &AlgoSetup, tracer: &TracerSetup) -> Vec<String> {
-        let mut a: Vec<String> = vec!["render".into(), self.loaded[0].display().to_string()];
-        let mut push = |option: &str, value: String| {
-            a.push(format!("--{option}"));
-            a.push(value);
-        };
-        push("output", self.outfile.display().to_string());
-        push("width", self.resolution.0.to_string());
-        push("height", self.resolution.1.to_string());
-        push("spp", self.sppx.to_string());
+    /// The `rtgi render` request that renders what `run` renders.
+    fn render_request(&self, algo: &AlgoSetup, tracer: &TracerSetup) -> Result<RenderRequest> {
+        let source = SceneSource::File { path: self.loaded[0].clone(), options: load_options() };
+        let mut request = RenderRequest::new(source, self.outfile.clone());
+        request.size = ImageSize::exactly(self.resolution.0, self.resolution.1);
+        request.sampling.samples_per_pixel = Some(self.sppx);
+        request.sampling.seed = self.options.seed;
         let (integrator, strategy, bounce, depth, roulette) = match algo.algo {
-            Algo::Primary | Algo::Info => ("albedo", None, None, None, None),
-            Algo::Local => ("direct", Some("light"), None, None, None),
+            Algo::Primary | Algo::Info => (Integrator::Albedo, None, None, None, None),
+            Algo::Local => (Integrator::Direct, Some(DirectStrategy::Light), None, None, None),
             Algo::Direct => match algo.sampling {
-                DirectSampling::Light => ("direct", Some("light"), None, None, None),
-                DirectSampling::Mis => ("direct", Some("mis"), None, None, None),
-                DirectSampling::Brdf => ("direct", Some("bsdf"), None, None, None),
-                DirectSampling::Cosine => ("direct", Some("bsdf"), Some(BounceSampling::Cosine), None, None),
-                DirectSampling::Uniform => ("direct", Some("bsdf"), Some(BounceSampling::Uniform), None, None),
+                DirectSampling::Light => (Integrator::Direct, Some(DirectStrategy::Light), None, None, None),
+                DirectSampling::Mis => (Integrator::Direct, Some(DirectStrategy::Mis), None, None, None),
+                DirectSampling::Brdf => (Integrator::Direct, Some(DirectStrategy::Bsdf), None, None, None),
+                DirectSampling::Cosine => {
+                    (Integrator::Direct, Some(DirectStrategy::Bsdf), Some(BounceSampling::Cosine), None, None)
+                }
+                DirectSampling::Uniform => {
+                    (Integrator::Direct, Some(DirectStrategy::Bsdf), Some(BounceSampling::Uniform), None, None)
+                }
             },
-            Algo::DirectMis => ("direct", Some("mis"), None, None, None),
+            Algo::DirectMis => (Integrator::Direct, Some(DirectStrategy::Mis), None, None, None),
             // The course's simple path tracer traces at most `len` rays, the
             // camera's included; ours counts bounces after the camera ray.
             // Its roulette starts after bounce rr-start + 1 (it tests the
             // ray index after the bounce, from 0): ours counts bounces from 1.
-            Algo::SimplePt => {
-                ("path", Some("bsdf"), Some(algo.bounce), Some(algo.length - 1), Some(algo.roulette_start + 2))
-            }
+            Algo::SimplePt => (
+                Integrator::Path,
+                Some(DirectStrategy::Bsdf),
+                Some(algo.bounce),
+                Some(algo.length - 1),
+                Some(algo.roulette_start + 2),
+            ),
             // With next-event estimation, `len` hits each light their paths.
             Algo::Pt => (
-                "path",
-                Some(if algo.mis { "mis" } else { "light" }),
+                Integrator::Path,
+                Some(if algo.mis { DirectStrategy::Mis } else { DirectStrategy::Light }),
                 Some(algo.bounce),
                 Some(algo.length),
                 Some(algo.roulette_start + 2),
             ),
         };
-        push("integrator", integrator.into());
+        let lighting = &mut request.lighting;
+        lighting.integrator = integrator;
         // The course's images show the estimators' noise as it is, unless
         // `denoise on` asked otherwise (for the algorithms that simulate light).
-        let denoised = self.denoise && matches!(integrator, "direct" | "path");
-        push("denoise", if denoised { "on" } else { "off" }.into());
+        request.denoise = if self.denoise && integrator.simulates_light() { Denoise::On } else { Denoise::Off };
         if let Some(strategy) = strategy {
-            push("direct-strategy", strategy.into());
+            lighting.direct_strategy = strategy;
         }
-        if let Some(bounce) = bounce.filter(|b| *b != BounceSampling::Bsdf) {
-            push("bounce-sampling", bounce.name().into());
+        if let Some(bounce) = bounce {
+            lighting.bounce_sampling = bounce;
         }
         if let Some(depth) = depth {
-            push("max-depth", depth.to_string());
+            lighting.max_depth = depth;
         }
-        if let Some(roulette) = roulette.filter(|r| *r != ROULETTE_START) {
-            push("roulette-start", roulette.to_string());
+        if let Some(roulette) = roulette {
+            lighting.roulette_start = roulette;
         }
-        push("accel", tracer.kind.name().into());
-        // Build parameters only where they shape the tree.
-        let defaults = tracer.kind.default_params();
-        let params = tracer.params();
-        if tracer.kind.split_method().is_some() && params.max_leaf_size != defaults.max_leaf_size {
-            push("leaf-size", params.max_leaf_size.to_string());
-        }
-        if tracer.kind == AccelKind::Sah && params.sah_bins != defaults.sah_bins {
-            push("sah-bins", params.sah_bins.to_string());
-        }
-        if tracer.kind == AccelKind::Sah && params.sah_axes != defaults.sah_axes {
-            push("sah-axes", params.sah_axes.name().into());
-        }
-        let camera = &self.camera;
-        push("at", comma(camera.position));
-        push("look", comma(camera.position + camera.direction));
-        push("up", comma(camera.up));
-        push("fov", COURSE_FOV_DEGREES.to_string());
         for &(position, colour) in &self.point_lights {
-            push("light", format!("point:{}:1:{}", comma(position), comma(colour)));
+            lighting.lights.push(format!("point:{}:1:{}", comma(position), comma(colour)).parse()?);
         }
         let lit_by_sky = !matches!(algo.algo, Algo::Primary | Algo::Info | Algo::Local);
         if let Some((file, scale)) = self.sky.as_ref().filter(|_| lit_by_sky) {
-            push("environment", file.display().to_string());
-            if *scale != 1.0 {
-                push("environment-scale", scale.to_string());
-            }
+            lighting.environment = Some(EnvironmentSpec::File(file.clone()));
+            lighting.environment_scale = *scale;
         }
         if algo.algo == Algo::Local {
             // Local illumination is the point light's alone.
-            push("effects", "-emission".into());
+            lighting.effects = "-emission".parse().map_err(|e: String| anyhow!(e))?;
         }
-        push("background", "0,0,0".into());
-        push("tonemap", "clamp".into());
-        push("exposure", "0".into());
-        push("seed", self.options.seed.to_string());
-        if let Some(threads) = self.threads() {
-            push("threads", threads.to_string());
+        lighting.no_default_lighting = true;
+        // Build parameters only where they shape the tree.
+        let mut structure = Structure::of(tracer.kind);
+        let (defaults, params) = (tracer.kind.default_params(), tracer.params());
+        if tracer.kind.split_method().is_some() && params.max_leaf_size != defaults.max_leaf_size {
+            structure.leaf_size = Some(params.max_leaf_size as u32);
         }
-        a.push("--no-default-lighting".into());
-        a
+        if tracer.kind == AccelKind::Sah {
+            structure.sah_bins = params.sah_bins as u32;
+            structure.sah_axes = params.sah_axes;
+        }
+        request.structure = structure;
+        let camera = &self.camera;
+        request.camera = CameraChoice {
+            index: None,
+            at: Some(camera.position),
+            look: Some(camera.position + camera.direction),
+            up: Some(camera.up),
+            fov_degrees: Some(COURSE_FOV_DEGREES),
+        };
+        request.background = Vec3::ZERO;
+        request.tone = Tone { exposure: Some(0.0), operator: Some(ToneOperator::Clamp) };
+        request.threads = self.threads();
+        Ok(request)
     }
 
     fn print_stats(&self) -> Result<()> {
@@ -941,18 +942,6 @@ fn triple(v: Vec3) -> String {
 /// A vector as rtgi's options take it.
 fn comma(v: Vec3) -> String {
     format!("{},{},{}", v.x, v.y, v.z)
-}
-
-/// Arguments as a shell would need them typed.
-fn shell_words(arguments: &[String]) -> String {
-    let quote = |a: &String| {
-        if a.chars().all(|c| c.is_ascii_alphanumeric() || "-_.,/:+=".contains(c)) {
-            a.clone()
-        } else {
-            format!("'{}'", a.replace('\'', r"'\''"))
-        }
-    };
-    arguments.iter().map(quote).collect::<Vec<_>>().join(" ")
 }
 
 /// Transforms a loaded scene by a model matrix: positions as points,
