@@ -486,7 +486,87 @@ fn adaptive_summary(request: &RenderRequest, adaptive: &rtgi_job::AdaptiveSummar
 
 #[cfg(test)]
 mod tests {
+    use rtgi_accel::AccelKind;
+    use rtgi_job::{CancelToken, Structure, Unobserved};
+    use rtgi_render::DirectStrategy;
+
     use super::*;
+    use crate::command_line::CommandLine;
+
+    /// A render through [`RenderRequest`] writes the bytes `rtgi render`
+    /// writes with the equivalent options ([`CommandLine`]), for every
+    /// option group: size and samples, lighting, camera, structure, tone,
+    /// denoising, AOVs, adaptive sampling, a split part, and a checkpoint resumed.
+    #[test]
+    fn a_request_renders_the_bytes_of_its_command_line() {
+        let dir = std::env::temp_dir().join(format!("rtgi-request-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let room = PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/../../tests/scenes/closed-room.toml"));
+        let base = |name: &str| {
+            let mut request = RenderRequest::new(SceneSource::BuiltIn, dir.join(name));
+            request.size = ImageSize::exactly(24, 16);
+            request.sampling.samples_per_pixel = Some(4);
+            request.threads = Some(2);
+            request
+        };
+        let mut cases = Vec::new();
+        let mut lit = base("lit.exr");
+        lit.lighting.direct_strategy = DirectStrategy::Light;
+        lit.lighting.max_depth = 3;
+        lit.lighting.indirect_clamp = Some(4.0);
+        lit.lighting.lights = vec!["point:278,500,280:20000".parse().unwrap()];
+        lit.lighting.environment = Some(rtgi_render::EnvironmentSpec::Uniform(Vec3::new(0.2, 0.3, 0.4)));
+        lit.camera.at = Some(Vec3::new(278.0, 273.0, -600.0));
+        lit.camera.fov_degrees = Some(50.0);
+        lit.structure = Structure::of(AccelKind::Sah);
+        lit.structure.leaf_size = Some(2);
+        lit.sampling.seed = 9;
+        lit.aovs = vec![Integrator::Albedo];
+        cases.push(lit);
+        let mut png = base("toned.png");
+        png.scene = SceneSource::file(&room);
+        png.tone = Tone { exposure: Some(1.5), operator: Some(rtgi_image::ToneOperator::Clamp) };
+        png.sampling.sampler = Some(PixelSampler::Sobol);
+        cases.push(png);
+        let mut denoised = base("denoised.png");
+        denoised.denoise = Denoise::On;
+        denoised.sampling.samples_per_pixel = Some(8);
+        cases.push(denoised);
+        let mut adaptive = base("adaptive.exr");
+        adaptive.sampling.noise = Some(0.2);
+        adaptive.sampling.samples_per_pixel = Some(32);
+        cases.push(adaptive);
+        let mut part = base("part.accum");
+        part.split = Split { samples: Some(1..3), tile: Some((1, 2)) };
+        cases.push(part);
+        let mut first_half = base("half.accum");
+        first_half.split.samples = Some(0..2);
+        let mut resumed = base("resumed.exr");
+        resumed.checkpoints.resume = Some(dir.join("half.accum"));
+        cases.push(resumed);
+
+        rtgi_job::render(&first_half, &Unobserved, &CancelToken::new()).unwrap();
+        for request in cases {
+            let ours = rtgi_job::render(&request, &Unobserved, &CancelToken::new()).unwrap();
+            let library_bytes: Vec<Vec<u8>> =
+                ours.outcome.outputs.iter().map(|o| std::fs::read(&o.path).unwrap()).collect();
+            assert!(!library_bytes.is_empty() && ours.ending == Ending::Complete, "{:?}", ours.outcome.outputs);
+            // The resumed file is the checkpoint too: start the CLI from the half again.
+            if request.checkpoints.resume.is_some() {
+                rtgi_job::render(&first_half, &Unobserved, &CancelToken::new()).unwrap();
+            }
+            let words = request.to_command_line();
+            let cli = crate::cli::parse(std::iter::once("rtgi".to_owned()).chain(words.iter().cloned())).unwrap();
+            let crate::cli::Command::Render(args) = cli.command else { unreachable!("a render") };
+            let printer = Printer::new(&request, false, crate::phrasing::Phrasing::Options);
+            let theirs = render(&args.request().unwrap(), None, &printer).unwrap();
+            assert_eq!(ours.outcome.outputs.len(), theirs.outcome.outputs.len(), "{words:?}");
+            for (bytes, output) in library_bytes.iter().zip(&theirs.outcome.outputs) {
+                assert!(*bytes == std::fs::read(&output.path).unwrap(), "{}: {words:?}", output.path);
+            }
+        }
+        let _ = std::fs::remove_dir_all(&dir);
+    }
 
     #[test]
     fn ranges_and_tiles_parse_strictly() {
