@@ -37,6 +37,9 @@ fn a_room_lit_only_from_outside_is_said_to_be_almost_black() {
     let (json, stderr) = render_room_summary(&dir.join("black.png"), &["--light", "point:5,5,5:100"]);
     assert_eq!(json["legibility"]["looks"], "almost black", "{json}");
     assert_eq!(json["legibility"]["fraction"], 1.0, "{json}");
+    // The outcome lists its warnings as data too (rtgi_job::Warning).
+    let warnings = json["warnings"].as_array().expect("a list of warnings");
+    assert!(warnings.iter().any(|w| w["kind"] == "almost_black" && w["fraction"] == 1.0), "{json}");
     // The warning says what to do, in the options' words.
     assert!(stderr.contains("warning: the image is almost black (100% of its pixels)"), "{stderr}");
     assert!(stderr.contains("--environment") && stderr.contains("--at"), "{stderr}");
@@ -53,6 +56,7 @@ fn an_overexposed_image_is_said_to_be_almost_white() {
     // Left to the automatic exposure, the same light gives an image that shows something.
     let (json, stderr) = render_room_summary(&dir.join("auto.png"), &["--light", "point:0,0.5,0:100"]);
     assert!(json["legibility"].is_null() && !stderr.contains("warning"), "{json} {stderr}");
+    assert_eq!(json["warnings"], serde_json::json!([]), "{json}");
     assert_eq!((&json["exposure"]["automatic"], &json["exposure"]["tone_map"]), (&true.into(), &"aces".into()));
     // The text says the same as the JSON.
     let run = render_room(&dir.join("auto.png"), &["--light", "point:0,0.5,0:100"]);
