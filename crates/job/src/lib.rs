@@ -22,6 +22,7 @@
 //! ```
 
 mod cancel;
+mod description;
 mod error;
 mod files;
 mod memory;
@@ -34,6 +35,7 @@ mod scene_source;
 mod split;
 
 pub use cancel::CancelToken;
+pub use description::{CameraInfo, ExtensionInfo, LightInfo, MaterialInfo, SceneDescription, TextureInfo, describe};
 pub use error::{Field, JobError};
 pub use files::{check_output_folder, same_file};
 pub use memory::{bytes_per_pixel, check_memory};
