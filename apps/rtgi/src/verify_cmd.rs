@@ -1,64 +1,15 @@
 //! `rtgi verify`: every chosen structure against the linear scan, bit for
 //! bit, on rays of the kinds that expose inexact structures.
 
-use std::collections::BTreeMap;
 use std::time::Instant;
 
 use anyhow::{Result, bail};
-use rtgi_accel::verify::{Answer, Case, ProbeRay, RayKind, Tally, adversarial_cases};
-use rtgi_accel::{Accel, AccelKind, BuildParams, Intersector, LinearScan, Traversal};
-use serde::Serialize;
+use rtgi_accel::verify::{Case, RayKind, VerifyReport, adversarial_cases, check_case};
+use rtgi_accel::{AccelKind, BuildParams, Intersector};
 
 use crate::cli::VerifyArgs;
 use crate::common::{check_output_folder, load_scene, write_atomically};
 use crate::output::outln;
-
-/// One row of the table: a ray kind, summed over scenes and structures.
-#[derive(Debug, Default, Serialize)]
-struct KindRow {
-    kind: String,
-    /// Rays of this kind (per structure).
-    rays: usize,
-    /// Of those, the rays the linear scan answered; the rest were compared
-    /// with the first structure checked.
-    linear_rays: usize,
-    /// Summed over the structures (the linear scan included for leaks and self-hits).
-    tally: Tally,
-    /// Summed over the peers' backends (Embree): their differences from
-    /// the reference, which are not failures.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    peers: Option<Tally>,
-}
-
-impl KindRow {
-    /// Adds one structure's failures on this kind's rays (the row counts
-    /// its rays itself); leaks only of a test that claims watertightness:
-    /// Möller-Trumbore's are reported per structure.
-    fn add_failures(&mut self, tally: &Tally, watertight: bool) {
-        let leaks = if watertight { tally.leaks } else { 0 };
-        self.tally.add(&Tally { rays: 0, compared: 0, leaks, ..tally.clone() });
-    }
-}
-
-/// The totals of one structure over every scene and kind.
-#[derive(Debug, Serialize)]
-struct StructureRow {
-    structure: String,
-    /// Whether it claims watertightness (its leaks are failures).
-    watertight: bool,
-    /// A peer's backend (Embree), not held to the exactness contract: its
-    /// differences, leaks and self-hits are reported, not failures.
-    peer: bool,
-    tally: Tally,
-}
-
-#[derive(Debug, Serialize)]
-struct Report {
-    scene: String,
-    seed: u64,
-    kinds: Vec<KindRow>,
-    structures: Vec<StructureRow>,
-}
 
 pub(crate) fn run(args: &VerifyArgs) -> Result<()> {
     if let Some(json) = &args.json {
@@ -94,8 +45,7 @@ pub(crate) fn run(args: &VerifyArgs) -> Result<()> {
     let pool = args.threads.pool()?;
     let start = Instant::now();
 
-    let mut kinds: BTreeMap<String, KindRow> = BTreeMap::new();
-    let mut structures: Vec<StructureRow> = Vec::new();
+    let mut report = VerifyReport::new(scene_name, args.seed.value);
     for (case, per_kind) in &cases {
         let rays = pool.install(|| case.rays(*per_kind, args.seed.value));
         let budget_rays = (args.linear_budget / case.triangles.len().max(1) as u64) as usize;
@@ -111,15 +61,9 @@ pub(crate) fn run(args: &VerifyArgs) -> Result<()> {
         }
         let mut heartbeat = Heartbeat { start, last: Instant::now() };
         pool.install(|| {
-            check_case(
-                case,
-                &rays,
-                &configurations,
-                &intersectors,
-                budget_rays,
-                (&mut kinds, &mut structures),
-                &mut heartbeat,
-            )
+            check_case(&mut report, case, &rays, &configurations, &intersectors, budget_rays, &mut |what| {
+                heartbeat.beat(what)
+            })
         })?;
         eprintln!(
             "{}: {} triangles, {} rays per structure checked ({:.1} s)",
@@ -129,18 +73,13 @@ pub(crate) fn run(args: &VerifyArgs) -> Result<()> {
             start.elapsed().as_secs_f64()
         );
     }
-    let report = Report { scene: scene_name, seed: args.seed.value, kinds: kinds.into_values().collect(), structures };
     // A reader that stops early (`| head`) must change neither the JSON
     // written nor the exit status that says whether verification failed.
     let printed = print_report(&report);
     if let Some(json) = &args.json {
         write_atomically(json, serde_json::to_string_pretty(&report)?.as_bytes())?;
     }
-    let failed = report.structures.iter().filter(|s| !s.peer).any(|s| {
-        let t = &s.tally;
-        t.closest_disagreements + t.any_disagreements + t.self_hits > 0 || (s.watertight && t.leaks > 0)
-    });
-    if failed {
+    if report.failed() {
         bail!("the structures do not all answer exactly as the linear scan, or rays leaked (see the table)");
     }
     printed
@@ -160,21 +99,6 @@ fn configurations(args: &VerifyArgs) -> Vec<(AccelKind, BuildParams)> {
     configurations
 }
 
-fn label(kind: AccelKind, params: &BuildParams) -> String {
-    if kind.is_peer() {
-        return format!("{kind} (peer)");
-    }
-    let mut label = format!("{kind} (leaf {}", params.max_leaf_size);
-    if kind == AccelKind::Sah {
-        label += &format!(", {} bins", params.sah_bins);
-    }
-    label += &format!(", {}", params.intersector);
-    if params.traversal != Traversal::Robust {
-        label += &format!(", {} traversal", params.traversal);
-    }
-    label + ")"
-}
-
 /// A progress line on standard error when a check has been quiet for a
 /// while: a large scene takes minutes, and a silent program looks hung.
 struct Heartbeat {
@@ -185,7 +109,7 @@ struct Heartbeat {
 impl Heartbeat {
     const QUIET: std::time::Duration = std::time::Duration::from_secs(5);
 
-    fn beat(&mut self, what: impl FnOnce() -> String) {
+    fn beat(&mut self, what: &dyn Fn() -> String) {
         if self.last.elapsed() >= Self::QUIET {
             eprintln!("  {} ({:.1} s)", what(), self.start.elapsed().as_secs_f64());
             self.last = Instant::now();
@@ -193,90 +117,7 @@ impl Heartbeat {
     }
 }
 
-/// Checks every configuration on one scene's rays, adding to the kind rows
-/// and the structure totals.
-fn check_case(
-    case: &Case,
-    rays: &[(&'static str, Vec<ProbeRay>)],
-    configurations: &[(AccelKind, BuildParams)],
-    intersectors: &[Intersector],
-    linear_rays: usize,
-    (kinds, structures): (&mut BTreeMap<String, KindRow>, &mut Vec<StructureRow>),
-    heartbeat: &mut Heartbeat,
-) -> anyhow::Result<()> {
-    let add = |name: String, watertight: bool, peer: bool, tally: &Tally, structures: &mut Vec<StructureRow>| {
-        match structures.iter_mut().find(|s| s.structure == name) {
-            Some(row) => row.tally.add(tally),
-            None => structures.push(StructureRow { structure: name, watertight, peer, tally: tally.clone() }),
-        }
-    };
-    for &intersector in intersectors {
-        let watertight = intersector.is_watertight();
-        let linear = LinearScan::new(&case.triangles, intersector);
-        let chosen: Vec<&(AccelKind, BuildParams)> =
-            configurations.iter().filter(|(_, p)| p.intersector == intersector).collect();
-        let built: Vec<(AccelKind, String, Box<dyn Accel>)> = chosen
-            .iter()
-            .map(|(kind, params)| {
-                let name = label(*kind, params);
-                let accel = kind.try_build(&case.triangles, params)?;
-                heartbeat.beat(|| format!("{}: built {name}", case.name));
-                Ok((*kind, name, accel))
-            })
-            .collect::<anyhow::Result<_>>()?;
-        for (kind, probes) in rays {
-            let ray_kind = *kind;
-            let checked = probes.len().min(linear_rays);
-            // In chunks, for the progress line: on a large scene the scan is most of the time.
-            let mut linear_answers = Vec::with_capacity(checked);
-            for chunk in probes[..checked].chunks(4096) {
-                linear_answers.extend(Answer::all(&linear, chunk));
-                heartbeat.beat(|| {
-                    format!(
-                        "{}: {ray_kind} rays: {} of {checked} through the linear scan ({intersector})",
-                        case.name,
-                        linear_answers.len()
-                    )
-                });
-            }
-            let linear_tally = Tally::of(&probes[..checked], &linear_answers, None);
-            add(format!("linear ({intersector})"), watertight, false, &linear_tally, structures);
-            // The reference: the linear scan where it answered, else the
-            // first of our structures (never a peer's).
-            let mut reference = linear_answers;
-            if checked < probes.len()
-                && let Some((_, _, first)) = built.iter().find(|(kind, _, _)| !kind.is_peer())
-            {
-                reference.extend(Answer::all(first.as_ref(), &probes[checked..]));
-            }
-            let row = kinds
-                .entry(kind.to_string())
-                .or_insert_with(|| KindRow { kind: kind.to_string(), ..KindRow::default() });
-            row.rays += probes.len();
-            row.linear_rays += checked;
-            row.add_failures(&linear_tally, watertight);
-            for (kind, name, accel) in &built {
-                let tally = Tally::of(probes, &Answer::all(accel.as_ref(), probes), Some(&reference));
-                add(name.clone(), watertight, kind.is_peer(), &tally, structures);
-                heartbeat.beat(|| format!("{}: {ray_kind} rays: {} through {name}", case.name, probes.len()));
-                if kind.is_peer() {
-                    row.peers.get_or_insert_with(Tally::default).add(&Tally { rays: 0, compared: 0, ..tally });
-                    continue;
-                }
-                row.add_failures(&tally, watertight);
-                // The wide BVHs trace batches as packets: those answers too.
-                if kind.node_width().is_some_and(|width| width > 2) {
-                    let batched = Tally::of(probes, &Answer::all_batched(accel.as_ref(), probes), Some(&reference));
-                    add(format!("{name} batch"), watertight, false, &batched, structures);
-                    row.add_failures(&batched, watertight);
-                }
-            }
-        }
-    }
-    Ok(())
-}
-
-fn print_report(report: &Report) -> Result<()> {
+fn print_report(report: &VerifyReport) -> Result<()> {
     outln!("rtgi verify: {} (seed {})", report.scene, report.seed)?;
     outln!()?;
     outln!(

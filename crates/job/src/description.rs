@@ -18,46 +18,70 @@ use crate::scene_source::LoadedScene;
 /// What a scene contains.
 #[derive(Clone, Debug, Serialize)]
 pub struct SceneDescription {
+    /// The scene's file, or the built-in scene's name.
     pub scene: String,
+    /// Triangles.
     pub triangles: usize,
+    /// Vertices (corners with their normals and texture coordinates).
     pub vertices: usize,
     /// Distinct vertex positions: fewer than `vertices` where corners at one
     /// position were split because their normals or texture coordinates differ.
     pub positions: usize,
+    /// Every material, with the triangles that use it.
     pub materials: Vec<MaterialInfo>,
+    /// Every texture.
     pub textures: Vec<TextureInfo>,
+    /// Every light the scene brings.
     pub lights: Vec<LightInfo>,
+    /// Every camera the scene brings.
     pub cameras: Vec<CameraInfo>,
+    /// The smallest and largest corner of the scene's box (`None` for an empty scene).
     pub bounds: Option<[[f32; 3]; 2]>,
+    /// The glTF extensions the file uses.
     pub extensions_used: Vec<String>,
+    /// Of those, the extensions rtgi does not render.
     pub extensions_unsupported: Vec<String>,
     /// Each extension the file uses, with how rtgi renders it.
     pub extensions: Vec<ExtensionInfo>,
     /// The file's material variants (KHR_materials_variants).
     pub material_variants: Vec<String>,
+    /// What the loader passed over.
     pub warnings: Vec<String>,
     /// What a render with the given lighting and camera would simulate, and why.
     pub plan: EffectPlan,
 }
 
+/// A material, as the renderer sees it.
 #[derive(Clone, Debug, Serialize)]
 pub struct MaterialInfo {
+    /// Its name in the file.
     pub name: String,
+    /// Triangles.
     pub triangles: usize,
+    /// Base colour (linear RGB).
     pub base_color: [f32; 3],
+    /// Whether a texture multiplies the base colour.
     pub textured: bool,
+    /// Metalness, 0 to 1.
     pub metallic: f32,
+    /// Perceptual roughness, 0 to 1.
     pub roughness: f32,
+    /// Emitted radiance (linear RGB).
     pub emission: [f32; 3],
+    /// Share of light transmitted through the surface.
     pub transmission: f32,
+    /// Index of refraction.
     pub ior: f32,
+    /// How light gets through it: opaque, cut-out, blend, transmission.
     pub alpha: String,
     /// What glTF's material extensions add: unlit, specular, sheen, clearcoat, ...
     pub layers: Vec<String>,
 }
 
+/// A glTF extension the file uses, and how rtgi renders it.
 #[derive(Clone, Debug, Serialize)]
 pub struct ExtensionInfo {
+    /// Its name in the file.
     pub name: String,
     /// simulated, approximated, not visual or unsupported.
     pub support: &'static str,
@@ -65,29 +89,46 @@ pub struct ExtensionInfo {
     pub detail: &'static str,
 }
 
+/// A texture.
 #[derive(Clone, Debug, Serialize)]
 pub struct TextureInfo {
+    /// Its name in the file.
     pub name: String,
+    /// Width in pixels.
     pub width: u32,
+    /// Height in pixels.
     pub height: u32,
 }
 
+/// A light of the scene.
 #[derive(Clone, Debug, Serialize)]
 pub struct LightInfo {
+    /// Its name in the file.
     pub name: String,
+    /// Point, directional or spot (with its cones).
     pub kind: String,
+    /// Position.
     pub position: [f32; 3],
+    /// Direction.
     pub direction: [f32; 3],
+    /// Colour (linear RGB).
     pub color: [f32; 3],
+    /// Intensity (candela for point and spot lights, lux for directional ones).
     pub intensity: f32,
 }
 
+/// A camera of the scene.
 #[derive(Clone, Debug, Serialize)]
 pub struct CameraInfo {
+    /// Position.
     pub position: [f32; 3],
+    /// Direction.
     pub direction: [f32; 3],
+    /// Up direction.
     pub up: [f32; 3],
+    /// Vertical field of view in degrees.
     pub vertical_fov_degrees: f32,
+    /// Width over height, if the camera fixes it.
     pub aspect: Option<f32>,
 }
 

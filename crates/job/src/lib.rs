@@ -21,6 +21,8 @@
 //! # Ok::<(), rtgi_job::JobError>(())
 //! ```
 
+#![warn(missing_docs)]
+
 mod cancel;
 mod description;
 mod error;

@@ -11,13 +11,17 @@ use serde::Serialize;
 /// What one render did.
 #[derive(Clone, Debug, Serialize)]
 pub struct RenderOutcome {
+    /// The scene's file, or the built-in scene's name.
     pub scene: SceneSummary,
     /// Which effects the render simulated, and why.
     pub plan: EffectPlan,
+    /// The camera used, and how it was chosen.
     pub camera: CameraSummary,
     /// Where the lamp hangs that an enclosed, unlit view was given.
     pub room_light: Option<[f32; 3]>,
+    /// The structure built.
     pub build: BuildSummary,
+    /// The samples: size, count, rays and times.
     pub render: PassesSummary,
     /// Milliseconds the denoiser took, when the image was denoised.
     pub denoise_ms: Option<f64>,
@@ -63,11 +67,14 @@ pub enum Warning {
     },
 }
 
+/// The scene rendered.
 #[derive(Clone, Debug, Serialize)]
 pub struct SceneSummary {
     /// The scene's file, or the built-in scene's name.
     pub name: String,
+    /// Triangles.
     pub triangles: usize,
+    /// Milliseconds the load took.
     pub load_ms: f64,
 }
 
@@ -85,9 +92,13 @@ pub struct CameraSummary {
     pub file_choice: Option<String>,
     /// Which automatic view, and why (as the note says).
     pub automatic_view: Option<String>,
+    /// Position.
     pub position: [f32; 3],
+    /// Direction.
     pub direction: [f32; 3],
+    /// Up direction.
     pub up: [f32; 3],
+    /// Vertical field of view in degrees.
     pub vertical_fov_degrees: f32,
     /// The scene's up axis (`+Y`, `+Z`, ...).
     pub up_axis: String,
@@ -133,33 +144,43 @@ impl CameraSummary {
     }
 }
 
+/// The acceleration structure built.
 #[derive(Clone, Debug, Serialize)]
 pub struct BuildSummary {
     /// The structure and its parameters.
     pub variant: String,
+    /// Milliseconds.
     pub ms: f64,
 }
 
 /// The render's samples: the size, how many and how fast.
 #[derive(Clone, Debug, Serialize)]
 pub struct PassesSummary {
+    /// Milliseconds.
     pub ms: f64,
+    /// Width in pixels.
     pub width: u32,
+    /// Height in pixels.
     pub height: u32,
     /// Samples per pixel asked for (the most a pixel takes, when sampling adapts).
     pub samples_per_pixel: u32,
     /// Samples per pixel done: fewer when the render was stopped.
     pub samples_done: u32,
+    /// The pixel sampler.
     pub sampler: String,
+    /// Worker threads.
     pub threads: usize,
     /// Passes over the image (rounds, when sampling adapts).
     pub passes: u32,
+    /// Rays traced.
     pub rays: u64,
+    /// Millions of rays a second.
     pub mrays_per_second: f64,
     /// When sampling adapted: the fewest samples a pixel took and the mean.
     pub adaptive: Option<AdaptiveSummary>,
 }
 
+/// What adaptive sampling did.
 #[derive(Clone, Debug, Serialize)]
 pub struct AdaptiveSummary {
     /// The fewest samples a pixel took.
@@ -176,21 +197,25 @@ pub struct AdaptiveSummary {
     pub stopped_by_time: bool,
 }
 
+/// How a PNG was exposed and tone mapped.
 #[derive(Clone, Debug, Serialize)]
 pub struct ExposureSummary {
     /// Stops of exposure applied before tone mapping.
     pub stops: f32,
     /// Whether the exposure was chosen from the image (no --exposure).
     pub automatic: bool,
+    /// The tone map.
     pub tone_map: String,
 }
 
 impl ExposureSummary {
+    /// The summary of `tone_map`; `automatic` when the exposure was chosen from the image.
     pub fn new(tone_map: &ToneMap, automatic: bool) -> Self {
         ExposureSummary { stops: tone_map.exposure, automatic, tone_map: tone_map.operator.to_string() }
     }
 }
 
+/// An image that came out almost black or almost white.
 #[derive(Clone, Debug, Serialize)]
 pub struct LegibilitySummary {
     /// `almost black` or `almost white`.
@@ -200,6 +225,7 @@ pub struct LegibilitySummary {
 }
 
 impl LegibilitySummary {
+    /// The summary of `legibility`.
     pub fn new(legibility: Legibility) -> Self {
         match legibility {
             Legibility::AlmostBlack(fraction) => LegibilitySummary { looks: "almost black", fraction },
@@ -208,14 +234,19 @@ impl LegibilitySummary {
     }
 }
 
+/// The share of a split render a job rendered.
 #[derive(Clone, Debug, Serialize)]
 pub struct PartSummary {
+    /// Rows `[start, end)`.
     pub rows: [u32; 2],
+    /// Samples of every pixel `[start, end)`.
     pub samples: [u32; 2],
 }
 
+/// A file a render wrote.
 #[derive(Clone, Debug, Serialize)]
 pub struct OutputSummary {
+    /// The file.
     pub path: String,
     /// `image`, `accumulation`, `checkpoint` or the AOV's name.
     pub kind: String,

@@ -18,10 +18,12 @@
 
 mod cases;
 mod rays;
+mod report;
 pub mod shapes;
 
 pub use cases::{Case, Solid, adversarial_cases, hollow_needles, needle, solids};
 pub use rays::RayKind;
+pub use report::{KindRow, StructureRow, VerifyReport, check_case, label};
 
 use rayon::prelude::*;
 use rtgi_math::{Ray, Rng, Vec3};
