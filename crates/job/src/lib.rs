@@ -54,3 +54,8 @@ pub use request::{
 pub use run::{Given, PREVIEW_FILTER_GLOSSY, Rendered, aov_path, check_output, render, render_given, thread_pool};
 pub use scene_source::{BUILT_IN_NAME, LoadedScene, SceneSource, built_in};
 pub use split::band;
+
+// The README's examples are compiled as doc tests, so they cannot rot.
+#[cfg(doctest)]
+#[doc = include_str!("../README.md")]
+struct ReadmeDoctests;
