@@ -17,6 +17,8 @@ mod merge_cmd;
 mod output;
 mod progress;
 mod rays_cmd;
+#[cfg(test)]
+mod reference;
 mod render_cmd;
 mod render_job;
 mod render_summary;
