@@ -37,7 +37,13 @@ fn cli_markdown() -> String {
         // The footer advertises the generator; the header below says how
         // the page is made instead.
         .show_footer(false);
-    let body = clap_markdown::help_markdown_command_custom(&command(), &options);
+    let mut body = clap_markdown::help_markdown_command_custom(&command(), &options);
+    // The generator leaves runs of blank lines between commands and at the
+    // end; one blank line reads the same and diffs cleaner.
+    while body.contains("\n\n\n") {
+        body = body.replace("\n\n\n", "\n\n");
+    }
+    let body = format!("{}\n", body.trim_end());
     // The generator's title comes first; the note goes after it.
     let (title, rest) = body.split_once('\n').unwrap_or((&body, ""));
     format!(
