@@ -13,8 +13,8 @@
 # machine's drift falls on all of them alike; each cell is the median of
 # the runs (min-max), and the ratio is to the shipped profile's median.
 # Writes docs/release-profiles.md (every run listed under its table, which
-# tests/tests/workspace/release_profiles_doc.rs checks) and the table into the README
-# between its release-profiles markers.
+# tests/tests/workspace/release_profiles_doc.rs checks), the table's only
+# home: the README and the guide link to it.
 #
 #   benches/release-profiles.sh [--runs N] [LTO:CGU ...]
 #   benches/release-profiles.sh --tabulate
@@ -169,12 +169,4 @@ fi
     echo '```'
 } >docs/release-profiles.md
 
-# The README's copy of the table, between its markers.
-awk -v table="$table" '
-    /<!-- release-profiles: begin -->/ { print; print table; skip = 1; next }
-    /<!-- release-profiles: end -->/ { skip = 0 }
-    !skip { print }
-' README.md >"$scratch/README.md"
-grep -q "release-profiles: begin" README.md || { echo "release-profiles: README.md has no release-profiles markers" >&2; exit 1; }
-cp "$scratch/README.md" README.md
-echo "wrote docs/release-profiles.md and the README's table" >&2
+echo "wrote docs/release-profiles.md" >&2

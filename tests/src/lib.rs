@@ -5,6 +5,13 @@ pub mod convergence;
 pub mod corpus;
 pub mod voxel_world;
 
+// The examples of the guide's page on the libraries are compiled (and the
+// runnable one run) as doctests, so that the page keeps to the crates' API:
+// this crate depends on all of them.
+#[doc = include_str!("../../docs/guide/library.md")]
+#[cfg(doctest)]
+pub struct GuideLibraryDoctests;
+
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 

@@ -19,6 +19,8 @@ mod output;
 mod phrasing;
 mod progress;
 mod rays_cmd;
+#[cfg(test)]
+mod reference;
 mod render_cmd;
 mod script;
 mod trace_cmd;

@@ -240,10 +240,15 @@ pub fn index_markdown(folder: &Path) -> Result<String, ExperimentError> {
             let _ = writeln!(md, "Front (fastest first): {}\n", pareto::describe_front(configurations));
         }
     }
+    // Our wide BVHs against Embree close the `accel` reports they come from.
+    let peers = peers_markdown(&reports);
     let mut knob = "";
     for entry in &reports {
         let report = &entry.report;
         if report.knob != knob {
+            if knob == "accel" {
+                md.push_str(&peers);
+            }
             knob = &report.knob;
             let _ = writeln!(md, "## `{}`: {}\n", report.knob, report.question);
         }
@@ -265,35 +270,9 @@ pub fn index_markdown(folder: &Path) -> Result<String, ExperimentError> {
         }
         md.push('\n');
     }
-    Ok(md)
-}
-
-/// The marker lines around the summary that the README carries.
-pub const SUMMARY_MARKERS: [&str; 2] = [
-    "<!-- generated from docs/experiments/*.json by the experiment_index test; RTGI_BLESS=1 rewrites it -->",
-    "<!-- end of the generated summary -->",
-];
-
-/// A short summary of the reports below `folder` for the README, from their
-/// JSON alone: each report's first finding, under its knob and scene.
-pub fn summary_markdown(folder: &Path) -> Result<String, ExperimentError> {
-    let reports = read_reports(folder)?;
-    check_one_version(&reports, None)?;
-    let mut md = String::new();
-    if let Some(first) = reports.first() {
-        let _ = writeln!(
-            md,
-            "{}
-",
-            first.report.provenance()
-        );
+    if knob == "accel" {
+        md.push_str(&peers);
     }
-    for entry in &reports {
-        if let Some(finding) = entry.report.findings.first() {
-            let _ = writeln!(md, "- **`{}`**, {}: {finding}", entry.report.knob, entry.report.scene);
-        }
-    }
-    md.push_str(&peers_markdown(&reports));
     Ok(md)
 }
 
@@ -368,10 +347,10 @@ fn peers_markdown(reports: &[IndexedReport]) -> String {
         _ => String::new(),
     };
     let mut md = format!(
-        "\nAgainst Embree (from the `accel` reports: the same rays for all, {threads} threads; in brackets, the \
-         multiple of Embree's figure: `rtcIntersect1` for camera and incoherent rays, `rtcIntersect16` for \
-         the batch of camera rays, and its build; \"not resolved\" where the rank test of the runs does not tell \
-         the two apart at 95% confidence). {rays_line}\n\n\
+        "### Our wide BVHs against Embree\n\nFrom the `accel` reports above: the same rays for all, {threads} threads. \
+         In brackets, the multiple of Embree's figure: `rtcIntersect1` for camera and incoherent rays, \
+         `rtcIntersect16` for the batch of camera rays, and its build; \"not resolved\" where the rank test of the \
+         runs does not tell the two apart at 95% confidence. {rays_line}\n\n\
          | scene | structure | camera Mrays/s | camera batch Mrays/s | incoherent Mrays/s | build ms |\n\
          |---|---|---:|---:|---:|---:|\n",
     );
@@ -379,6 +358,7 @@ fn peers_markdown(reports: &[IndexedReport]) -> String {
         md.push_str(&row);
         md.push('\n');
     }
+    md.push('\n');
     md
 }
 

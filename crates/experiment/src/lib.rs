@@ -46,9 +46,7 @@ mod runner;
 pub mod stats;
 pub mod verdict;
 
-pub use index::{
-    IndexedReport, RUN_RECORD, RunRecord, SUMMARY_MARKERS, index_markdown, read_reports, summary_markdown, write_index,
-};
+pub use index::{IndexedReport, RUN_RECORD, RunRecord, index_markdown, read_reports, write_index};
 pub use knobs::Knob;
 pub use machine::Machine;
 pub use report::{Point, Report, Series, Table};

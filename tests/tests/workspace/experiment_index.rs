@@ -1,27 +1,53 @@
 //! The committed report (`docs/experiments`) says only what its JSON holds:
-//! `index.md` and the README's summary are regenerated from the JSON and
-//! must equal what is committed, byte for byte. Edit a figure by hand and
-//! this test fails; rerun the experiments and regenerate instead:
+//! `index.md` is regenerated from the JSON and must equal what is
+//! committed, byte for byte. Edit a figure by hand and this test fails;
+//! rerun the experiments and regenerate instead:
 //!
 //! ```sh
 //! cargo run --release -p rtgi -- experiment all --out docs/experiments
-//! RTGI_BLESS=1 cargo test -p rtgi-tests --test workspace experiment_index   # the README's summary
+//! cargo run --release -p rtgi -- experiment index --out docs/experiments   # the index alone, from the JSON
 //! ```
+//!
+//! `index.md` is the one home of the results: the README and the guide,
+//! written by hand, link to it and copy none of its findings, figures or
+//! provenance (a copy would not be regenerated with it, and would go stale).
 
 use std::path::{Path, PathBuf};
 
-use rtgi_experiment::{SUMMARY_MARKERS, index_markdown, summary_markdown};
+use rtgi_experiment::index_markdown;
 use rtgi_tests::{scratch_dir, workspace_root};
 
 fn docs() -> PathBuf {
     workspace_root().join("docs/experiments")
 }
 
-/// The README's generated block, between the markers.
-fn readme_block(readme: &str) -> Option<(usize, usize)> {
-    let start = readme.find(SUMMARY_MARKERS[0])? + SUMMARY_MARKERS[0].len();
-    let end = start + readme[start..].find(SUMMARY_MARKERS[1])?;
-    Some((start, end))
+/// The pages written by hand through which a reader comes to the results:
+/// the README and the guide.
+fn hand_written_pages() -> Vec<PathBuf> {
+    let guide = workspace_root().join("docs/guide");
+    let mut pages: Vec<PathBuf> = std::fs::read_dir(&guide)
+        .unwrap_or_else(|e| panic!("{}: {e}", guide.display()))
+        .map(|entry| entry.unwrap().path())
+        .filter(|path| path.extension().is_some_and(|e| e == "md"))
+        .collect();
+    pages.sort();
+    pages.insert(0, workspace_root().join("README.md"));
+    pages
+}
+
+/// The lines of the index that state results: its provenance ("Measured
+/// ... at commit ..."), its findings and fits (list items) and the rows of
+/// its tables, those with a figure and long enough not to recur by chance.
+fn result_lines(index: &str) -> impl Iterator<Item = &str> {
+    index.lines().map(str::trim).filter(|line| {
+        let kind = line.starts_with("Measured ") || line.starts_with("- ") || line.starts_with("| ");
+        kind && line.len() >= 40 && line.contains(|c: char| c.is_ascii_digit())
+    })
+}
+
+/// The index's results that `page` repeats.
+fn copied_results<'a>(page: &str, index: &'a str) -> Vec<&'a str> {
+    result_lines(index).filter(|line| page.contains(line)).collect()
 }
 
 #[test]
@@ -39,21 +65,36 @@ fn the_committed_index_is_its_json() {
 }
 
 #[test]
-fn the_readme_summary_is_the_json() {
-    let readme_path = workspace_root().join("README.md");
-    let readme = std::fs::read_to_string(&readme_path).expect("README.md");
-    let (start, end) = readme_block(&readme).expect("the README has the generated summary's markers");
-    let generated = format!("\n{}", summary_markdown(&docs()).unwrap_or_else(|e| panic!("{e}")));
-    if std::env::var_os("RTGI_BLESS").is_some() {
-        let updated = format!("{}{generated}{}", &readme[..start], &readme[end..]);
-        std::fs::write(&readme_path, updated).expect("README.md written");
-        return;
+fn the_readme_and_the_guide_link_to_the_results_and_copy_none() {
+    let index = std::fs::read_to_string(docs().join("index.md")).expect("docs/experiments/index.md");
+    assert!(result_lines(&index).count() > 30, "the index's results were not found: has its form changed?");
+    let readme = std::fs::read_to_string(workspace_root().join("README.md")).expect("README.md");
+    assert!(readme.contains("](docs/experiments/index.md)"), "the README does not link to docs/experiments/index.md");
+    for page in hand_written_pages() {
+        let text = std::fs::read_to_string(&page).unwrap_or_else(|e| panic!("{}: {e}", page.display()));
+        let copied = copied_results(&text, &index);
+        assert!(
+            copied.is_empty(),
+            "{} repeats results of docs/experiments/index.md, which is their only home (it is regenerated from \
+             the JSON, a copy is not): link to it instead of\n{}",
+            page.display(),
+            copied.join("\n")
+        );
     }
-    assert!(
-        readme[start..end] == generated,
-        "the README's summary of the experiments differs from docs/experiments/*.json; rewrite it with \
-         RTGI_BLESS=1 cargo test -p rtgi-tests --test workspace experiment_index"
-    );
+}
+
+#[test]
+fn a_result_copied_into_a_page_is_caught() {
+    let index = std::fs::read_to_string(docs().join("index.md")).expect("docs/experiments/index.md");
+    let finding = index.lines().find(|l| l.starts_with("- ") && l.contains("Mann–Whitney")).expect("a finding");
+    let provenance = index.lines().find(|l| l.starts_with("Measured ")).expect("the provenance line");
+    let row = index.lines().find(|l| l.starts_with("| ") && l.contains("Embree |")).expect("a row against Embree");
+    let page = "# A page\n\nSee [the report](../experiments/index.md).\n";
+    assert_eq!(copied_results(page, &index), Vec::<&str>::new());
+    for copy in [finding, provenance, row] {
+        let planted = format!("{page}\n{copy}\n");
+        assert_eq!(copied_results(&planted, &index), vec![copy.trim()], "not caught: {copy}");
+    }
 }
 
 /// Copies the committed reports into a scratch folder.
