@@ -160,7 +160,7 @@ pub fn run(
 /// Renders `subject` with `settings` on its structure, as every experiment's
 /// measured render does: the image `rtgi render` makes of the same options.
 pub fn render(subject: &Subject, settings: &RenderSettings) -> rtgi_image::HdrImage {
-    runner::render(subject, settings).0
+    runner::render(subject, settings)
 }
 
 /// Counts the steps of an experiment and estimates the time left from the

@@ -1,7 +1,9 @@
-//! Measuring, written once for the experiments and `rtgi bench`: timing
-//! with warm-up and repeats (median, min and max), timed renders, ray throughput on a
-//! thread pool, evenly spaced ray subsets, and traversal counters summed
-//! over a batch.
+//! Measuring, written once for the experiments, `rtgi bench` and the
+//! benches: the only clock of the crate. Timing with warm-up and repeats
+//! (median, min and max, every run kept), variants timed in alternation so
+//! that drift hits them alike, timed renders, ray throughput on a thread
+//! pool, evenly spaced ray subsets, and traversal counters summed over a
+//! batch.
 
 use std::time::Instant;
 
@@ -24,14 +26,47 @@ pub fn time(repeats: usize, warm_up: usize, mut run: impl FnMut()) -> Timing {
     for _ in 0..warm_up {
         run();
     }
+    time_each(repeats, |_| run(), |()| {})
+}
+
+/// Runs `f` once; returns what it made and its time in milliseconds.
+pub fn once<T>(f: impl FnOnce() -> T) -> (T, f64) {
+    let start = Instant::now();
+    let made = f();
+    (made, start.elapsed().as_secs_f64() * 1e3)
+}
+
+/// Times `run(repeat)` for each of `repeats` repeats (at least one, no
+/// warm-up) and hands what each run made to `keep`, outside the clock:
+/// renders that are compared with a reference after each seed are timed
+/// without the comparison, and need not all be held at once.
+pub fn time_each<T>(repeats: usize, mut run: impl FnMut(usize) -> T, mut keep: impl FnMut(T)) -> Timing {
     let runs: Vec<f64> = (0..repeats.max(1))
-        .map(|_| {
-            let start = Instant::now();
-            run();
-            start.elapsed().as_secs_f64() * 1e3
+        .map(|repeat| {
+            let (made, ms) = once(|| run(repeat));
+            keep(made);
+            ms
         })
         .collect();
     Timing::of(&runs)
+}
+
+/// Times each of `variants` `rounds` times (at least once) after one
+/// untimed warm-up round, taking them in turn within each round: on a
+/// shared machine the speed drifts (other work, the clock's boost), and in
+/// alternation the drift hits every variant alike instead of whichever ran
+/// during it. Returns each variant's timing, in their order.
+pub fn alternate(rounds: usize, variants: &mut [&mut dyn FnMut()]) -> Vec<Timing> {
+    for run in variants.iter_mut() {
+        run();
+    }
+    let mut runs = vec![Vec::new(); variants.len()];
+    for _ in 0..rounds.max(1) {
+        for (run, runs) in variants.iter_mut().zip(&mut runs) {
+            runs.push(once(&mut **run).1);
+        }
+    }
+    runs.iter().map(|r| Timing::of(r)).collect()
 }
 
 /// Times `trace` over `rays` in chunks of [`CHUNK`] on the current thread
@@ -75,22 +110,21 @@ pub fn count(accel: &dyn Accel, rays: &[Ray]) -> (TraversalCounters, u64) {
         )
 }
 
-/// Renders `subject` with `settings` on the subject's structure; returns the image and the time in ms.
+/// Renders `subject` with `settings` on the subject's structure.
+pub(crate) fn render(subject: &Subject, settings: &RenderSettings) -> HdrImage {
+    rtgi_render::render(&subject.scene, subject.accel.as_ref(), &subject.camera, settings, &|_| {}).0
+}
+
+/// [`render`], timed: the image and the time in ms.
 pub(crate) fn render_timed(subject: &Subject, settings: &RenderSettings) -> (HdrImage, f64) {
-    let start = Instant::now();
-    let (image, _) = rtgi_render::render(&subject.scene, subject.accel.as_ref(), &subject.camera, settings, &|_| {});
-    (image, start.elapsed().as_secs_f64() * 1e3)
+    once(|| render(subject, settings))
 }
 
 /// Renders `subject` with `settings` and denoises the image as `rtgi
-/// render` does for PNG output (`rtgi_render::render_denoised`); returns
-/// the image and the time of the render, its guides and the filter in ms.
-pub(crate) fn render_denoised(subject: &Subject, settings: &RenderSettings) -> (HdrImage, f64) {
-    let start = Instant::now();
+/// render` does for PNG output (`rtgi_render::render_denoised`).
+pub(crate) fn render_denoised(subject: &Subject, settings: &RenderSettings) -> HdrImage {
     let denoise = rtgi_render::DenoiseSettings::for_samples(settings.samples_per_pixel);
-    let (clean, _) =
-        rtgi_render::render_denoised(&subject.scene, subject.accel.as_ref(), &subject.camera, settings, &denoise);
-    (clean, start.elapsed().as_secs_f64() * 1e3)
+    rtgi_render::render_denoised(&subject.scene, subject.accel.as_ref(), &subject.camera, settings, &denoise).0
 }
 
 #[cfg(test)]
@@ -103,6 +137,22 @@ mod tests {
         let timing = time(4, 2, || calls += 1);
         assert_eq!((calls, timing.runs), (6, 4));
         assert!(timing.min_ms <= timing.median_ms && timing.median_ms <= timing.max_ms);
+    }
+
+    #[test]
+    fn alternation_times_every_variant_each_round_in_turn() {
+        let order = std::cell::RefCell::new(Vec::new());
+        let (mut a, mut b) = (|| order.borrow_mut().push('a'), || order.borrow_mut().push('b'));
+        let timings = alternate(3, &mut [&mut a, &mut b]);
+        assert_eq!(order.into_inner().iter().collect::<String>(), "abababab");
+        assert!(timings.iter().all(|t| t.runs == 3 && t.runs_ms.len() == 3));
+    }
+
+    #[test]
+    fn each_run_is_kept_outside_the_clock() {
+        let mut kept = Vec::new();
+        let timing = time_each(3, |repeat| repeat * 10, |made| kept.push(made));
+        assert_eq!((kept, timing.runs), (vec![0, 10, 20], 3));
     }
 
     #[test]

@@ -7,9 +7,7 @@
 //! shared by two triangles), and the rays run from random points around
 //! the sphere to random points inside it, so every ray hits.
 
-use std::time::Instant;
-
-use rtgi_accel::{AccelKind, BuildParams};
+use rtgi_accel::AccelKind;
 use rtgi_math::{Ray, Rng, Vec3, uniform_sphere};
 
 use crate::plot::{BOUND_NOTE, Corner, Curve, Plot, is_bound, rate_or_bound};
@@ -98,11 +96,8 @@ pub(super) fn run(options: &Options, mut report: Report, progress: &dyn Fn(&str)
         for (kind, series) in kinds.iter().zip(&mut series) {
             steps.next(&format!("{kind} over {} triangles", triangles.len()));
             let params = kind.default_params();
-            let start = Instant::now();
-            let accel = kind
-                .try_build(&triangles, &BuildParams { ..params })
-                .map_err(|e| ExperimentError::Build(e.to_string()))?;
-            let build_ms = start.elapsed().as_secs_f64() * 1e3;
+            let (accel, build_ms) = crate::measure::once(|| kind.try_build(&triangles, &params));
+            let accel = accel.map_err(|e| ExperimentError::Build(e.to_string()))?;
             let bytes_per_triangle = accel.build_stats().memory_bytes as f64 / triangles.len() as f64;
             let limit = if *kind == AccelKind::Linear {
                 (LINEAR_BUDGET / triangles.len()).clamp(64, ray_count)

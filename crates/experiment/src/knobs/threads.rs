@@ -38,13 +38,14 @@ pub(super) fn run(
             .map_err(|e| ExperimentError::Unsuitable(format!("cannot start {threads} threads: {e}")))?;
         let (image, timing) = pool.install(|| {
             let mut image = None;
-            let mut times = Vec::new();
-            for repeat in 0..options.repeats.max(1) {
-                let (rendered, ms) = render(subject, &RenderSettings { seed: repeat as u64, ..settings.clone() });
-                times.push(ms);
-                image.get_or_insert(rendered);
-            }
-            (image.expect("at least one run"), Timing::of(&times))
+            let timing = crate::measure::time_each(
+                options.repeats,
+                |repeat| render(subject, &RenderSettings { seed: repeat as u64, ..settings.clone() }),
+                |rendered| {
+                    image.get_or_insert(rendered);
+                },
+            );
+            (image.expect("at least one run"), timing)
         });
         let (same, speedup) = match &first {
             Some((one, one_time)) => {
