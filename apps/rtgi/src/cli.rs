@@ -65,90 +65,12 @@ pub(crate) enum Command {
     Gallery(crate::gallery_cmd::GalleryArgs),
     /// What accuracy costs in time: vary one knob (or all) and write a table (KNOB.md), every
     /// measurement (KNOB.json) and SVG plots
-    Experiment(ExperimentArgs),
+    Experiment(crate::experiment_cmd::ExperimentArgs),
     /// Run scripts in the command language of the course framework (at, load, raytracer, algo,
     /// commit, run, ...); with no script, open a prompt
     Script(crate::script::ScriptArgs),
     /// Open a prompt that takes the course framework's commands (after running any scripts given)
     Repl(crate::script::ScriptArgs),
-}
-
-/// `rtgi experiment`: one knob measured as time against error.
-#[derive(Debug, Args)]
-pub(crate) struct ExperimentArgs {
-    /// The knob to vary
-    #[arg(value_parser = knob_parser())]
-    pub(crate) knob: KnobChoice,
-
-    /// Scene file (.obj, .gltf, .glb or .toml); the built-in Cornell box when omitted
-    pub(crate) scene: Option<PathBuf>,
-
-    /// Folder for the results [default: experiments/KNOB]; with 'all', one folder per knob inside it
-    #[arg(long)]
-    pub(crate) out: Option<PathBuf>,
-
-    /// Timed runs per measurement; times are reported as median, min and max
-    #[arg(long, default_value_t = 5, value_parser = clap::value_parser!(u32).range(1..=1000))]
-    pub(crate) repeats: u32,
-
-    /// A reduced version that runs in seconds (small images, few points): for tests, not conclusions
-    #[arg(long)]
-    pub(crate) quick: bool,
-
-    /// Samples per pixel of the converged references [default: 4096; 256 with --quick]
-    #[arg(long, value_parser = clap::value_parser!(u32).range(2..=1_048_576))]
-    pub(crate) reference_spp: Option<u32>,
-
-    /// Where references are cached between runs [default: experiments/.references]
-    #[arg(long)]
-    pub(crate) cache: Option<PathBuf>,
-
-    /// Render every reference again instead of reading the cache
-    #[arg(long)]
-    pub(crate) no_cache: bool,
-
-    /// Image width of the measured renders [default: 128; 32 with --quick]
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=MAX_IMAGE_SIDE as i64))]
-    pub(crate) width: Option<u32>,
-
-    /// Image height of the measured renders [default: 128; 32 with --quick]
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=MAX_IMAGE_SIDE as i64))]
-    pub(crate) height: Option<u32>,
-
-    #[command(flatten)]
-    pub(crate) lighting: LightingArgs,
-
-    #[command(flatten)]
-    pub(crate) accel: AccelArgs,
-
-    #[command(flatten)]
-    pub(crate) camera: CameraArgs,
-
-    #[command(flatten)]
-    pub(crate) threads: ThreadArgs,
-}
-
-/// One knob, or all of them.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub(crate) enum KnobChoice {
-    One(rtgi_experiment::Knob),
-    All,
-    Index,
-}
-
-/// The knobs' names (from [`rtgi_experiment::Knob`]'s `ValueEnum`) and `all`.
-fn knob_parser() -> impl TypedValueParser<Value = KnobChoice> {
-    let all = PossibleValue::new("all").help("Every knob in turn, one folder each, and the index");
-    let index = PossibleValue::new("index")
-        .help("Measure nothing: remake index.md in --out from the reports' JSON there (refused if they are of different code)");
-    PossibleValuesParser::new(
-        rtgi_experiment::Knob::value_variants().iter().filter_map(ValueEnum::to_possible_value).chain([all, index]),
-    )
-    .map(|name| match name.as_str() {
-        "all" => KnobChoice::All,
-        "index" => KnobChoice::Index,
-        name => KnobChoice::One(ValueEnum::from_str(name, false).expect("one of the possible values")),
-    })
 }
 
 /// `rtgi verify`: the exactness contract, checked on a scene or on the built-in adversarial set.
@@ -1092,7 +1014,6 @@ mod tests {
         agree(Traversal::ALL, |t| t.name());
         agree(rtgi_accel::simd::SimdLevel::ALL, |l| l.name());
         agree(ToneOperator::ALL, |t| t.name());
-        agree(rtgi_experiment::Knob::ALL, |k| k.name());
         agree(PixelSampler::ALL, |p| p.name());
         agree(rtgi_render::Effect::ALL, |e| e.name());
         agree(Integrator::ALL, |i| i.name());

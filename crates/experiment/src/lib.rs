@@ -3,7 +3,7 @@
 //!
 //! An experiment takes a [`Subject`] (a scene, a camera, a structure and
 //! base render settings, prepared by the caller) and [`Options`], varies one
-//! [`Knob`], and returns a [`Report`]: every measurement, the machine, the
+//! [`Knob`] (each a file of its own, all listed in [`KNOBS`]), and returns a [`Report`]: every measurement, the machine, the
 //! command, tables, findings (fitted slopes...) and plots, which
 //! [`Report::write`] turns into `KNOB.md`, `KNOB.json` and SVG files.
 //!
@@ -49,7 +49,7 @@ pub mod verdict;
 pub use index::{
     IndexedReport, RUN_RECORD, RunRecord, SUMMARY_MARKERS, index_markdown, read_reports, summary_markdown, write_index,
 };
-pub use knobs::Knob;
+pub use knobs::{KNOBS, Knob, Scenes, knob};
 pub use machine::Machine;
 pub use report::{Point, Report, Series, Table};
 
@@ -149,7 +149,7 @@ pub enum ExperimentError {
 /// Runs `knob` on `subject`; `progress` receives a line per step, with the
 /// time spent and an estimate of the time left.
 pub fn run(
-    knob: Knob,
+    knob: &dyn Knob,
     subject: &Subject,
     options: &Options,
     progress: &dyn Fn(&str),

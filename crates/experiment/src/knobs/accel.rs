@@ -427,3 +427,34 @@ pub(super) fn run(
     report.tables.push(table);
     Ok(report)
 }
+
+/// The `accel` knob.
+pub(super) struct AccelStructures;
+
+impl super::Knob for AccelStructures {
+    fn name(&self) -> &'static str {
+        "accel"
+    }
+
+    fn about(&self) -> &'static str {
+        "The acceleration structures and their build parameters."
+    }
+
+    fn question(&self) -> &'static str {
+        "what does each acceleration structure cost to build and to trace, and does it change any answer?"
+    }
+
+    fn scenes(&self) -> super::Scenes {
+        super::Scenes::Subject(&[super::CORNELL, super::BUNNY, super::SPONZA, super::CONFERENCE])
+    }
+
+    fn run(
+        &self,
+        subject: &Subject,
+        options: &Options,
+        report: Report,
+        progress: &dyn Fn(&str),
+    ) -> Result<Report, ExperimentError> {
+        run(subject, options, report, progress)
+    }
+}

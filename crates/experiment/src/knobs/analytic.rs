@@ -189,3 +189,34 @@ pub(super) fn run(options: &Options, mut report: Report, progress: &dyn Fn(&str)
     report.tables.push(table);
     Ok(report)
 }
+
+/// The `analytic` knob.
+pub(super) struct Analytic;
+
+impl super::Knob for Analytic {
+    fn name(&self) -> &'static str {
+        "analytic"
+    }
+
+    fn about(&self) -> &'static str {
+        "Each estimator's bias against answers known in closed form (white furnaces)."
+    }
+
+    fn question(&self) -> &'static str {
+        "is any estimator (sampler, direct-light strategy, roulette) biased against an answer known exactly?"
+    }
+
+    fn scenes(&self) -> super::Scenes {
+        super::Scenes::Own("white furnaces (built in: closed emitting spheres)")
+    }
+
+    fn run(
+        &self,
+        _subject: &Subject,
+        options: &Options,
+        report: Report,
+        progress: &dyn Fn(&str),
+    ) -> Result<Report, ExperimentError> {
+        run(options, report, progress)
+    }
+}

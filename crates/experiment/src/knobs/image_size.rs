@@ -91,3 +91,34 @@ pub(super) fn run(
     report.tables.push(table);
     Ok(report)
 }
+
+/// The `image-size` knob.
+pub(super) struct ImageSize;
+
+impl super::Knob for ImageSize {
+    fn name(&self) -> &'static str {
+        "image-size"
+    }
+
+    fn about(&self) -> &'static str {
+        "Render time against the image's pixel count."
+    }
+
+    fn question(&self) -> &'static str {
+        "does render time grow in proportion to the pixels, or does a fixed cost weigh on small images?"
+    }
+
+    fn scenes(&self) -> super::Scenes {
+        super::Scenes::Subject(&[super::CORNELL])
+    }
+
+    fn run(
+        &self,
+        subject: &Subject,
+        options: &Options,
+        report: Report,
+        progress: &dyn Fn(&str),
+    ) -> Result<Report, ExperimentError> {
+        run(subject, options, report, progress)
+    }
+}

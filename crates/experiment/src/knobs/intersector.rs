@@ -405,3 +405,35 @@ fn plots(report: &mut Report) {
         y_range: None,
     });
 }
+
+/// The `intersector` knob.
+pub(super) struct Intersectors;
+
+impl super::Knob for Intersectors {
+    fn name(&self) -> &'static str {
+        "intersector"
+    }
+
+    fn about(&self) -> &'static str {
+        "The ray/triangle tests: time, and failures on the hard cases of `rtgi verify`."
+    }
+
+    fn question(&self) -> &'static str {
+        "what does each ray/triangle test cost, and how often do rays slip through shared edges or hit the \
+            surface they leave?"
+    }
+
+    fn scenes(&self) -> super::Scenes {
+        super::Scenes::Subject(&[super::CORNELL])
+    }
+
+    fn run(
+        &self,
+        subject: &Subject,
+        options: &Options,
+        report: Report,
+        progress: &dyn Fn(&str),
+    ) -> Result<Report, ExperimentError> {
+        run(subject, options, report, progress)
+    }
+}
