@@ -43,7 +43,7 @@ pub(crate) enum Command {
     /// bounds, or rays leaving its surfaces
     Rays(crate::rays_cmd::RaysArgs),
     /// Measure build time, tree quality and ray throughput of acceleration structures
-    Bench(BenchArgs),
+    Bench(crate::bench_cmd::BenchArgs),
     /// Export the boxes of chosen BVH levels as an OBJ file, to look at the tree
     BvhBoxes(BvhBoxesArgs),
     /// Render the traversal cost (BVH nodes visited per pixel) as a heat map
@@ -54,7 +54,7 @@ pub(crate) enum Command {
     /// Measure how far an EXR image is from a reference EXR image (RMSE, relative MSE, max)
     Compare(CompareArgs),
     /// Measure what each effect costs: render time with effects forced on and off, and how the image changes
-    BenchEffects(BenchEffectsArgs),
+    BenchEffects(crate::effects_cmd::BenchEffectsArgs),
     /// Check that every acceleration structure answers hard rays exactly as the linear scan does,
     /// bit for bit, and that rays aimed inside closed surfaces never leak
     Verify(VerifyArgs),
@@ -108,40 +108,6 @@ pub(crate) struct VerifyArgs {
     pub(crate) threads: ThreadArgs,
 
     /// Also write the table as JSON to this file
-    #[arg(long)]
-    pub(crate) json: Option<PathBuf>,
-}
-
-/// `rtgi bench-effects`: the time each effect of the plan costs or saves.
-#[derive(Debug, Args)]
-pub(crate) struct BenchEffectsArgs {
-    /// Scene file (.obj, .gltf, .glb or .toml); the built-in Cornell box when omitted
-    pub(crate) scene: Option<PathBuf>,
-
-    #[command(flatten)]
-    pub(crate) size: ImageSize,
-
-    /// Samples per pixel of each render
-    #[arg(long, default_value_t = 8, value_parser = clap::value_parser!(u32).range(1..=1_048_576))]
-    pub(crate) spp: u32,
-
-    /// Timed renders per row; the median is reported
-    #[arg(long, default_value_t = 3, value_parser = clap::value_parser!(u32).range(1..=1000))]
-    pub(crate) repeats: u32,
-
-    #[command(flatten)]
-    pub(crate) threads: ThreadArgs,
-
-    #[command(flatten)]
-    pub(crate) lighting: LightingArgs,
-
-    #[command(flatten)]
-    pub(crate) accel: AccelArgs,
-
-    #[command(flatten)]
-    pub(crate) camera: CameraArgs,
-
-    /// Also write the results as JSON to this file
     #[arg(long)]
     pub(crate) json: Option<PathBuf>,
 }
@@ -351,58 +317,6 @@ pub(crate) struct HeatmapArgs {
     pub(crate) threads: ThreadArgs,
 }
 
-/// `rtgi bench`: what each acceleration structure costs and gives, side by side.
-#[derive(Debug, Args)]
-pub(crate) struct BenchArgs {
-    /// Scene file (.obj, .gltf, .glb or .toml); the built-in Cornell box when omitted
-    pub(crate) scene: Option<PathBuf>,
-
-    /// Structures to measure: names separated by commas, or all
-    #[arg(long, default_value = "all", value_parser = AccelParser { list: true })]
-    pub(crate) accel: AccelList,
-
-    #[command(flatten)]
-    pub(crate) build: BuildArgs,
-
-    /// Width of the primary-ray batch (one ray per pixel of the scene's camera)
-    #[arg(long, default_value_t = 1024, value_parser = clap::value_parser!(u32).range(1..=MAX_IMAGE_SIDE as i64))]
-    pub(crate) width: u32,
-
-    /// Height of the primary-ray batch
-    #[arg(long, default_value_t = 1024, value_parser = clap::value_parser!(u32).range(1..=MAX_IMAGE_SIDE as i64))]
-    pub(crate) height: u32,
-
-    /// Incoherent rays: from random points on the surfaces in random directions
-    #[arg(long, default_value_t = 1_000_000, value_parser = clap::value_parser!(u32).range(1..=100_000_000))]
-    pub(crate) rays: u32,
-
-    #[command(flatten)]
-    pub(crate) seed: SeedArgs,
-
-    /// Timed runs per measurement; the median is reported
-    #[arg(long, default_value_t = 5, value_parser = clap::value_parser!(u32).range(1..=1000))]
-    pub(crate) repeats: u32,
-
-    /// Rays per batch that the linear scan is timed on (an evenly spaced subset)
-    #[arg(long, default_value_t = 2048, value_parser = clap::value_parser!(u32).range(1..=100_000_000))]
-    pub(crate) linear_rays: u32,
-
-    #[command(flatten)]
-    pub(crate) threads: ThreadArgs,
-
-    /// Also write the results as JSON to this file
-    #[arg(long)]
-    pub(crate) json: Option<PathBuf>,
-
-    /// Structure on which every intersector and traversal is compared for speed and failure rates
-    #[arg(long, default_value = "sah", value_parser = AccelParser { list: false }.map(|list| list.0[0]))]
-    pub(crate) accuracy_accel: AccelKind,
-
-    /// Rays from inside a closed mesh for the escape rate
-    #[arg(long, default_value_t = 1_000_000, value_parser = clap::value_parser!(u32).range(1..=100_000_000))]
-    pub(crate) leak_rays: u32,
-}
-
 /// A list of acceleration structures chosen on the command line.
 #[derive(Clone, Debug)]
 pub(crate) struct AccelList(pub(crate) Vec<AccelKind>);
@@ -414,8 +328,8 @@ pub(crate) struct AccelList(pub(crate) Vec<AccelKind>);
 /// build without the feature is refused with [`AccelKind`]'s own message,
 /// which says how to build it in.
 #[derive(Clone, Copy, Debug)]
-struct AccelParser {
-    list: bool,
+pub(crate) struct AccelParser {
+    pub(crate) list: bool,
 }
 
 impl TypedValueParser for AccelParser {

@@ -8,14 +8,14 @@
 use std::time::Instant;
 
 use rayon::prelude::*;
-use rtgi_accel::{Accel, TraversalCounters};
+use rtgi_accel::{Accel, AccelKind, BuildParams, TraversalCounters};
 use rtgi_math::Ray;
 
 use rtgi_image::HdrImage;
 use rtgi_render::RenderSettings;
 
-use crate::Subject;
 use crate::stats::Timing;
+use crate::{ExperimentError, Subject};
 
 /// Rays a thread takes at a time.
 pub const CHUNK: usize = 1024;
@@ -108,6 +108,139 @@ pub fn count(accel: &dyn Accel, rays: &[Ray]) -> (TraversalCounters, u64) {
                 (a, h + g)
             },
         )
+}
+
+/// Builds `kind` over `triangles` `repeats` times (at least once) on the
+/// current thread pool; returns the last structure and the timing.
+///
+/// # Errors
+/// [`ExperimentError::Build`] where the structure cannot be built (a peer
+/// whose library is missing, triangles it refuses).
+pub fn build(
+    triangles: &[[rtgi_math::Vec3; 3]],
+    kind: AccelKind,
+    params: &BuildParams,
+    repeats: usize,
+) -> Result<(Box<dyn Accel>, Timing), ExperimentError> {
+    let mut built = Ok(None);
+    let timing = time(repeats, 0, || {
+        // After a failure the rest would fail alike: no need to build again.
+        if built.is_ok() {
+            built = kind.try_build(triangles, params).map(Some).map_err(|e| ExperimentError::Build(e.to_string()));
+        }
+    });
+    Ok((built?.expect("at least one build"), timing))
+}
+
+/// What tracing a batch of rays costs on the current thread pool.
+#[derive(Clone, Debug)]
+pub struct TraceCost {
+    /// One ray at a time ([`Accel::intersect`]).
+    pub single: Timing,
+    /// Through the batch API ([`Accel::intersect_batch`]) on chunks of
+    /// [`CHUNK`] consecutive rays: packets where the structure has them.
+    pub batched: Timing,
+}
+
+/// Times tracing `rays` through `accel`, one ray at a time and through the
+/// batch API, `repeats` times each after a warm-up ([`time_rays`]): what
+/// the accel knob and `rtgi bench` measure of every structure.
+pub fn trace_cost(accel: &dyn Accel, rays: &[Ray], repeats: usize) -> TraceCost {
+    let single = trace_time(accel, rays, repeats);
+    let batched = time_rays(rays, repeats, |chunk| {
+        let mut hits = vec![None; chunk.len()];
+        accel.intersect_batch(chunk, &mut hits);
+        hits.iter().filter(|h| h.is_some()).count()
+    });
+    TraceCost { single, batched }
+}
+
+/// Times tracing `rays` through `accel` one ray at a time ([`time_rays`]).
+pub fn trace_time(accel: &dyn Accel, rays: &[Ray], repeats: usize) -> Timing {
+    time_rays(rays, repeats, |chunk| chunk.iter().filter(|r| accel.intersect(r).is_some()).count())
+}
+
+/// Rays that fail on the robustness probes of `rtgi_render::probes`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct ProbeFailures {
+    /// Rays exactly through the shared edge of two triangles.
+    pub shared_edge_rays: usize,
+    /// Of those, the rays that hit neither triangle.
+    pub shared_edge_misses: usize,
+    /// Rays from inside a closed mesh, half aimed at its vertices and edges.
+    pub closed_mesh_rays: usize,
+    /// Of those, the rays that hit nothing (escape).
+    pub closed_mesh_escapes: usize,
+}
+
+/// Builds `kind` with `params` over the shared-edge probe and over a
+/// closed mesh with `leak_rays` rays from inside it (seeded by `seed`),
+/// and counts the rays that miss: on the current thread pool.
+///
+/// # Errors
+/// [`ExperimentError::Build`] where the structure cannot be built.
+pub fn probe_failures(
+    kind: AccelKind,
+    params: &BuildParams,
+    leak_rays: usize,
+    seed: u64,
+) -> Result<ProbeFailures, ExperimentError> {
+    let (edge_triangles, edge_rays) = rtgi_render::probes::shared_edge_probe();
+    let (mesh_triangles, mesh_rays) = rtgi_render::probes::closed_mesh_probe(leak_rays, seed);
+    let misses = |triangles: &[[rtgi_math::Vec3; 3]], rays: &[Ray]| -> Result<usize, ExperimentError> {
+        let accel = kind.try_build(triangles, params).map_err(|e| ExperimentError::Build(e.to_string()))?;
+        Ok(rays.par_iter().filter(|r| accel.intersect(r).is_none()).count())
+    };
+    Ok(ProbeFailures {
+        shared_edge_rays: edge_rays.len(),
+        shared_edge_misses: misses(&edge_triangles, &edge_rays)?,
+        closed_mesh_rays: mesh_rays.len(),
+        closed_mesh_escapes: misses(&mesh_triangles, &mesh_rays)?,
+    })
+}
+
+/// One render of an effects plan's comparison: the plan as planned, or
+/// one of its decisions reversed.
+#[derive(Clone, Debug)]
+pub struct EffectRender {
+    /// `plan`, `+effect` (forced on) or `-effect` (forced off).
+    pub label: String,
+    /// Whether the plan simulates the reversed effect; `None` for the plan itself.
+    pub planned: Option<bool>,
+    /// The settings rendered.
+    pub settings: RenderSettings,
+    /// The render's time over the repeats.
+    pub time: Timing,
+    /// The last repeat's image (every repeat renders the same seed).
+    pub image: HdrImage,
+}
+
+/// Renders `subject` with its effects plan for `settings`, then once per
+/// decision of the plan reversed (`EffectPlan::reversals`), each timed
+/// `repeats` times with the same seed, so that the images differ by the
+/// effects alone: the plan first. One untimed render of a sample first
+/// wakes the threads, which must not make the plan look slow. `progress`
+/// receives each render's label before it is measured.
+pub fn effect_renders(
+    subject: &Subject,
+    settings: &RenderSettings,
+    repeats: usize,
+    progress: &dyn Fn(&str),
+) -> Vec<EffectRender> {
+    let plan = rtgi_render::EffectPlan::new(&subject.scene, settings);
+    render(subject, &RenderSettings { samples_per_pixel: 1, ..settings.clone() });
+    let planned = ("plan".to_owned(), None, settings.clone());
+    let reversals =
+        plan.reversals(&subject.scene, settings).into_iter().map(|r| (r.label(), Some(r.planned), r.settings));
+    std::iter::once(planned)
+        .chain(reversals)
+        .map(|(label, planned, settings)| {
+            progress(&label);
+            let mut image = None;
+            let time = time_each(repeats, |_| render(subject, &settings), |made| image = Some(made));
+            EffectRender { label, planned, settings, time, image: image.expect("at least one repeat") }
+        })
+        .collect()
 }
 
 /// Renders `subject` with `settings` on the subject's structure.

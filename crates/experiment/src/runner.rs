@@ -1,6 +1,5 @@
 //! Renders and times them: what every knob that renders shares.
 
-use rtgi_accel::{Accel, AccelKind};
 use rtgi_image::HdrImage;
 use rtgi_render::RenderSettings;
 
@@ -214,25 +213,6 @@ pub(crate) fn time_and_error(series: &crate::Series) -> Vec<(Timing, f64, f64, f
         .map(|(t, e)| (t.clone(), e.rmse, e.rmse_min, e.rmse_max))
         .collect()
 }
-
-/// Builds `kind` over the subject's triangles `repeats` times; returns the last structure and the timing.
-pub(crate) fn build_timed(
-    triangles: &[[rtgi_math::Vec3; 3]],
-    kind: AccelKind,
-    params: &rtgi_accel::BuildParams,
-    repeats: usize,
-) -> Result<(Box<dyn Accel>, Timing), crate::ExperimentError> {
-    let mut built = Ok(None);
-    let timing = crate::measure::time(repeats, 0, || {
-        if built.is_ok() {
-            built =
-                kind.try_build(triangles, params).map(Some).map_err(|e| crate::ExperimentError::Build(e.to_string()));
-        }
-    });
-    Ok((built?.expect("at least one build"), timing))
-}
-
-pub(crate) use crate::measure::time_rays;
 
 #[cfg(test)]
 mod tests {

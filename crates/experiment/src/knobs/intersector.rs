@@ -20,9 +20,9 @@ use rtgi_accel::{Accel, AccelKind, BuildParams, Intersector};
 use rtgi_math::{Ray, Vec3};
 use rtgi_render::rays::{primary_rays, surface_rays};
 
+use crate::measure::time_rays;
 use crate::plot::{BOUND_NOTE, Corner, Curve, Plot, is_bound, rate_or_bound};
 use crate::report::{Point, Report, Series, Table, format_number};
-use crate::runner::time_rays;
 use crate::stats::Timing;
 use crate::{ExperimentError, Options, Steps, Subject};
 
