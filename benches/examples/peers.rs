@@ -14,13 +14,14 @@
 //! contenders' runs alternate and each figure is the median of 15 runs
 //! (builds: 15 builds).
 
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
 use obvhs::BvhBuildParams;
 use obvhs::bvh2::builder::build_bvh2_from_tris;
 use rayon::prelude::*;
 use rtgi_accel::{Accel, AccelKind, Hit};
 use rtgi_benches::workspace_root;
+use rtgi_experiment::measure::alternate;
 use rtgi_math::Ray;
 use rtgi_math::glam::Vec3A;
 use rtgi_render::rays::{bounding_sphere_camera, box_rays, primary_rays};
@@ -30,26 +31,6 @@ const RUNS: usize = 15;
 
 /// Rays per parallel work item; a multiple of 16, so that packets stay full.
 const CHUNK: usize = 1024;
-
-fn median(mut values: Vec<f64>) -> f64 {
-    values.sort_by(f64::total_cmp);
-    values[values.len() / 2]
-}
-
-/// Medians of `RUNS` rounds in which each of `runs` runs once, in turn
-/// (after one warm-up round), so that drift hits every contender alike.
-fn alternate(runs: &mut [&mut dyn FnMut() -> f64]) -> Vec<f64> {
-    for run in runs.iter_mut() {
-        run();
-    }
-    let mut times = vec![Vec::new(); runs.len()];
-    for _ in 0..RUNS {
-        for (run, times) in runs.iter_mut().zip(&mut times) {
-            times.push(run());
-        }
-    }
-    times.into_iter().map(median).collect()
-}
 
 /// Traces a chunk of rays and counts the hits.
 type Trace<'a> = Box<dyn Fn(&[Ray]) -> usize + Sync + 'a>;
@@ -163,11 +144,6 @@ fn main() {
     // in the tables, names wider than a column push the rest along.
     println!("columns: threads, {}", names.join(", "));
 
-    let timed = |pool: &rayon::ThreadPool, work: &(dyn Fn() + Sync)| {
-        let start = Instant::now();
-        pool.install(work);
-        start.elapsed().as_secs_f64()
-    };
     let pools: Vec<rayon::ThreadPool> =
         [1, 2].iter().map(|&n| rayon::ThreadPoolBuilder::new().num_threads(n).build().unwrap()).collect();
     let header = |what: &str| {
@@ -182,25 +158,28 @@ fn main() {
         values.iter().for_each(|v| print!(" {v:>12.decimals$}"));
         println!();
     };
+    // The contenders' runs alternate (`measure::alternate`), after one warm-up round.
+    let medians_ms = |work: &mut [Box<dyn FnMut() + '_>]| -> Vec<f64> {
+        let mut runs: Vec<&mut dyn FnMut()> = work.iter_mut().map(|r| &mut **r as _).collect();
+        alternate(RUNS, &mut runs).into_iter().map(|t| t.median_ms).collect()
+    };
     let measure_builds = |pool: &rayon::ThreadPool| {
-        let mut runs: Vec<Box<dyn FnMut() -> f64 + '_>> =
-            contenders.iter().map(|c| Box::new(|| timed(pool, &*c.build)) as Box<dyn FnMut() -> f64>).collect();
-        let mut runs: Vec<&mut dyn FnMut() -> f64> = runs.iter_mut().map(|r| &mut **r as _).collect();
-        alternate(&mut runs).into_iter().map(|s| s * 1e3).collect::<Vec<_>>()
+        let mut work: Vec<Box<dyn FnMut() + '_>> =
+            contenders.iter().map(|c| Box::new(|| pool.install(&*c.build)) as Box<dyn FnMut()>).collect();
+        medians_ms(&mut work)
     };
     let measure_rays = |pool: &rayon::ThreadPool, rays: &[Ray]| {
-        let mut runs: Vec<Box<dyn FnMut() -> f64 + '_>> = contenders
+        let mut work: Vec<Box<dyn FnMut() + '_>> = contenders
             .iter()
             .map(|c| {
                 Box::new(|| {
-                    timed(pool, &|| {
+                    pool.install(|| {
                         std::hint::black_box(rays.par_chunks(CHUNK).map(|chunk| (c.trace)(chunk)).sum::<usize>());
                     })
-                }) as Box<dyn FnMut() -> f64>
+                }) as Box<dyn FnMut()>
             })
             .collect();
-        let mut runs: Vec<&mut dyn FnMut() -> f64> = runs.iter_mut().map(|r| &mut **r as _).collect();
-        alternate(&mut runs).into_iter().map(|s| rays.len() as f64 / s * 1e-6).collect::<Vec<_>>()
+        medians_ms(&mut work).into_iter().map(|ms| rays.len() as f64 / ms * 1e-3).collect::<Vec<_>>()
     };
     header("build ms");
     for pool in &pools {

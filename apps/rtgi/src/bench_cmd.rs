@@ -1,18 +1,77 @@
 //! `rtgi bench`: build time, tree quality and throughput of every
-//! acceleration structure on one scene, as a table and as JSON.
+//! acceleration structure on one scene, as a table and as JSON: the quick
+//! mode of the `accel` knob. The measuring is the experiment library's
+//! (`rtgi_experiment::measure`: builds, trace costs, traversal counts,
+//! failures on the robustness probes); this file parses and prints.
+
+use std::path::PathBuf;
 
 use anyhow::{Result, bail};
-use rayon::prelude::*;
-use rtgi_accel::{Accel, AccelKind, BuildParams, BuildStats, Intersector, Traversal};
-use rtgi_experiment::measure;
+use clap::Args;
+use clap::builder::TypedValueParser;
+use rtgi_accel::{AccelKind, BuildParams, BuildStats, Intersector, Traversal};
+use rtgi_experiment::measure::{self, TraceCost};
 use rtgi_math::Ray;
-use rtgi_render::probes::{closed_mesh_probe, shared_edge_probe};
 use rtgi_render::rays::{primary_rays, surface_rays};
 use serde::Serialize;
 
-use crate::cli::BenchArgs;
+use rtgi_job::MAX_IMAGE_SIDE;
+
 use crate::common::{LoadedScene, check_output_folder, choose_camera, load_scene, thread_pool};
+use crate::options::{AccelList, AccelParser, BuildArgs, SeedArgs, ThreadArgs};
 use crate::output::outln;
+
+/// `rtgi bench`: what each acceleration structure costs and gives, side by side.
+#[derive(Debug, Args)]
+pub(crate) struct BenchArgs {
+    /// Scene file (.obj, .gltf, .glb or .toml); the built-in Cornell box when omitted
+    pub(crate) scene: Option<PathBuf>,
+
+    /// Structures to measure: names separated by commas, or all
+    #[arg(long, default_value = "all", value_parser = AccelParser { list: true })]
+    pub(crate) accel: AccelList,
+
+    #[command(flatten)]
+    pub(crate) build: BuildArgs,
+
+    /// Width of the primary-ray batch (one ray per pixel of the scene's camera)
+    #[arg(long, default_value_t = 1024, value_parser = clap::value_parser!(u32).range(1..=MAX_IMAGE_SIDE as i64))]
+    pub(crate) width: u32,
+
+    /// Height of the primary-ray batch
+    #[arg(long, default_value_t = 1024, value_parser = clap::value_parser!(u32).range(1..=MAX_IMAGE_SIDE as i64))]
+    pub(crate) height: u32,
+
+    /// Incoherent rays: from random points on the surfaces in random directions
+    #[arg(long, default_value_t = 1_000_000, value_parser = clap::value_parser!(u32).range(1..=100_000_000))]
+    pub(crate) rays: u32,
+
+    #[command(flatten)]
+    pub(crate) seed: SeedArgs,
+
+    /// Timed runs per measurement; the median is reported
+    #[arg(long, default_value_t = 5, value_parser = clap::value_parser!(u32).range(1..=1000))]
+    pub(crate) repeats: u32,
+
+    /// Rays per batch that the linear scan is timed on (an evenly spaced subset)
+    #[arg(long, default_value_t = 2048, value_parser = clap::value_parser!(u32).range(1..=100_000_000))]
+    pub(crate) linear_rays: u32,
+
+    #[command(flatten)]
+    pub(crate) threads: ThreadArgs,
+
+    /// Also write the results as JSON to this file
+    #[arg(long)]
+    pub(crate) json: Option<PathBuf>,
+
+    /// Structure on which every intersector and traversal is compared for speed and failure rates
+    #[arg(long, default_value = "sah", value_parser = AccelParser { list: false }.map(|list| list.0[0]))]
+    pub(crate) accuracy_accel: AccelKind,
+
+    /// Rays from inside a closed mesh for the escape rate
+    #[arg(long, default_value_t = 1_000_000, value_parser = clap::value_parser!(u32).range(1..=100_000_000))]
+    pub(crate) leak_rays: u32,
+}
 
 /// Everything one run of `rtgi bench` measured.
 #[derive(Debug, Serialize)]
@@ -136,7 +195,7 @@ pub(crate) fn run(args: &BenchArgs) -> Result<()> {
     }
 
     let accuracy =
-        measure_accuracy(args, &triangles, &args.build.params_for(args.accuracy_accel), &primary, &incoherent, &pool);
+        measure_accuracy(args, &triangles, &args.build.params_for(args.accuracy_accel), &primary, &incoherent, &pool)?;
 
     let report = BenchReport {
         scene: name,
@@ -159,6 +218,9 @@ pub(crate) fn run(args: &BenchArgs) -> Result<()> {
     printed
 }
 
+/// One structure, measured as the accel knob measures it (`rtgi_experiment::measure`):
+/// its builds, and each batch one ray at a time and through the batch API,
+/// on one thread and on all.
 #[allow(clippy::too_many_arguments)]
 fn measure_variant(
     kind: AccelKind,
@@ -172,51 +234,29 @@ fn measure_variant(
     linear: Option<(f64, f64)>,
 ) -> Result<VariantReport> {
     let repeats = args.repeats as usize;
-    let build_ms = |pool: &rayon::ThreadPool| -> Result<f64> {
-        let mut failed = None;
-        let timing = measure::time(repeats, 0, || {
-            if let Err(e) = pool.install(|| kind.try_build(triangles, params)) {
-                failed = Some(e);
-            }
-        });
-        match failed {
-            Some(e) => Err(e.into()),
-            None => Ok(timing.median_ms),
-        }
-    };
-    let build_ms_1_thread = build_ms(single)?;
-    let build_ms_all_threads = build_ms(pool)?;
-    let accel = pool.install(|| kind.try_build(triangles, params))?;
+    let (_, build_1_thread) = single.install(|| measure::build(triangles, kind, params, repeats))?;
+    let (accel, build_all_threads) = pool.install(|| measure::build(triangles, kind, params, repeats))?;
 
-    // The linear scan is timed on an evenly spaced subset of each batch.
-    let subset = |rays: &[Ray]| -> Vec<Ray> {
-        if kind != AccelKind::Linear { rays.to_vec() } else { measure::every_nth(rays, args.linear_rays as usize) }
-    };
+    // The linear scan is timed on an evenly spaced subset of each batch, at most 3 times.
+    let (subset, timed_repeats) =
+        if kind == AccelKind::Linear { (Some(args.linear_rays as usize), repeats.min(3)) } else { (None, repeats) };
     let batch = |rays: &[Ray], linear_mrays: Option<f64>| {
-        let rays = subset(rays);
-        let timed_repeats = if kind == AccelKind::Linear { repeats.min(3) } else { repeats };
-        let trace = |chunk: &[Ray]| chunk.iter().filter(|r| accel.intersect(r).is_some()).count();
-        let mrays_1_thread = throughput(&rays, single, timed_repeats, trace);
-        let mrays_all_threads = throughput(&rays, pool, timed_repeats, trace);
-        let batch_trace = |chunk: &[Ray]| {
-            let mut hits = vec![None; chunk.len()];
-            accel.intersect_batch(chunk, &mut hits);
-            hits.iter().filter(|h| h.is_some()).count()
-        };
-        let batch_mrays_1_thread = throughput(&rays, single, timed_repeats, batch_trace);
-        let batch_mrays_all_threads = throughput(&rays, pool, timed_repeats, batch_trace);
+        let rays = subset.map_or_else(|| rays.to_vec(), |budget| measure::every_nth(rays, budget));
+        let rate = |timing: &rtgi_experiment::stats::Timing| measure::mrays(rays.len(), timing).0;
+        let one: TraceCost = single.install(|| measure::trace_cost(accel.as_ref(), &rays, timed_repeats));
+        let all: TraceCost = pool.install(|| measure::trace_cost(accel.as_ref(), &rays, timed_repeats));
         let (counters, hits) = pool.install(|| measure::count(accel.as_ref(), &rays));
         let per_ray = |n: u64| n as f64 / rays.len().max(1) as f64;
         BatchReport {
             rays_timed: rays.len(),
-            mrays_1_thread,
-            mrays_all_threads,
+            mrays_1_thread: rate(&one.single),
+            mrays_all_threads: rate(&all.single),
             hit_fraction: hits as f64 / rays.len().max(1) as f64,
-            batch_mrays_1_thread,
-            batch_mrays_all_threads,
+            batch_mrays_1_thread: rate(&one.batched),
+            batch_mrays_all_threads: rate(&all.batched),
             nodes_visited_per_ray: per_ray(counters.nodes_visited),
             triangles_tested_per_ray: per_ray(counters.triangles_tested),
-            speedup_vs_linear: linear_mrays.map(|l| mrays_all_threads / l),
+            speedup_vs_linear: linear_mrays.map(|l| rate(&all.single) / l),
         }
     };
     let primary = batch(primary, linear.map(|l| l.0));
@@ -229,21 +269,12 @@ fn measure_variant(
             traversal_cost: params.traversal_cost,
         },
         peer: kind.is_peer(),
-        build_ms_1_thread,
-        build_ms_all_threads,
+        build_ms_1_thread: build_1_thread.median_ms,
+        build_ms_all_threads: build_all_threads.median_ms,
         stats: accel.build_stats().clone(),
         primary,
         incoherent,
     })
-}
-
-/// Traversal work and hits of a batch.
-/// Million rays a second of `trace` (which answers a chunk of rays and
-/// returns its hits) over `rays` on `pool`: the median of the repeats.
-fn throughput(rays: &[Ray], pool: &rayon::ThreadPool, repeats: usize, trace: impl Fn(&[Ray]) -> usize + Sync) -> f64 {
-    let trace = &trace;
-    let timing = pool.install(|| measure::time_rays(rays, repeats, trace));
-    measure::mrays(rays.len(), &timing).0
 }
 
 fn print_table(report: &BenchReport, linear_rays: u32) -> Result<()> {
@@ -355,7 +386,8 @@ fn significant(x: f64) -> String {
 }
 
 /// Every intersector with every traversal on one structure: throughput on
-/// the scene's batches beside the failure rates on the robustness probes.
+/// the scene's batches beside the failure rates on the robustness probes,
+/// both measured by `rtgi_experiment::measure`.
 fn measure_accuracy(
     args: &BenchArgs,
     triangles: &[[rtgi_math::Vec3; 3]],
@@ -363,36 +395,34 @@ fn measure_accuracy(
     primary: &[Ray],
     incoherent: &[Ray],
     pool: &rayon::ThreadPool,
-) -> Vec<AccuracyReport> {
+) -> Result<Vec<AccuracyReport>> {
     let kind = args.accuracy_accel;
-    let (edge_triangles, edge_rays) = shared_edge_probe();
-    let (mesh_triangles, mesh_rays) = closed_mesh_probe(args.leak_rays as usize, args.seed.value);
     let mut reports = Vec::new();
     for &intersector in Intersector::ALL {
         for &traversal in Traversal::ALL {
             eprintln!("measuring {kind} with {intersector} and {traversal} traversal ...");
             let params = BuildParams { intersector, traversal, ..params.clone() };
-            let accel = pool.install(|| kind.build(triangles, &params));
-            let trace = |chunk: &[Ray]| chunk.iter().filter(|r| accel.intersect(r).is_some()).count();
-            let edges = kind.build(&edge_triangles, &params);
-            let mesh = kind.build(&mesh_triangles, &params);
-            let misses = |accel: &dyn Accel, rays: &[Ray]| {
-                pool.install(|| rays.par_iter().filter(|r| accel.intersect(r).is_none()).count())
+            let (accel, _) = pool.install(|| measure::build(triangles, kind, &params, 1))?;
+            let rate = |rays: &[Ray]| {
+                let timing = pool.install(|| measure::trace_time(accel.as_ref(), rays, args.repeats as usize));
+                measure::mrays(rays.len(), &timing).0
             };
+            let failures =
+                pool.install(|| measure::probe_failures(kind, &params, args.leak_rays as usize, args.seed.value))?;
             reports.push(AccuracyReport {
                 variant: kind.name().to_owned(),
                 intersector: intersector.name().to_owned(),
                 traversal: traversal.name().to_owned(),
-                primary_mrays_all_threads: throughput(primary, pool, args.repeats as usize, trace),
-                incoherent_mrays_all_threads: throughput(incoherent, pool, args.repeats as usize, trace),
-                shared_edge_rays: edge_rays.len(),
-                shared_edge_misses: misses(edges.as_ref(), &edge_rays),
-                closed_mesh_rays: mesh_rays.len(),
-                closed_mesh_escapes: misses(mesh.as_ref(), &mesh_rays),
+                primary_mrays_all_threads: rate(primary),
+                incoherent_mrays_all_threads: rate(incoherent),
+                shared_edge_rays: failures.shared_edge_rays,
+                shared_edge_misses: failures.shared_edge_misses,
+                closed_mesh_rays: failures.closed_mesh_rays,
+                closed_mesh_escapes: failures.closed_mesh_escapes,
             });
         }
     }
-    reports
+    Ok(reports)
 }
 
 fn print_accuracy(reports: &[AccuracyReport]) -> Result<()> {

@@ -4,15 +4,9 @@
 use std::path::PathBuf;
 use std::process::ExitCode;
 
-use clap::builder::{PossibleValue, PossibleValuesParser, TypedValueParser};
-use clap::{Args, Parser, Subcommand, ValueEnum};
-use rtgi_accel::AccelKind;
-use rtgi_job::MAX_IMAGE_SIDE;
+use clap::{Args, Parser, Subcommand};
 
-use crate::options::{
-    AccelArgs, AccelList, AccelParser, BuildArgs, CameraArgs, ImageSizeArgs, LightingArgs, OutputArgs, SeedArgs,
-    ThreadArgs, parse_positive, threads_from_environment,
-};
+use crate::options::{AccelArgs, OutputArgs, ThreadArgs, threads_from_environment};
 
 #[derive(Debug, Parser)]
 #[command(name = "rtgi", version, about = "Ray tracing and global illumination toolkit")]
@@ -49,21 +43,21 @@ pub(crate) enum Command {
     /// bounds, or rays leaving its surfaces
     Rays(crate::rays_cmd::RaysArgs),
     /// Measure build time, tree quality and ray throughput of acceleration structures
-    Bench(BenchArgs),
+    Bench(crate::bench_cmd::BenchArgs),
     /// Export the boxes of chosen BVH levels as an OBJ file, to look at the tree
-    BvhBoxes(BvhBoxesArgs),
+    BvhBoxes(crate::debug_cmd::BvhBoxesArgs),
     /// Render the traversal cost (BVH nodes visited per pixel) as a heat map
-    Heatmap(HeatmapArgs),
+    Heatmap(crate::debug_cmd::HeatmapArgs),
     /// Describe a scene: triangles, materials, textures, lights, cameras, bounds, extensions,
     /// and the effects a render of it simulates
-    Info(InfoArgs),
+    Info(crate::info_cmd::InfoArgs),
     /// Measure how far an EXR image is from a reference EXR image (RMSE, relative MSE, max)
-    Compare(CompareArgs),
+    Compare(crate::info_cmd::CompareArgs),
     /// Measure what each effect costs: render time with effects forced on and off, and how the image changes
-    BenchEffects(BenchEffectsArgs),
+    BenchEffects(crate::effects_cmd::BenchEffectsArgs),
     /// Check that every acceleration structure answers hard rays exactly as the linear scan does,
     /// bit for bit, and that rays aimed inside closed surfaces never leak
-    Verify(VerifyArgs),
+    Verify(crate::verify_cmd::VerifyArgs),
     /// Put the parts of a split render (--samples, --tile) or a checkpoint together into one
     /// image or accumulation, bit-identical to the render in one go
     Merge(crate::merge_cmd::MergeArgs),
@@ -71,301 +65,12 @@ pub(crate) enum Command {
     Gallery(crate::gallery_cmd::GalleryArgs),
     /// What accuracy costs in time: vary one knob (or all) and write a table (KNOB.md), every
     /// measurement (KNOB.json) and SVG plots
-    Experiment(ExperimentArgs),
+    Experiment(crate::experiment_cmd::ExperimentArgs),
     /// Run scripts in the command language of the course framework (at, load, raytracer, algo,
     /// commit, run, ...); with no script, open a prompt
     Script(crate::script::ScriptArgs),
     /// Open a prompt that takes the course framework's commands (after running any scripts given)
     Repl(crate::script::ScriptArgs),
-}
-
-/// `rtgi experiment`: one knob measured as time against error.
-#[derive(Debug, Args)]
-pub(crate) struct ExperimentArgs {
-    /// The knob to vary
-    #[arg(value_parser = knob_parser())]
-    pub(crate) knob: KnobChoice,
-
-    /// Scene file (.obj, .gltf, .glb or .toml); the built-in Cornell box when omitted
-    pub(crate) scene: Option<PathBuf>,
-
-    /// Folder for the results [default: experiments/KNOB]; with 'all', one folder per knob inside it
-    #[arg(long)]
-    pub(crate) out: Option<PathBuf>,
-
-    /// Timed runs per measurement; times are reported as median, min and max
-    #[arg(long, default_value_t = 5, value_parser = clap::value_parser!(u32).range(1..=1000))]
-    pub(crate) repeats: u32,
-
-    /// A reduced version that runs in seconds (small images, few points): for tests, not conclusions
-    #[arg(long)]
-    pub(crate) quick: bool,
-
-    /// Samples per pixel of the converged references [default: 4096; 256 with --quick]
-    #[arg(long, value_parser = clap::value_parser!(u32).range(2..=1_048_576))]
-    pub(crate) reference_spp: Option<u32>,
-
-    /// Where references are cached between runs [default: experiments/.references]
-    #[arg(long)]
-    pub(crate) cache: Option<PathBuf>,
-
-    /// Render every reference again instead of reading the cache
-    #[arg(long)]
-    pub(crate) no_cache: bool,
-
-    /// Image width of the measured renders [default: 128; 32 with --quick]
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=MAX_IMAGE_SIDE as i64))]
-    pub(crate) width: Option<u32>,
-
-    /// Image height of the measured renders [default: 128; 32 with --quick]
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=MAX_IMAGE_SIDE as i64))]
-    pub(crate) height: Option<u32>,
-
-    #[command(flatten)]
-    pub(crate) lighting: LightingArgs,
-
-    #[command(flatten)]
-    pub(crate) accel: AccelArgs,
-
-    #[command(flatten)]
-    pub(crate) camera: CameraArgs,
-
-    #[command(flatten)]
-    pub(crate) threads: ThreadArgs,
-}
-
-/// One knob, or all of them.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub(crate) enum KnobChoice {
-    One(rtgi_experiment::Knob),
-    All,
-    Index,
-}
-
-/// The knobs' names (from [`rtgi_experiment::Knob`]'s `ValueEnum`) and `all`.
-fn knob_parser() -> impl TypedValueParser<Value = KnobChoice> {
-    let all = PossibleValue::new("all").help("Every knob in turn, one folder each, and the index");
-    let index = PossibleValue::new("index")
-        .help("Measure nothing: remake index.md in --out from the reports' JSON there (refused if they are of different code)");
-    PossibleValuesParser::new(
-        rtgi_experiment::Knob::value_variants().iter().filter_map(ValueEnum::to_possible_value).chain([all, index]),
-    )
-    .map(|name| match name.as_str() {
-        "all" => KnobChoice::All,
-        "index" => KnobChoice::Index,
-        name => KnobChoice::One(ValueEnum::from_str(name, false).expect("one of the possible values")),
-    })
-}
-
-/// `rtgi verify`: the exactness contract, checked on a scene or on the built-in adversarial set.
-#[derive(Debug, Args)]
-pub(crate) struct VerifyArgs {
-    /// Scene file (.obj, .gltf, .glb or .toml); the built-in adversarial scenes when omitted
-    pub(crate) scene: Option<PathBuf>,
-
-    /// Rays in all, shared evenly among the ray kinds (and scenes)
-    #[arg(long, default_value_t = 1_000_000, value_parser = clap::value_parser!(u32).range(1..=1_000_000_000))]
-    pub(crate) rays: u32,
-
-    /// Structures to check against the linear scan: names separated by commas, or all
-    #[arg(long, default_value = "all", value_parser = AccelParser { list: true })]
-    pub(crate) accel: AccelList,
-
-    /// Check every leaf size (1, 2, 4, 8, 16), bin count and intersector, as the tests do,
-    /// instead of the build options below
-    #[arg(long)]
-    pub(crate) exhaustive: bool,
-
-    #[command(flatten)]
-    pub(crate) build: BuildArgs,
-
-    /// Triangle tests the linear scan may spend per ray kind; on big scenes it answers only the
-    /// first rays of each kind within this budget, and the others are compared with the first
-    /// structure checked
-    #[arg(long, default_value_t = 2_000_000_000, value_parser = clap::value_parser!(u64).range(1..))]
-    pub(crate) linear_budget: u64,
-
-    #[command(flatten)]
-    pub(crate) seed: SeedArgs,
-
-    #[command(flatten)]
-    pub(crate) threads: ThreadArgs,
-
-    /// Also write the table as JSON to this file
-    #[arg(long)]
-    pub(crate) json: Option<PathBuf>,
-}
-
-/// `rtgi bench-effects`: the time each effect of the plan costs or saves.
-#[derive(Debug, Args)]
-pub(crate) struct BenchEffectsArgs {
-    /// Scene file (.obj, .gltf, .glb or .toml); the built-in Cornell box when omitted
-    pub(crate) scene: Option<PathBuf>,
-
-    #[command(flatten)]
-    pub(crate) size: ImageSizeArgs,
-
-    /// Samples per pixel of each render
-    #[arg(long, default_value_t = 8, value_parser = clap::value_parser!(u32).range(1..=1_048_576))]
-    pub(crate) spp: u32,
-
-    /// Timed renders per row; the median is reported
-    #[arg(long, default_value_t = 3, value_parser = clap::value_parser!(u32).range(1..=1000))]
-    pub(crate) repeats: u32,
-
-    #[command(flatten)]
-    pub(crate) threads: ThreadArgs,
-
-    #[command(flatten)]
-    pub(crate) lighting: LightingArgs,
-
-    #[command(flatten)]
-    pub(crate) accel: AccelArgs,
-
-    #[command(flatten)]
-    pub(crate) camera: CameraArgs,
-
-    /// Also write the results as JSON to this file
-    #[arg(long)]
-    pub(crate) json: Option<PathBuf>,
-}
-
-/// `rtgi compare`: the error of an image against a reference.
-#[derive(Debug, Args)]
-pub(crate) struct CompareArgs {
-    /// The image to measure (.exr)
-    pub(crate) image: PathBuf,
-
-    /// The reference (.exr), for example a high-sample render
-    pub(crate) reference: PathBuf,
-
-    /// Print JSON instead of text
-    #[arg(long)]
-    pub(crate) json: bool,
-}
-
-/// `rtgi info`: what a scene file contains.
-#[derive(Debug, Args)]
-pub(crate) struct InfoArgs {
-    /// Scene file (.obj, .gltf, .glb or .toml); the built-in Cornell box when omitted
-    pub(crate) scene: Option<PathBuf>,
-
-    /// Print JSON instead of text
-    #[arg(long)]
-    pub(crate) json: bool,
-
-    /// The render options the printed plan is for
-    #[command(flatten)]
-    pub(crate) lighting: LightingArgs,
-
-    /// The view the plan is for: the lights a render adds depend on what the camera sees
-    #[command(flatten)]
-    pub(crate) camera: CameraArgs,
-}
-
-/// `rtgi bvh-boxes`: the boxes of some levels of a BVH as a wireframe-able mesh.
-#[derive(Debug, Args)]
-#[command(mut_arg("output", |arg| arg.help(
-    "OBJ file to write; each level becomes a group named level_N [default: SCENE.boxes.obj, in the current folder]"
-)))]
-pub(crate) struct BvhBoxesArgs {
-    /// Scene file (.obj, .gltf, .glb or .toml); the built-in Cornell box when omitted
-    pub(crate) scene: Option<PathBuf>,
-
-    #[command(flatten)]
-    pub(crate) output: OutputArgs,
-
-    /// Depths to export, separated by commas (the root is 0)
-    #[arg(long, default_value = "0,1,2,3", value_delimiter = ',')]
-    pub(crate) levels: Vec<usize>,
-
-    #[command(flatten)]
-    pub(crate) accel: AccelArgs,
-}
-
-/// `rtgi heatmap`: nodes visited per pixel, in false colour.
-#[derive(Debug, Args)]
-#[command(mut_arg("output", |arg| arg.help(
-    "Output image: .png for the false-colour map, .exr for the raw counts [default: SCENE.heatmap.png, in the current folder]"
-)))]
-pub(crate) struct HeatmapArgs {
-    /// Scene file (.obj, .gltf, .glb or .toml); the built-in Cornell box when omitted
-    pub(crate) scene: Option<PathBuf>,
-
-    #[command(flatten)]
-    pub(crate) output: OutputArgs,
-
-    #[command(flatten)]
-    pub(crate) size: ImageSizeArgs,
-
-    /// Count that maps to the top of the colour scale [default: the image's maximum]
-    #[arg(long, value_parser = parse_positive, allow_negative_numbers = true)]
-    pub(crate) scale: Option<f32>,
-
-    /// Count triangle tests instead of nodes visited
-    #[arg(long)]
-    pub(crate) triangles: bool,
-
-    #[command(flatten)]
-    pub(crate) accel: AccelArgs,
-
-    #[command(flatten)]
-    pub(crate) camera: CameraArgs,
-
-    #[command(flatten)]
-    pub(crate) threads: ThreadArgs,
-}
-
-/// `rtgi bench`: what each acceleration structure costs and gives, side by side.
-#[derive(Debug, Args)]
-pub(crate) struct BenchArgs {
-    /// Scene file (.obj, .gltf, .glb or .toml); the built-in Cornell box when omitted
-    pub(crate) scene: Option<PathBuf>,
-
-    /// Structures to measure: names separated by commas, or all
-    #[arg(long, default_value = "all", value_parser = AccelParser { list: true })]
-    pub(crate) accel: AccelList,
-
-    #[command(flatten)]
-    pub(crate) build: BuildArgs,
-
-    /// Width of the primary-ray batch (one ray per pixel of the scene's camera)
-    #[arg(long, default_value_t = 1024, value_parser = clap::value_parser!(u32).range(1..=MAX_IMAGE_SIDE as i64))]
-    pub(crate) width: u32,
-
-    /// Height of the primary-ray batch
-    #[arg(long, default_value_t = 1024, value_parser = clap::value_parser!(u32).range(1..=MAX_IMAGE_SIDE as i64))]
-    pub(crate) height: u32,
-
-    /// Incoherent rays: from random points on the surfaces in random directions
-    #[arg(long, default_value_t = 1_000_000, value_parser = clap::value_parser!(u32).range(1..=100_000_000))]
-    pub(crate) rays: u32,
-
-    #[command(flatten)]
-    pub(crate) seed: SeedArgs,
-
-    /// Timed runs per measurement; the median is reported
-    #[arg(long, default_value_t = 5, value_parser = clap::value_parser!(u32).range(1..=1000))]
-    pub(crate) repeats: u32,
-
-    /// Rays per batch that the linear scan is timed on (an evenly spaced subset)
-    #[arg(long, default_value_t = 2048, value_parser = clap::value_parser!(u32).range(1..=100_000_000))]
-    pub(crate) linear_rays: u32,
-
-    #[command(flatten)]
-    pub(crate) threads: ThreadArgs,
-
-    /// Also write the results as JSON to this file
-    #[arg(long)]
-    pub(crate) json: Option<PathBuf>,
-
-    /// Structure on which every intersector and traversal is compared for speed and failure rates
-    #[arg(long, default_value = "sah", value_parser = AccelParser { list: false }.map(|list| list.0[0]))]
-    pub(crate) accuracy_accel: AccelKind,
-
-    /// Rays from inside a closed mesh for the escape rate
-    #[arg(long, default_value_t = 1_000_000, value_parser = clap::value_parser!(u32).range(1..=100_000_000))]
-    pub(crate) leak_rays: u32,
 }
 
 /// `rtgi trace`: rays in, hits out, for tests and comparisons with other ray tracers.
@@ -532,7 +237,6 @@ mod tests {
         agree(Traversal::ALL, |t| t.name());
         agree(rtgi_accel::simd::SimdLevel::ALL, |l| l.name());
         agree(ToneOperator::ALL, |t| t.name());
-        agree(rtgi_experiment::Knob::ALL, |k| k.name());
         agree(PixelSampler::ALL, |p| p.name());
         agree(rtgi_render::Effect::ALL, |e| e.name());
         agree(Integrator::ALL, |i| i.name());

@@ -1,15 +1,70 @@
 //! Commands that let users see their BVH: its boxes, and what traversal costs.
 
 use std::fmt::Write as _;
+use std::path::PathBuf;
 
 use anyhow::{Result, bail};
+use clap::Args;
 use rtgi_accel::{Accel, AccelKind, BuildParams, Bvh, Bvh4, Bvh8};
 use rtgi_image::{HdrImage, OutputFormat, ToneMap, check_writable, heat_colour};
 use rtgi_render::render_traversal_cost;
 
-use crate::cli::{BvhBoxesArgs, HeatmapArgs};
 use crate::common::{LoadedScene, check_output_folder, choose_camera, load_scene, write_atomically};
+use crate::options::{AccelArgs, CameraArgs, ImageSizeArgs, OutputArgs, ThreadArgs, parse_positive};
 use crate::output::outln;
+
+/// `rtgi bvh-boxes`: the boxes of some levels of a BVH as a wireframe-able mesh.
+#[derive(Debug, Args)]
+#[command(mut_arg("output", |arg| arg.help(
+    "OBJ file to write; each level becomes a group named level_N [default: SCENE.boxes.obj, in the current folder]"
+)))]
+pub(crate) struct BvhBoxesArgs {
+    /// Scene file (.obj, .gltf, .glb or .toml); the built-in Cornell box when omitted
+    pub(crate) scene: Option<PathBuf>,
+
+    #[command(flatten)]
+    pub(crate) output: OutputArgs,
+
+    /// Depths to export, separated by commas (the root is 0)
+    #[arg(long, default_value = "0,1,2,3", value_delimiter = ',')]
+    pub(crate) levels: Vec<usize>,
+
+    #[command(flatten)]
+    pub(crate) accel: AccelArgs,
+}
+
+/// `rtgi heatmap`: nodes visited per pixel, in false colour.
+#[derive(Debug, Args)]
+#[command(mut_arg("output", |arg| arg.help(
+    "Output image: .png for the false-colour map, .exr for the raw counts [default: SCENE.heatmap.png, in the current folder]"
+)))]
+pub(crate) struct HeatmapArgs {
+    /// Scene file (.obj, .gltf, .glb or .toml); the built-in Cornell box when omitted
+    pub(crate) scene: Option<PathBuf>,
+
+    #[command(flatten)]
+    pub(crate) output: OutputArgs,
+
+    #[command(flatten)]
+    pub(crate) size: ImageSizeArgs,
+
+    /// Count that maps to the top of the colour scale [default: the image's maximum]
+    #[arg(long, value_parser = parse_positive, allow_negative_numbers = true)]
+    pub(crate) scale: Option<f32>,
+
+    /// Count triangle tests instead of nodes visited
+    #[arg(long)]
+    pub(crate) triangles: bool,
+
+    #[command(flatten)]
+    pub(crate) accel: AccelArgs,
+
+    #[command(flatten)]
+    pub(crate) camera: CameraArgs,
+
+    #[command(flatten)]
+    pub(crate) threads: ThreadArgs,
+}
 
 /// Writes the boxes of the chosen levels as OBJ: eight corners and six
 /// quads a box, one group per level, so that viewers can show or hide

@@ -5,16 +5,56 @@
 //! specialising saves; the image must not change) and simulated effects
 //! forced off (the time the effect costs, and how much the image changes
 //! without it). Every render uses the same seed, so differences are the
-//! effects', not noise.
+//! effects', not noise. The quick mode of the `effects` knob: the renders
+//! are measured by `rtgi_experiment::measure::effect_renders`; this file
+//! parses and prints.
+
+use std::path::PathBuf;
 
 use anyhow::Result;
-use rtgi_image::{Difference, HdrImage, compare};
-use rtgi_render::{EffectPlan, RenderSettings, render};
+use clap::Args;
+use rtgi_experiment::Subject;
+use rtgi_image::{Difference, compare};
+use rtgi_render::{EffectPlan, RenderSettings};
 use serde::Serialize;
 
-use crate::cli::BenchEffectsArgs;
 use crate::common::{LoadedScene, check_output_folder, load_scene, prepare_render};
+use crate::options::{AccelArgs, CameraArgs, ImageSizeArgs, LightingArgs, ThreadArgs};
 use crate::output::{out, outln};
+
+/// `rtgi bench-effects`: the time each effect of the plan costs or saves.
+#[derive(Debug, Args)]
+pub(crate) struct BenchEffectsArgs {
+    /// Scene file (.obj, .gltf, .glb or .toml); the built-in Cornell box when omitted
+    pub(crate) scene: Option<PathBuf>,
+
+    #[command(flatten)]
+    pub(crate) size: ImageSizeArgs,
+
+    /// Samples per pixel of each render
+    #[arg(long, default_value_t = 8, value_parser = clap::value_parser!(u32).range(1..=1_048_576))]
+    pub(crate) spp: u32,
+
+    /// Timed renders per row; the median is reported
+    #[arg(long, default_value_t = 3, value_parser = clap::value_parser!(u32).range(1..=1000))]
+    pub(crate) repeats: u32,
+
+    #[command(flatten)]
+    pub(crate) threads: ThreadArgs,
+
+    #[command(flatten)]
+    pub(crate) lighting: LightingArgs,
+
+    #[command(flatten)]
+    pub(crate) accel: AccelArgs,
+
+    #[command(flatten)]
+    pub(crate) camera: CameraArgs,
+
+    /// Also write the results as JSON to this file
+    #[arg(long)]
+    pub(crate) json: Option<PathBuf>,
+}
 
 #[derive(Debug, Serialize)]
 struct Row {
@@ -62,23 +102,25 @@ pub(crate) fn run(args: &BenchEffectsArgs) -> Result<()> {
     // and returned at the end, and nothing more is printed after it.
     let mut printed = out!("{plan}");
 
-    let measure = |settings: &RenderSettings| -> (f64, HdrImage) {
-        let mut image = None;
-        let timing = rtgi_experiment::measure::time(args.repeats as usize, 0, || {
-            image = Some(pool.install(|| render(&scene, accel.as_ref(), &camera, settings, &|_| {})).0);
-        });
-        (timing.median_ms, image.expect("at least one repeat"))
-    };
-
-    eprintln!("measuring the plan ...");
-    let (planned_ms, planned) = measure(&settings);
+    // Measured as the effects knob's renders are (`rtgi_experiment::measure`).
+    let subject = Subject { name: name.clone(), scene, camera, accel, settings: settings.clone() };
+    let renders = pool.install(|| {
+        rtgi_experiment::measure::effect_renders(&subject, &settings, args.repeats as usize, &|label| {
+            eprintln!("measuring {label} ...")
+        })
+    });
+    let (planned, reversals) = renders.split_first().expect("the plan is rendered first");
+    let planned_ms = planned.time.median_ms;
     let mut rows = vec![Row { label: "plan".into(), median_ms: planned_ms, relative_time: 1.0, difference: None }];
     // Effects the user forced stay as forced; every other decision is reversed once.
-    for reversal in plan.reversals(&scene, &settings) {
-        let label = reversal.label();
-        eprintln!("measuring {label} ...");
-        let (ms, image) = measure(&reversal.settings);
-        rows.push(Row { label, median_ms: ms, relative_time: ms / planned_ms, difference: compare(&image, &planned) });
+    for reversal in reversals {
+        let ms = reversal.time.median_ms;
+        rows.push(Row {
+            label: reversal.label.clone(),
+            median_ms: ms,
+            relative_time: ms / planned_ms,
+            difference: compare(&reversal.image, &planned.image),
+        });
     }
 
     printed = printed.and_then(|()| {

@@ -10,54 +10,93 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use anyhow::{Result, bail};
+use clap::Args;
+use clap::builder::{PossibleValue, PossibleValuesParser, TypedValueParser};
 use rtgi_experiment::provenance::Build;
-use rtgi_experiment::{Knob, Machine, Options, RunRecord, Subject};
+use rtgi_experiment::{KNOBS, Knob, Machine, Options, RunRecord, Scenes, Subject};
 use rtgi_render::{RenderSettings, recipe};
 
-use crate::cli::{ExperimentArgs, KnobChoice};
+use rtgi_job::MAX_IMAGE_SIDE;
+
 use crate::common::{LoadedScene, load_scene, prepare_render, write_atomically};
+use crate::options::{AccelArgs, CameraArgs, LightingArgs, ThreadArgs};
 use crate::output::outln;
 
-/// The shared scenes of the report, relative to the scenes folder.
-const CORNELL: &str = "cornell-box/CornellBox-Original.obj";
-/// The Cornell box with a mirror block: caustics off the mirror.
-const MIRROR: &str = "cornell-box/CornellBox-Mirror.obj";
-const BUNNY: &str = "bunny/stanford-bunny.obj";
-const SPONZA: &str = "sponza-dabrovic/sponza.obj";
-const CONFERENCE: &str = "conference/conference.obj";
-const HELMET: &str = "gltf/DamagedHelmet/glTF/DamagedHelmet.gltf";
-/// The project's own glossy scene (in `scenes/`, not the shared folder):
-/// glossy metals, where transport noise is of the BSDF's lobes.
-const GLOSSY: &str = "project:direct-glossy.toml";
-/// The project's closed room lit only by light bounced off its ceiling:
-/// transport noise, with no emitter in view.
-const ROOM: &str = "project:indirect-room.toml";
-/// The project's Cornell box with a glass and a mirror sphere: caustics.
-const CAUSTICS: &str = "project:caustics.toml";
+/// `rtgi experiment`: one knob measured as time against error.
+#[derive(Debug, Args)]
+pub(crate) struct ExperimentArgs {
+    /// The knob to vary
+    #[arg(value_parser = knob_parser())]
+    pub(crate) knob: KnobChoice,
 
-/// The scenes each knob is measured on in the report: the Cornell box
-/// (small, closed, converges; its error at high spp is mostly the
-/// emitter's edge), the bunny (one mesh under the sky), Sponza and the
-/// conference room (large, many materials), the project's indirectly lit
-/// room and glossy scene (where transport noise dominates: cheap enough to
-/// converge), and the damaged helmet (textures, normal maps, emissive
-/// details: effects the box does not need).
-fn report_scenes(knob: Knob) -> &'static [&'static str] {
-    match knob {
-        Knob::Spp => &[CORNELL, BUNNY, ROOM, GLOSSY],
-        Knob::Depth => &[CORNELL, SPONZA],
-        Knob::BounceSampling => &[CORNELL, GLOSSY],
-        Knob::RouletteStart => &[CORNELL, ROOM],
-        Knob::Clamp => &[CORNELL, ROOM, CONFERENCE],
-        // Sponza has no glossy or transmitting material: regularisation leaves it bit for bit.
-        Knob::FilterGlossy => &[CAUSTICS, MIRROR, CONFERENCE],
-        Knob::Adaptive => &[CORNELL, ROOM],
-        Knob::Denoise => &[CORNELL, SPONZA, CONFERENCE],
-        Knob::Accel => &[CORNELL, BUNNY, SPONZA, CONFERENCE],
-        Knob::Effects => &[CORNELL, HELMET],
-        Knob::Traversal | Knob::Packets => &[BUNNY],
-        _ => &[CORNELL],
-    }
+    /// Scene file (.obj, .gltf, .glb or .toml); the built-in Cornell box when omitted
+    pub(crate) scene: Option<PathBuf>,
+
+    /// Folder for the results [default: experiments/KNOB]; with 'all', one folder per knob inside it
+    #[arg(long)]
+    pub(crate) out: Option<PathBuf>,
+
+    /// Timed runs per measurement; times are reported as median, min and max
+    #[arg(long, default_value_t = 5, value_parser = clap::value_parser!(u32).range(1..=1000))]
+    pub(crate) repeats: u32,
+
+    /// A reduced version that runs in seconds (small images, few points): for tests, not conclusions
+    #[arg(long)]
+    pub(crate) quick: bool,
+
+    /// Samples per pixel of the converged references [default: 4096; 256 with --quick]
+    #[arg(long, value_parser = clap::value_parser!(u32).range(2..=1_048_576))]
+    pub(crate) reference_spp: Option<u32>,
+
+    /// Where references are cached between runs [default: experiments/.references]
+    #[arg(long)]
+    pub(crate) cache: Option<PathBuf>,
+
+    /// Render every reference again instead of reading the cache
+    #[arg(long)]
+    pub(crate) no_cache: bool,
+
+    /// Image width of the measured renders [default: 128; 32 with --quick]
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=MAX_IMAGE_SIDE as i64))]
+    pub(crate) width: Option<u32>,
+
+    /// Image height of the measured renders [default: 128; 32 with --quick]
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=MAX_IMAGE_SIDE as i64))]
+    pub(crate) height: Option<u32>,
+
+    #[command(flatten)]
+    pub(crate) lighting: LightingArgs,
+
+    #[command(flatten)]
+    pub(crate) accel: AccelArgs,
+
+    #[command(flatten)]
+    pub(crate) camera: CameraArgs,
+
+    #[command(flatten)]
+    pub(crate) threads: ThreadArgs,
+}
+
+/// One knob, or all of them.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum KnobChoice {
+    One(&'static dyn Knob),
+    All,
+    Index,
+}
+
+/// The knobs' names (from the registry, [`rtgi_experiment::KNOBS`], each
+/// with what it varies as its help), `all` and `index`.
+fn knob_parser() -> impl TypedValueParser<Value = KnobChoice> {
+    let all = PossibleValue::new("all").help("Every knob in turn, one folder each, and the index");
+    let index = PossibleValue::new("index")
+        .help("Measure nothing: remake index.md in --out from the reports' JSON there (refused if they are of different code)");
+    let knobs = KNOBS.iter().map(|k| PossibleValue::new(k.name()).help(k.about().trim_end_matches('.')));
+    PossibleValuesParser::new(knobs.chain([all, index])).map(|name| match name.as_str() {
+        "all" => KnobChoice::All,
+        "index" => KnobChoice::Index,
+        name => KnobChoice::One(rtgi_experiment::knob(name).expect("one of the possible values")),
+    })
 }
 
 /// Where a report scene is: `project:NAME` in this workspace's `scenes/`,
@@ -90,9 +129,9 @@ fn scenes_folder() -> PathBuf {
 
 pub(crate) fn run(args: &ExperimentArgs) -> Result<()> {
     let started = (Instant::now(), rtgi_experiment::provenance::utc_now());
-    let knobs: Vec<Knob> = match args.knob {
+    let knobs: Vec<&dyn Knob> = match args.knob {
         KnobChoice::One(knob) => vec![knob],
-        KnobChoice::All => Knob::ALL.to_vec(),
+        KnobChoice::All => KNOBS.to_vec(),
         KnobChoice::Index => {
             let folder = args.out.clone().unwrap_or_else(|| PathBuf::from("experiments"));
             let path = rtgi_experiment::write_index(&folder)?;
@@ -119,17 +158,20 @@ pub(crate) fn run(args: &ExperimentArgs) -> Result<()> {
         reference_spp: args.reference_spp,
     };
     // (knob, scene, its name in the report, folder) for every run.
-    let mut runs: Vec<(Knob, Option<PathBuf>, Option<String>, PathBuf)> = Vec::new();
+    type Run = (&'static dyn Knob, Option<PathBuf>, Option<String>, PathBuf);
+    let mut runs: Vec<Run> = Vec::new();
     for &knob in &knobs {
         let single_folder = match (args.knob, &args.out) {
             (KnobChoice::One(_), Some(out)) => out.clone(),
             _ => out_root.join(knob.name()),
         };
-        if !report_mode || !knob.uses_scene() {
-            runs.push((knob, args.scene.clone(), None, single_folder));
-            continue;
-        }
-        let scenes = report_scenes(knob);
+        let scenes = match knob.scenes() {
+            Scenes::Subject(scenes) if report_mode => scenes,
+            _ => {
+                runs.push((knob, args.scene.clone(), None, single_folder));
+                continue;
+            }
+        };
         for scene in scenes {
             let (path, name) = report_scene(scene);
             if !path.is_file() {

@@ -1,16 +1,50 @@
 //! `rtgi info`: what a scene contains ([`rtgi_job::describe`]), as text
 //! or JSON; `rtgi compare`: the error of an image against a reference.
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result, bail};
+use clap::Args;
 use rtgi_image::HdrImage;
 use rtgi_job::SceneDescription;
 
-use crate::cli::{CompareArgs, InfoArgs};
 use crate::common::load_scene;
+use crate::options::{CameraArgs, LightingArgs};
 use crate::output::{out, outln};
 use crate::phrasing::{Phrasing, job_error};
+
+/// `rtgi compare`: the error of an image against a reference.
+#[derive(Debug, Args)]
+pub(crate) struct CompareArgs {
+    /// The image to measure (.exr)
+    pub(crate) image: PathBuf,
+
+    /// The reference (.exr), for example a high-sample render
+    pub(crate) reference: PathBuf,
+
+    /// Print JSON instead of text
+    #[arg(long)]
+    pub(crate) json: bool,
+}
+
+/// `rtgi info`: what a scene file contains.
+#[derive(Debug, Args)]
+pub(crate) struct InfoArgs {
+    /// Scene file (.obj, .gltf, .glb or .toml); the built-in Cornell box when omitted
+    pub(crate) scene: Option<PathBuf>,
+
+    /// Print JSON instead of text
+    #[arg(long)]
+    pub(crate) json: bool,
+
+    /// The render options the printed plan is for
+    #[command(flatten)]
+    pub(crate) lighting: LightingArgs,
+
+    /// The view the plan is for: the lights a render adds depend on what the camera sees
+    #[command(flatten)]
+    pub(crate) camera: CameraArgs,
+}
 
 pub(crate) fn run(args: &InfoArgs) -> Result<()> {
     let loaded = load_scene(args.scene.as_deref())?;

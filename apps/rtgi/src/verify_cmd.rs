@@ -1,15 +1,56 @@
 //! `rtgi verify`: every chosen structure against the linear scan, bit for
 //! bit, on rays of the kinds that expose inexact structures.
 
+use std::path::PathBuf;
 use std::time::Instant;
 
 use anyhow::{Result, bail};
+use clap::Args;
 use rtgi_accel::verify::{Case, RayKind, VerifyReport, adversarial_cases, check_case};
 use rtgi_accel::{AccelKind, BuildParams, Intersector};
 
-use crate::cli::VerifyArgs;
 use crate::common::{check_output_folder, load_scene, write_atomically};
+use crate::options::{AccelList, AccelParser, BuildArgs, SeedArgs, ThreadArgs};
 use crate::output::outln;
+
+/// `rtgi verify`: the exactness contract, checked on a scene or on the built-in adversarial set.
+#[derive(Debug, Args)]
+pub(crate) struct VerifyArgs {
+    /// Scene file (.obj, .gltf, .glb or .toml); the built-in adversarial scenes when omitted
+    pub(crate) scene: Option<PathBuf>,
+
+    /// Rays in all, shared evenly among the ray kinds (and scenes)
+    #[arg(long, default_value_t = 1_000_000, value_parser = clap::value_parser!(u32).range(1..=1_000_000_000))]
+    pub(crate) rays: u32,
+
+    /// Structures to check against the linear scan: names separated by commas, or all
+    #[arg(long, default_value = "all", value_parser = AccelParser { list: true })]
+    pub(crate) accel: AccelList,
+
+    /// Check every leaf size (1, 2, 4, 8, 16), bin count and intersector, as the tests do,
+    /// instead of the build options below
+    #[arg(long)]
+    pub(crate) exhaustive: bool,
+
+    #[command(flatten)]
+    pub(crate) build: BuildArgs,
+
+    /// Triangle tests the linear scan may spend per ray kind; on big scenes it answers only the
+    /// first rays of each kind within this budget, and the others are compared with the first
+    /// structure checked
+    #[arg(long, default_value_t = 2_000_000_000, value_parser = clap::value_parser!(u64).range(1..))]
+    pub(crate) linear_budget: u64,
+
+    #[command(flatten)]
+    pub(crate) seed: SeedArgs,
+
+    #[command(flatten)]
+    pub(crate) threads: ThreadArgs,
+
+    /// Also write the table as JSON to this file
+    #[arg(long)]
+    pub(crate) json: Option<PathBuf>,
+}
 
 pub(crate) fn run(args: &VerifyArgs) -> Result<()> {
     if let Some(json) = &args.json {

@@ -13,11 +13,12 @@ use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
 
+use crate::knobs::direct::Direct;
 use crate::pareto;
 use crate::plot::Plot;
 use crate::provenance::Build;
 use crate::report::{Point, format_number};
-use crate::{ExperimentError, Knob, Machine, Report};
+use crate::{ExperimentError, KNOBS, Knob, Machine, Report, knob};
 
 /// What one `rtgi experiment all` run was: its command and how long it took.
 /// Written as `run.json` beside the index.
@@ -65,7 +66,7 @@ pub struct IndexedReport {
 pub fn read_reports(folder: &Path) -> Result<Vec<IndexedReport>, ExperimentError> {
     let mut found = Vec::new();
     collect(folder, folder, &mut found)?;
-    let order = |report: &Report| Knob::ALL.iter().position(|k| k.name() == report.knob).unwrap_or(usize::MAX);
+    let order = |report: &Report| KNOBS.iter().position(|k| k.name() == report.knob).unwrap_or(usize::MAX);
     found.sort_by(|a, b| order(&a.report).cmp(&order(&b.report)).then_with(|| a.folder.cmp(&b.folder)));
     Ok(found)
 }
@@ -86,7 +87,7 @@ fn collect(root: &Path, folder: &Path, found: &mut Vec<IndexedReport>) -> Result
         if path.is_dir() {
             collect(root, &path, found)?;
         } else if let Some(stem) = name.strip_suffix(".json")
-            && Knob::ALL.iter().any(|k| k.name() == stem)
+            && knob(stem).is_some()
         {
             let text = std::fs::read_to_string(&path).map_err(|e| unreadable(&path, e))?;
             let report: Report = serde_json::from_str(&text).map_err(|e| ExperimentError::Read {
@@ -135,8 +136,8 @@ fn pareto_plots(reports: &[IndexedReport]) -> Vec<(String, Plot, Vec<pareto::Con
     // The analytic knob measures bias against exact answers, not render
     // error against a reference: it has no front. The direct knob renders
     // three scenes of its own, each against its own reference: a front each.
-    let on_the_scene = |r: &&IndexedReport| Knob::ALL.iter().any(|k| k.name() == r.report.knob && k.uses_scene());
-    let direct = reports.iter().filter(|r| r.report.knob == Knob::Direct.name());
+    let on_the_scene = |r: &&IndexedReport| knob(&r.report.knob).is_some_and(|k| k.uses_scene());
+    let direct = reports.iter().filter(|r| r.report.knob == Direct.name());
     let reports: Vec<&IndexedReport> = reports.iter().filter(on_the_scene).collect();
     let mut scenes: Vec<&str> = Vec::new();
     for r in &reports {

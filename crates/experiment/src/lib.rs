@@ -3,7 +3,7 @@
 //!
 //! An experiment takes a [`Subject`] (a scene, a camera, a structure and
 //! base render settings, prepared by the caller) and [`Options`], varies one
-//! [`Knob`], and returns a [`Report`]: every measurement, the machine, the
+//! [`Knob`] (each a file of its own, all listed in [`KNOBS`]), and returns a [`Report`]: every measurement, the machine, the
 //! command, tables, findings (fitted slopes...) and plots, which
 //! [`Report::write`] turns into `KNOB.md`, `KNOB.json` and SVG files.
 //!
@@ -47,7 +47,7 @@ pub mod stats;
 pub mod verdict;
 
 pub use index::{IndexedReport, RUN_RECORD, RunRecord, index_markdown, read_reports, write_index};
-pub use knobs::Knob;
+pub use knobs::{KNOBS, Knob, Scenes, knob};
 pub use machine::Machine;
 pub use report::{Point, Report, Series, Table};
 
@@ -147,7 +147,7 @@ pub enum ExperimentError {
 /// Runs `knob` on `subject`; `progress` receives a line per step, with the
 /// time spent and an estimate of the time left.
 pub fn run(
-    knob: Knob,
+    knob: &dyn Knob,
     subject: &Subject,
     options: &Options,
     progress: &dyn Fn(&str),
@@ -158,7 +158,7 @@ pub fn run(
 /// Renders `subject` with `settings` on its structure, as every experiment's
 /// measured render does: the image `rtgi render` makes of the same options.
 pub fn render(subject: &Subject, settings: &RenderSettings) -> rtgi_image::HdrImage {
-    runner::render(subject, settings).0
+    runner::render(subject, settings)
 }
 
 /// Counts the steps of an experiment and estimates the time left from the

@@ -1,6 +1,5 @@
 //! Renders and times them: what every knob that renders shares.
 
-use rtgi_accel::{Accel, AccelKind};
 use rtgi_image::HdrImage;
 use rtgi_render::RenderSettings;
 
@@ -10,7 +9,7 @@ use crate::report::Point;
 use crate::stats::{SeedErrors, Timing};
 use crate::{Options, Subject};
 
-pub(crate) use crate::measure::{render_denoised, render_timed as render};
+pub(crate) use crate::measure::{render, render_denoised, render_timed};
 
 /// Renders `options.repeats` times with seeds 0, 1, 2... and measures the
 /// time and the error against `reference`: RMSE, relative MSE, the split
@@ -20,9 +19,9 @@ pub(crate) fn measure(subject: &Subject, settings: &RenderSettings, options: &Op
     measure_with(subject, settings, options, reference, render)
 }
 
-/// How a knob makes an image: [`render`], or [`render_denoised`]; returns
-/// the image and its time in ms.
-pub(crate) type MakeImage = fn(&Subject, &RenderSettings) -> (HdrImage, f64);
+/// How a knob makes an image: [`render`], or [`render_denoised`] (the
+/// render and its filter, timed together).
+pub(crate) type MakeImage = fn(&Subject, &RenderSettings) -> HdrImage;
 
 /// [`measure`], each image made by `make` (a render, or a render and a filter).
 pub(crate) fn measure_with(
@@ -32,15 +31,14 @@ pub(crate) fn measure_with(
     reference: &Reference,
     make: MakeImage,
 ) -> Point {
-    let mut times = Vec::new();
     let mut errors = SeedErrors::new(&reference.image, reference.info.noise_rmse);
-    for repeat in 0..options.repeats.max(1) {
-        let (image, ms) = make(subject, &RenderSettings { seed: repeat as u64, ..settings.clone() });
-        times.push(ms);
-        errors.add(&image);
-    }
+    let time = crate::measure::time_each(
+        options.repeats,
+        |repeat| make(subject, &RenderSettings { seed: repeat as u64, ..settings.clone() }),
+        |image| errors.add(&image),
+    );
     let mut point = Point::new(settings.samples_per_pixel as f64, settings.samples_per_pixel.to_string());
-    let (time, error) = (Timing::of(&times), errors.error());
+    let error = errors.error();
     let efficiency = error.efficiency(time.median_ms);
     let biased = error.bias_resolved();
     point.time = Some(time);
@@ -94,7 +92,7 @@ pub(crate) fn equal_time(
                 let mut seconds = budget_ms * 1e-3;
                 let mut best: Option<(HdrImage, f64, f64)> = None;
                 for _ in 0..EQUAL_TIME_ATTEMPTS {
-                    let (image, time_ms) = render(subject, &bounded(seconds));
+                    let (image, time_ms) = render_timed(subject, &bounded(seconds));
                     let next = seconds * budget_ms / time_ms.max(1e-9);
                     if best.as_ref().is_none_or(|b| off(time_ms) < off(b.1)) {
                         best = Some((image, time_ms, seconds));
@@ -107,8 +105,9 @@ pub(crate) fn equal_time(
                 let (image, time_ms, seconds) = best.expect("at least one attempt");
                 return entry(image, time_ms, format!("{label}, --time {seconds:.3} s"));
             }
-            let render_at =
-                |spp: u32| render(subject, &RenderSettings { samples_per_pixel: spp, seed: 0, ..settings.clone() });
+            let render_at = |spp: u32| {
+                render_timed(subject, &RenderSettings { samples_per_pixel: spp, seed: 0, ..settings.clone() })
+            };
             let first = (budget_ms / ms_per_sample.max(1e-9)).round().clamp(1.0, MAX_PANEL_SPP) as u32;
             // The first render after another configuration's pays for cold
             // caches and sleeping threads: one untimed, shorter, first.
@@ -214,25 +213,6 @@ pub(crate) fn time_and_error(series: &crate::Series) -> Vec<(Timing, f64, f64, f
         .map(|(t, e)| (t.clone(), e.rmse, e.rmse_min, e.rmse_max))
         .collect()
 }
-
-/// Builds `kind` over the subject's triangles `repeats` times; returns the last structure and the timing.
-pub(crate) fn build_timed(
-    triangles: &[[rtgi_math::Vec3; 3]],
-    kind: AccelKind,
-    params: &rtgi_accel::BuildParams,
-    repeats: usize,
-) -> Result<(Box<dyn Accel>, Timing), crate::ExperimentError> {
-    let mut built = Ok(None);
-    let timing = crate::measure::time(repeats, 0, || {
-        if built.is_ok() {
-            built =
-                kind.try_build(triangles, params).map(Some).map_err(|e| crate::ExperimentError::Build(e.to_string()));
-        }
-    });
-    Ok((built?.expect("at least one build"), timing))
-}
-
-pub(crate) use crate::measure::time_rays;
 
 #[cfg(test)]
 mod tests {

@@ -14,10 +14,9 @@ use rtgi_accel::{Accel, AccelKind, BuildParams, Hit};
 use rtgi_math::Ray;
 use rtgi_render::rays::{primary_rays, surface_rays};
 
-use crate::measure::every_nth;
+use crate::measure::{TraceCost, every_nth, trace_cost};
 use crate::plot::{BOUND_NOTE, Corner, Curve, Plot, is_bound, rate_or_bound};
 use crate::report::{Point, Report, Series, Table, format_ms, format_number};
-use crate::runner::{build_timed, time_rays};
 use crate::stats::Timing;
 use crate::verdict::{compare, resolved_lower};
 use crate::{ExperimentError, Options, Steps, Subject};
@@ -146,7 +145,7 @@ pub(super) fn run(
     let repeats = options.repeats.max(1);
     for (index, (name, kind, params)) in configurations.iter().enumerate() {
         steps.next(name);
-        let (accel, build) = build_timed(&triangles, *kind, params, repeats)?;
+        let (accel, build) = crate::measure::build(&triangles, *kind, params, repeats)?;
         let bytes_per_triangle = accel.build_stats().memory_bytes as f64 / triangles.len().max(1) as f64;
         let mut point = Point::new(index as f64, name.clone());
         point.time = Some(build.clone());
@@ -160,13 +159,7 @@ pub(super) fn run(
             // The linear scan is timed on the subset it answers for the
             // others: on the whole batch it would take hours.
             let rays: &[Ray] = if *kind == AccelKind::Linear { subset } else { all_rays };
-            let single =
-                time_rays(rays, repeats, |chunk| chunk.iter().filter(|r| accel.intersect(r).is_some()).count());
-            let batched = time_rays(rays, repeats, |chunk| {
-                let mut hits = vec![None; chunk.len()];
-                accel.intersect_batch(chunk, &mut hits);
-                hits.iter().filter(|h| h.is_some()).count()
-            });
+            let TraceCost { single, batched } = trace_cost(accel.as_ref(), rays, repeats);
             let mrays = |t: &Timing| rays.len() as f64 / (t.median_ms * 1e3);
             // Evenly spaced: camera rays come in tiles, and the first ones may all be sky.
             let counted_rays = &every_nth(rays, COUNTED_RAYS);
@@ -426,4 +419,35 @@ pub(super) fn run(
     });
     report.tables.push(table);
     Ok(report)
+}
+
+/// The `accel` knob.
+pub(super) struct AccelStructures;
+
+impl super::Knob for AccelStructures {
+    fn name(&self) -> &'static str {
+        "accel"
+    }
+
+    fn about(&self) -> &'static str {
+        "The acceleration structures and their build parameters."
+    }
+
+    fn question(&self) -> &'static str {
+        "what does each acceleration structure cost to build and to trace, and does it change any answer?"
+    }
+
+    fn scenes(&self) -> super::Scenes {
+        super::Scenes::Subject(&[super::CORNELL, super::BUNNY, super::SPONZA, super::CONFERENCE])
+    }
+
+    fn run(
+        &self,
+        subject: &Subject,
+        options: &Options,
+        report: Report,
+        progress: &dyn Fn(&str),
+    ) -> Result<Report, ExperimentError> {
+        run(subject, options, report, progress)
+    }
 }

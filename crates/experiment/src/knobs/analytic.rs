@@ -79,15 +79,16 @@ pub(super) fn run(options: &Options, mut report: Report, progress: &dyn Fn(&str)
         for (index, (label, settings)) in estimators.iter().enumerate() {
             steps.next(&format!("{name}: {label}"));
             let mut means = Vec::new();
-            let mut times = Vec::new();
-            for seed in 0..seeds {
-                let (image, ms) = crate::runner::render(&subject, &RenderSettings { seed, ..settings.clone() });
-                means.push(
-                    image.pixels().iter().map(|p| p.element_sum() as f64 / 3.0).sum::<f64>()
-                        / image.pixels().len() as f64,
-                );
-                times.push(ms);
-            }
+            let time = crate::measure::time_each(
+                seeds as usize,
+                |seed| crate::runner::render(&subject, &RenderSettings { seed: seed as u64, ..settings.clone() }),
+                |image| {
+                    means.push(
+                        image.pixels().iter().map(|p| p.element_sum() as f64 / 3.0).sum::<f64>()
+                            / image.pixels().len() as f64,
+                    )
+                },
+            );
             let n = means.len() as f64;
             let mean = means.iter().sum::<f64>() / n;
             let spread = (means.iter().map(|m| (m - mean).powi(2)).sum::<f64>() / (n - 1.0)).sqrt();
@@ -98,7 +99,6 @@ pub(super) fn run(options: &Options, mut report: Report, progress: &dyn Fn(&str)
             // of 0; its mean is then exact to the f32 rounding of the
             // radiance, about 10⁻⁶ of it, which stands in for the error.
             let z = bias / standard_error.max(ROUNDING * exact);
-            let time = Timing::of(&times);
             if z.abs() > RESOLVED_SE {
                 resolved.push(format!("{label} ({:+.4}, {:.1} SE)", bias / exact, z));
             }
@@ -188,4 +188,35 @@ pub(super) fn run(options: &Options, mut report: Report, progress: &dyn Fn(&str)
     });
     report.tables.push(table);
     Ok(report)
+}
+
+/// The `analytic` knob.
+pub(super) struct Analytic;
+
+impl super::Knob for Analytic {
+    fn name(&self) -> &'static str {
+        "analytic"
+    }
+
+    fn about(&self) -> &'static str {
+        "Each estimator's bias against answers known in closed form (white furnaces)."
+    }
+
+    fn question(&self) -> &'static str {
+        "is any estimator (sampler, direct-light strategy, roulette) biased against an answer known exactly?"
+    }
+
+    fn scenes(&self) -> super::Scenes {
+        super::Scenes::Own("white furnaces (built in: closed emitting spheres)")
+    }
+
+    fn run(
+        &self,
+        _subject: &Subject,
+        options: &Options,
+        report: Report,
+        progress: &dyn Fn(&str),
+    ) -> Result<Report, ExperimentError> {
+        run(options, report, progress)
+    }
 }

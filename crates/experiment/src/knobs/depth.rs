@@ -17,6 +17,8 @@ pub(super) fn run(
     mut report: Report,
     progress: &dyn Fn(&str),
 ) -> Result<Report, ExperimentError> {
+    // The report's line on the renders says the depth is what varies.
+    report.renders = Some(super::renders(&super::at_reference_depth(subject), Some("varied")));
     if !subject.settings.integrator.simulates_light() || subject.settings.integrator == Integrator::Direct {
         return Err(ExperimentError::Unsuitable(format!(
             "the depth experiment needs the path integrator (the subject uses '{}')",
@@ -177,4 +179,35 @@ pub(super) fn run(
     report.tables.push(table);
     report.reference = Some(reference.info);
     Ok(report)
+}
+
+/// The `depth` knob.
+pub(super) struct Depth;
+
+impl super::Knob for Depth {
+    fn name(&self) -> &'static str {
+        "depth"
+    }
+
+    fn about(&self) -> &'static str {
+        "Bounces, with Russian roulette on and off."
+    }
+
+    fn question(&self) -> &'static str {
+        "what do bounces cost, and how much light is missing without them?"
+    }
+
+    fn scenes(&self) -> super::Scenes {
+        super::Scenes::Subject(&[super::CORNELL, super::SPONZA])
+    }
+
+    fn run(
+        &self,
+        subject: &Subject,
+        options: &Options,
+        report: Report,
+        progress: &dyn Fn(&str),
+    ) -> Result<Report, ExperimentError> {
+        run(subject, options, report, progress)
+    }
 }

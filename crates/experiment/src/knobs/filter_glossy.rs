@@ -210,3 +210,35 @@ pub(super) fn run(
     report.reference = Some(reference.info);
     Ok(report)
 }
+
+/// The `filter-glossy` knob.
+pub(super) struct FilterGlossyKnob;
+
+impl super::Knob for FilterGlossyKnob {
+    fn name(&self) -> &'static str {
+        "filter-glossy"
+    }
+
+    fn about(&self) -> &'static str {
+        "Path regularisation (Cycles' \"filter glossy\") against the clamp."
+    }
+
+    fn question(&self) -> &'static str {
+        "does widening mirrors, glass and sharp highlights after a diffuse bounce (path regularisation) \
+            remove the fireflies of caustics at less bias than the clamp, raw and denoised?"
+    }
+
+    fn scenes(&self) -> super::Scenes {
+        super::Scenes::Subject(&[super::CAUSTICS, super::MIRROR, super::CONFERENCE])
+    }
+
+    fn run(
+        &self,
+        subject: &Subject,
+        options: &Options,
+        report: Report,
+        progress: &dyn Fn(&str),
+    ) -> Result<Report, ExperimentError> {
+        run(subject, options, report, progress)
+    }
+}

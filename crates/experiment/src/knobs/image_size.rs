@@ -8,7 +8,6 @@ use rtgi_render::RenderSettings;
 use crate::plot::{Corner, Curve, Plot};
 use crate::report::{Point, Report, Series, Table, format_number, format_timing};
 use crate::runner::render;
-use crate::stats::Timing;
 use crate::verdict::compare;
 use crate::{ExperimentError, Options, Steps, Subject};
 
@@ -37,10 +36,12 @@ pub(super) fn run(
             (((base.width as f64 * scale).round() as u32).max(1), ((base.height as f64 * scale).round() as u32).max(1));
         steps.next(&format!("{width}x{height}"));
         let settings = RenderSettings { width, height, ..base.clone() };
-        let times: Vec<f64> = (0..options.repeats.max(1))
-            .map(|repeat| render(subject, &RenderSettings { seed: repeat as u64, ..settings.clone() }).1)
-            .collect();
-        let timing = Timing::of(&times);
+        let timing = crate::measure::time_each(
+            options.repeats,
+            |repeat| render(subject, &RenderSettings { seed: repeat as u64, ..settings.clone() }),
+            drop,
+        );
+        let times = &timing.runs_ms;
         let samples = (width as f64) * (height as f64) * spp as f64;
         let ns: Vec<f64> = times.iter().map(|ms| ms * 1e6 / samples).collect();
         table.rows.push(vec![
@@ -89,4 +90,35 @@ pub(super) fn run(
     report.series.push(series);
     report.tables.push(table);
     Ok(report)
+}
+
+/// The `image-size` knob.
+pub(super) struct ImageSize;
+
+impl super::Knob for ImageSize {
+    fn name(&self) -> &'static str {
+        "image-size"
+    }
+
+    fn about(&self) -> &'static str {
+        "Render time against the image's pixel count."
+    }
+
+    fn question(&self) -> &'static str {
+        "does render time grow in proportion to the pixels, or does a fixed cost weigh on small images?"
+    }
+
+    fn scenes(&self) -> super::Scenes {
+        super::Scenes::Subject(&[super::CORNELL])
+    }
+
+    fn run(
+        &self,
+        subject: &Subject,
+        options: &Options,
+        report: Report,
+        progress: &dyn Fn(&str),
+    ) -> Result<Report, ExperimentError> {
+        run(subject, options, report, progress)
+    }
 }

@@ -20,9 +20,9 @@ use rtgi_accel::{Accel, AccelKind, BuildParams, Intersector};
 use rtgi_math::{Ray, Vec3};
 use rtgi_render::rays::{primary_rays, surface_rays};
 
+use crate::measure::time_rays;
 use crate::plot::{BOUND_NOTE, Corner, Curve, Plot, is_bound, rate_or_bound};
 use crate::report::{Point, Report, Series, Table, format_number};
-use crate::runner::time_rays;
 use crate::stats::Timing;
 use crate::{ExperimentError, Options, Steps, Subject};
 
@@ -404,4 +404,36 @@ fn plots(report: &mut Report) {
         legend: Corner::UpperRight,
         y_range: None,
     });
+}
+
+/// The `intersector` knob.
+pub(super) struct Intersectors;
+
+impl super::Knob for Intersectors {
+    fn name(&self) -> &'static str {
+        "intersector"
+    }
+
+    fn about(&self) -> &'static str {
+        "The ray/triangle tests: time, and failures on the hard cases of `rtgi verify`."
+    }
+
+    fn question(&self) -> &'static str {
+        "what does each ray/triangle test cost, and how often do rays slip through shared edges or hit the \
+            surface they leave?"
+    }
+
+    fn scenes(&self) -> super::Scenes {
+        super::Scenes::Subject(&[super::CORNELL])
+    }
+
+    fn run(
+        &self,
+        subject: &Subject,
+        options: &Options,
+        report: Report,
+        progress: &dyn Fn(&str),
+    ) -> Result<Report, ExperimentError> {
+        run(subject, options, report, progress)
+    }
 }

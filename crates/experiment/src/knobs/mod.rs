@@ -12,7 +12,7 @@ mod bounce_sampling;
 mod clamp;
 mod denoise;
 mod depth;
-mod direct;
+pub(crate) mod direct;
 mod effects;
 mod filter_glossy;
 mod image_size;
@@ -26,190 +26,129 @@ mod sweep;
 mod threads;
 mod traversal;
 
-/// Something an experiment varies.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
-pub enum Knob {
-    /// Samples per pixel, for each pixel sampler.
-    Spp,
-    /// Bounces, with Russian roulette on and off.
-    Depth,
-    /// Where bounce directions come from: the BSDF, the cosine or the uniform hemisphere.
-    BounceSampling,
-    /// The bounce from which Russian roulette may end paths.
-    RouletteStart,
-    /// The acceleration structures and their build parameters.
-    Accel,
-    /// The naive O(n) search against the BVH, over triangle counts.
-    Scaling,
-    /// The robust slab test of traversal against the textbook one.
-    Traversal,
-    /// Batch queries (packets of 16 coherent rays) against one ray at a time.
-    Packets,
-    /// Light, BSDF and MIS sampling of direct light, on scenes built for each.
-    Direct,
-    /// The indirect-light clamp: bias traded for variance.
-    Clamp,
-    /// Path regularisation (Cycles' "filter glossy") against the clamp.
-    FilterGlossy,
-    /// Adaptive sampling (noise targets) against fixed samples per pixel.
-    Adaptive,
-    /// The edge-avoiding denoiser against the samples' mean.
-    Denoise,
-    /// Worker threads: render time, and the same bits at every count.
-    Threads,
-    /// Render time against the image's pixel count.
-    ImageSize,
-    /// Each estimator's bias against answers known in closed form (white furnaces).
-    Analytic,
-    /// Each decision of the effects planner reversed.
-    Effects,
-    /// The ray/triangle tests: time, and failures on the hard cases of `rtgi verify`.
-    Intersector,
-    /// The triangle test in single against double precision: time, and
-    /// error against the exact answer on hard triangles.
-    ///
-    /// The hard triangles are near-degenerate ones and far ones.
-    Precision,
-}
-
-impl Knob {
-    /// Every knob, in the order `all` runs them.
-    pub const ALL: &'static [Knob] = &[
-        Knob::Spp,
-        Knob::Depth,
-        Knob::BounceSampling,
-        Knob::RouletteStart,
-        Knob::Accel,
-        Knob::Scaling,
-        Knob::Traversal,
-        Knob::Packets,
-        Knob::Direct,
-        Knob::Clamp,
-        Knob::FilterGlossy,
-        Knob::Adaptive,
-        Knob::Denoise,
-        Knob::Threads,
-        Knob::ImageSize,
-        Knob::Analytic,
-        Knob::Effects,
-        Knob::Intersector,
-        Knob::Precision,
-    ];
-
+/// One knob of the experiments: what it varies, the question it answers,
+/// where it measures, and the measurement with its own settings (quick
+/// and full). Each knob is a file of its own in `knobs/` and one line of
+/// [`KNOBS`]; the command line, the report, its index and the tests take
+/// every knob from there, so a new one cannot be left out of any.
+pub trait Knob: Sync {
     /// The knob's name on command lines and in file names (`spp`, `depth`, ...).
-    pub fn name(self) -> &'static str {
-        match self {
-            Knob::Spp => "spp",
-            Knob::Depth => "depth",
-            Knob::BounceSampling => "bounce-sampling",
-            Knob::RouletteStart => "roulette-start",
-            Knob::Accel => "accel",
-            Knob::Scaling => "scaling",
-            Knob::Traversal => "traversal",
-            Knob::Packets => "packets",
-            Knob::Direct => "direct",
-            Knob::Clamp => "clamp",
-            Knob::FilterGlossy => "filter-glossy",
-            Knob::Adaptive => "adaptive",
-            Knob::Denoise => "denoise",
-            Knob::Threads => "threads",
-            Knob::ImageSize => "image-size",
-            Knob::Analytic => "analytic",
-            Knob::Effects => "effects",
-            Knob::Intersector => "intersector",
-            Knob::Precision => "precision",
-        }
-    }
+    fn name(&self) -> &'static str;
+
+    /// What the knob varies, in a sentence (the command line's help).
+    fn about(&self) -> &'static str;
 
     /// The question the knob's experiment answers.
-    pub fn question(self) -> &'static str {
-        match self {
-            Knob::Spp => {
-                "how fast does the error fall with samples per pixel, for each pixel sampler, and at equal time?"
-            }
-            Knob::Depth => "what do bounces cost, and how much light is missing without them?",
-            Knob::BounceSampling => {
-                "which source of bounce directions (BSDF, cosine or uniform hemisphere) reaches the least error in \
-                 equal time?"
-            }
-            Knob::RouletteStart => {
-                "from which bounce should Russian roulette end paths: what does an early start save in time and cost \
-                 in noise?"
-            }
-            Knob::Accel => {
-                "what does each acceleration structure cost to build and to trace, and does it change any answer?"
-            }
-            Knob::Scaling => {
-                "how does the time per ray grow with the triangle count, for the naive search and for the BVH?"
-            }
-            Knob::Traversal => {
-                "what does the robust slab test cost, and how many answers does the textbook one change?"
-            }
-            Knob::Packets => {
-                "what do packets of coherent rays gain over one ray at a time, and do they change any answer?"
-            }
-            Knob::Direct => {
-                "which sampling of direct light (light, BSDF or MIS) gives the least error in equal time, and where?"
-            }
-            Knob::Clamp => "how much bias does clamping indirect light add for the variance it removes?",
-            Knob::FilterGlossy => {
-                "does widening mirrors, glass and sharp highlights after a diffuse bounce (path regularisation) \
-                 remove the fireflies of caustics at less bias than the clamp, raw and denoised?"
-            }
-            Knob::Adaptive => {
-                "does sampling until each pixel meets a noise target beat the same samples everywhere, at equal time?"
-            }
-            Knob::Denoise => {
-                "does the denoiser lower the error at equal time, and how much bias does it trade for the noise?"
-            }
-            Knob::Threads => {
-                "what do worker threads buy in render time, and is the image the same bits at every count?"
-            }
-            Knob::ImageSize => {
-                "does render time grow in proportion to the pixels, or does a fixed cost weigh on small images?"
-            }
-            Knob::Analytic => {
-                "is any estimator (sampler, direct-light strategy, roulette) biased against an answer known exactly?"
-            }
-            Knob::Effects => {
-                "what does each effect cost, and does leaving out one the scene does not call for cost accuracy?"
-            }
-            Knob::Intersector => {
-                "what does each ray/triangle test cost, and how often do rays slip through shared edges or hit \
-                 the surface they leave?"
-            }
-            Knob::Precision => {
-                "how far are t and the barycentrics from the exact answer in single and double precision, on \
-                 near-degenerate and far-from-origin triangles, and what does double precision cost?"
-            }
-        }
-    }
+    fn question(&self) -> &'static str;
+
+    /// Where the knob measures: on the subject's scene, or on scenes of its own.
+    fn scenes(&self) -> Scenes;
+
+    /// Measures on `subject` (or on the knob's own scenes) and fills in
+    /// `report`, whose provenance is already written; `progress` receives
+    /// a line per step.
+    fn run(
+        &self,
+        subject: &Subject,
+        options: &Options,
+        report: Report,
+        progress: &dyn Fn(&str),
+    ) -> Result<Report, ExperimentError>;
 
     /// Whether the knob measures on the subject's scene (and so needs a
-    /// reference of it); `scaling` and `precision` make their own
-    /// triangles and `direct` renders scenes of its own, at the subject's size.
-    pub fn uses_scene(self) -> bool {
-        !matches!(self, Knob::Scaling | Knob::Direct | Knob::Precision | Knob::Analytic)
+    /// reference of it).
+    fn uses_scene(&self) -> bool {
+        matches!(self.scenes(), Scenes::Subject(_))
     }
 }
 
-impl rtgi_math::NamedChoice for Knob {
-    const KIND: &'static str = "experiment";
-    const ALL: &'static [Self] = Knob::ALL;
-    fn name(self) -> &'static str {
-        Knob::name(self)
+/// Where a knob measures.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Scenes {
+    /// The subject's scene; the report (`rtgi experiment all` without a
+    /// scene) measures it on each of these shared scenes: paths in the
+    /// shared scenes' folder, or `project:NAME` for `scenes/NAME` of this
+    /// workspace.
+    Subject(&'static [&'static str]),
+    /// Scenes the knob makes itself (generated meshes, built-in scenes),
+    /// as the report names them.
+    Own(&'static str),
+}
+
+/// Every knob, in the order `rtgi experiment all` runs them: adding a knob
+/// is its file and its line here.
+pub static KNOBS: &[&dyn Knob] = &[
+    &spp::Spp,
+    &depth::Depth,
+    &bounce_sampling::BounceSamplingKnob,
+    &roulette_start::RouletteStart,
+    &accel::AccelStructures,
+    &scaling::Scaling,
+    &traversal::TraversalTest,
+    &packets::Packets,
+    &direct::Direct,
+    &clamp::Clamp,
+    &filter_glossy::FilterGlossyKnob,
+    &adaptive::Adaptive,
+    &denoise::Denoise,
+    &threads::Threads,
+    &image_size::ImageSize,
+    &analytic::Analytic,
+    &effects::Effects,
+    &intersector::Intersectors,
+    &precision::Precision,
+];
+
+/// The knob named `name` (as [`Knob::name`] gives it).
+pub fn knob(name: &str) -> Option<&'static dyn Knob> {
+    KNOBS.iter().copied().find(|k| k.name() == name)
+}
+
+// Knobs are told apart by name: the registry holds each once.
+impl PartialEq for dyn Knob + '_ {
+    fn eq(&self, other: &Self) -> bool {
+        self.name() == other.name()
     }
 }
 
-impl std::fmt::Display for Knob {
+impl Eq for dyn Knob + '_ {}
+
+impl std::fmt::Debug for dyn Knob + '_ {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "Knob({})", self.name())
+    }
+}
+
+impl std::fmt::Display for dyn Knob + '_ {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.write_str(self.name())
     }
 }
 
+/// The shared scenes of the report, relative to the shared scenes' folder.
+/// The Cornell box: small, closed, converges; its error at high spp is mostly the emitter's edge.
+const CORNELL: &str = "cornell-box/CornellBox-Original.obj";
+/// The Cornell box with a mirror block: caustics off the mirror.
+const MIRROR: &str = "cornell-box/CornellBox-Mirror.obj";
+/// One mesh under the sky.
+const BUNNY: &str = "bunny/stanford-bunny.obj";
+/// Large, many materials.
+const SPONZA: &str = "sponza-dabrovic/sponza.obj";
+/// Large, many materials, glossy ones among them.
+const CONFERENCE: &str = "conference/conference.obj";
+/// Textures, normal maps, emissive details: effects the box does not need.
+const HELMET: &str = "gltf/DamagedHelmet/glTF/DamagedHelmet.gltf";
+/// The project's own glossy scene (in `scenes/`, not the shared folder):
+/// glossy metals, where transport noise is of the BSDF's lobes.
+const GLOSSY: &str = "project:direct-glossy.toml";
+/// The project's closed room lit only by light bounced off its ceiling:
+/// transport noise, with no emitter in view.
+const ROOM: &str = "project:indirect-room.toml";
+/// The project's Cornell box with a glass and a mirror sphere: caustics.
+const CAUSTICS: &str = "project:caustics.toml";
+
 pub(crate) fn run(
-    knob: Knob,
+    knob: &dyn Knob,
     subject: &Subject,
     options: &Options,
     progress: &dyn Fn(&str),
@@ -217,12 +156,9 @@ pub(crate) fn run(
     let report = Report {
         knob: knob.name().to_owned(),
         question: knob.question().to_owned(),
-        scene: match knob {
-            _ if knob.uses_scene() => subject.name.clone(),
-            Knob::Direct => "scenes/direct-*.toml (built in: small light, large light, glossy)".to_owned(),
-            Knob::Precision => "generated triangles".to_owned(),
-            Knob::Analytic => "white furnaces (built in: closed emitting spheres)".to_owned(),
-            _ => "generated meshes".to_owned(),
+        scene: match knob.scenes() {
+            Scenes::Subject(_) => subject.name.clone(),
+            Scenes::Own(scenes) => scenes.to_owned(),
         },
         machine: Machine::this(options.threads),
         build: Build::this(),
@@ -231,22 +167,7 @@ pub(crate) fn run(
         repeats: options.repeats.max(1),
         quick: options.quick,
         reference: None,
-        renders: knob.uses_scene().then(|| {
-            let settings = at_reference_depth(subject);
-            let depth = if knob == Knob::Depth { "varied".to_owned() } else { settings.max_depth.to_string() };
-            format!(
-                "{}x{} pixels, {} integrator, maximum depth {depth}, Russian roulette {} from bounce {}, {} bounce \
-                 sampling, {} sampler, {} direct light",
-                settings.width,
-                settings.height,
-                settings.integrator,
-                if settings.russian_roulette { "on" } else { "off" },
-                settings.roulette_start,
-                settings.bounce_sampling,
-                settings.sampler,
-                settings.direct_strategy
-            )
-        }),
+        renders: knob.uses_scene().then(|| renders(&at_reference_depth(subject), None)),
         series: Vec::new(),
         fits: Vec::new(),
         findings: Vec::new(),
@@ -254,29 +175,27 @@ pub(crate) fn run(
         plots: Vec::new(),
         panels: Vec::new(),
     };
-    let mut report = match knob {
-        Knob::Spp => spp::run(subject, options, report, progress),
-        Knob::Depth => depth::run(subject, options, report, progress),
-        Knob::BounceSampling => bounce_sampling::run(subject, options, report, progress),
-        Knob::RouletteStart => roulette_start::run(subject, options, report, progress),
-        Knob::Threads => threads::run(subject, options, report, progress),
-        Knob::ImageSize => image_size::run(subject, options, report, progress),
-        Knob::Accel => accel::run(subject, options, report, progress),
-        Knob::Scaling => scaling::run(options, report, progress),
-        Knob::Traversal => traversal::run(subject, options, report, progress),
-        Knob::Packets => packets::run(subject, options, report, progress),
-        Knob::Direct => direct::run(subject, options, report, progress),
-        Knob::Clamp => clamp::run(subject, options, report, progress),
-        Knob::FilterGlossy => filter_glossy::run(subject, options, report, progress),
-        Knob::Adaptive => adaptive::run(subject, options, report, progress),
-        Knob::Denoise => denoise::run(subject, options, report, progress),
-        Knob::Analytic => analytic::run(options, report, progress),
-        Knob::Effects => effects::run(subject, options, report, progress),
-        Knob::Intersector => intersector::run(subject, options, report, progress),
-        Knob::Precision => precision::run(options, report, progress),
-    }?;
+    let mut report = knob.run(subject, options, report, progress)?;
     report.date = crate::provenance::utc_now();
     Ok(report)
+}
+
+/// The report's line on what the knob's renders share; `depth` says how
+/// deep paths go where the knob varies it, else the settings' maximum depth.
+fn renders(settings: &rtgi_render::RenderSettings, depth: Option<&str>) -> String {
+    let depth = depth.map_or_else(|| settings.max_depth.to_string(), str::to_owned);
+    format!(
+        "{}x{} pixels, {} integrator, maximum depth {depth}, Russian roulette {} from bounce {}, {} bounce \
+         sampling, {} sampler, {} direct light",
+        settings.width,
+        settings.height,
+        settings.integrator,
+        if settings.russian_roulette { "on" } else { "off" },
+        settings.roulette_start,
+        settings.bounce_sampling,
+        settings.sampler,
+        settings.direct_strategy
+    )
 }
 
 /// Refuses a subject whose integrator simulates no light, for the knobs

@@ -7,14 +7,12 @@
 //! shared by two triangles), and the rays run from random points around
 //! the sphere to random points inside it, so every ray hits.
 
-use std::time::Instant;
-
-use rtgi_accel::{AccelKind, BuildParams};
+use rtgi_accel::AccelKind;
 use rtgi_math::{Ray, Rng, Vec3, uniform_sphere};
 
 use crate::plot::{BOUND_NOTE, Corner, Curve, Plot, is_bound, rate_or_bound};
 use crate::report::{Point, Report, Series, Table, format_ms, format_number};
-use crate::{ExperimentError, Options, Steps};
+use crate::{ExperimentError, Options, Steps, Subject};
 
 /// A unit sphere of about `count` triangles: `rows` bands of `2 rows`
 /// quads, the poles' quads folded to single triangles.
@@ -98,11 +96,8 @@ pub(super) fn run(options: &Options, mut report: Report, progress: &dyn Fn(&str)
         for (kind, series) in kinds.iter().zip(&mut series) {
             steps.next(&format!("{kind} over {} triangles", triangles.len()));
             let params = kind.default_params();
-            let start = Instant::now();
-            let accel = kind
-                .try_build(&triangles, &BuildParams { ..params })
-                .map_err(|e| ExperimentError::Build(e.to_string()))?;
-            let build_ms = start.elapsed().as_secs_f64() * 1e3;
+            let (accel, build_ms) = crate::measure::once(|| kind.try_build(&triangles, &params));
+            let accel = accel.map_err(|e| ExperimentError::Build(e.to_string()))?;
             let bytes_per_triangle = accel.build_stats().memory_bytes as f64 / triangles.len() as f64;
             let limit = if *kind == AccelKind::Linear {
                 (LINEAR_BUDGET / triangles.len()).clamp(64, ray_count)
@@ -236,4 +231,35 @@ pub(super) fn run(options: &Options, mut report: Report, progress: &dyn Fn(&str)
     });
     report.tables.push(table);
     Ok(report)
+}
+
+/// The `scaling` knob.
+pub(super) struct Scaling;
+
+impl super::Knob for Scaling {
+    fn name(&self) -> &'static str {
+        "scaling"
+    }
+
+    fn about(&self) -> &'static str {
+        "The naive O(n) search against the BVH, over triangle counts."
+    }
+
+    fn question(&self) -> &'static str {
+        "how does the time per ray grow with the triangle count, for the naive search and for the BVH?"
+    }
+
+    fn scenes(&self) -> super::Scenes {
+        super::Scenes::Own("generated meshes")
+    }
+
+    fn run(
+        &self,
+        _subject: &Subject,
+        options: &Options,
+        report: Report,
+        progress: &dyn Fn(&str),
+    ) -> Result<Report, ExperimentError> {
+        run(options, report, progress)
+    }
 }

@@ -38,13 +38,14 @@ pub(super) fn run(
             .map_err(|e| ExperimentError::Unsuitable(format!("cannot start {threads} threads: {e}")))?;
         let (image, timing) = pool.install(|| {
             let mut image = None;
-            let mut times = Vec::new();
-            for repeat in 0..options.repeats.max(1) {
-                let (rendered, ms) = render(subject, &RenderSettings { seed: repeat as u64, ..settings.clone() });
-                times.push(ms);
-                image.get_or_insert(rendered);
-            }
-            (image.expect("at least one run"), Timing::of(&times))
+            let timing = crate::measure::time_each(
+                options.repeats,
+                |repeat| render(subject, &RenderSettings { seed: repeat as u64, ..settings.clone() }),
+                |rendered| {
+                    image.get_or_insert(rendered);
+                },
+            );
+            (image.expect("at least one run"), timing)
         });
         let (same, speedup) = match &first {
             Some((one, one_time)) => {
@@ -101,4 +102,35 @@ pub(super) fn run(
     report.series.push(series);
     report.tables.push(table);
     Ok(report)
+}
+
+/// The `threads` knob.
+pub(super) struct Threads;
+
+impl super::Knob for Threads {
+    fn name(&self) -> &'static str {
+        "threads"
+    }
+
+    fn about(&self) -> &'static str {
+        "Worker threads: render time, and the same bits at every count."
+    }
+
+    fn question(&self) -> &'static str {
+        "what do worker threads buy in render time, and is the image the same bits at every count?"
+    }
+
+    fn scenes(&self) -> super::Scenes {
+        super::Scenes::Subject(&[super::CORNELL])
+    }
+
+    fn run(
+        &self,
+        subject: &Subject,
+        options: &Options,
+        report: Report,
+        progress: &dyn Fn(&str),
+    ) -> Result<Report, ExperimentError> {
+        run(subject, options, report, progress)
+    }
 }
