@@ -2,14 +2,13 @@
 //! framework this toolkit comes from (`at`, `load`, `raytracer`, `algo`,
 //! `commit`, `run`, ...), as scripts and at a prompt.
 //!
-//! - [`parse`] turns a line into a command, or says what it expects;
+//! - the language itself, each line parsed into a command and the course's
+//!   BRDF names as our materials, is the `rtgi-script` library (pure code,
+//!   fuzzed there);
 //! - [`session`] holds what the commands set up and runs them, rendering
 //!   through `rtgi render`'s own code;
-//! - [`brdf`] realises the course's BRDF names as our materials;
 //! - this file reads scripts line by line and runs the prompt.
 
-mod brdf;
-mod parse;
 mod session;
 
 use std::path::PathBuf;
@@ -130,5 +129,15 @@ fn prompt(session: &mut Session) -> Result<()> {
             Err(rustyline::error::ReadlineError::Interrupted | rustyline::error::ReadlineError::Eof) => return Ok(()),
             Err(error) => return Err(error.into()),
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    /// `resolution` refuses what `rtgi render --width/--height` would: the
+    /// library keeps its own bound, since it knows no command line.
+    #[test]
+    fn a_script_resolution_has_the_command_lines_bound() {
+        assert_eq!(rtgi_script::MAX_RESOLUTION, crate::cli::MAX_IMAGE_SIDE);
     }
 }
