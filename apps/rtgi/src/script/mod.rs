@@ -2,14 +2,13 @@
 //! framework this toolkit comes from (`at`, `load`, `raytracer`, `algo`,
 //! `commit`, `run`, ...), as scripts and at a prompt.
 //!
-//! - [`parse`] turns a line into a command, or says what it expects;
+//! - the language itself, each line parsed into a command and the course's
+//!   BRDF names as our materials, is the `rtgi-script` library (pure code,
+//!   fuzzed there);
 //! - [`session`] holds what the commands set up and runs them, rendering
 //!   through `rtgi render`'s own code;
-//! - [`brdf`] realises the course's BRDF names as our materials;
 //! - this file reads scripts line by line and runs the prompt.
 
-mod brdf;
-mod parse;
 mod session;
 
 use std::path::PathBuf;

@@ -14,9 +14,11 @@ use rtgi_accel::{Accel, AccelKind, BuildParams, SahAxes};
 use rtgi_math::{Mat3, Mat4, Vec3};
 use rtgi_render::BounceSampling;
 use rtgi_scene::{ColorEncoding, Scene, Texture, TextureId};
+use rtgi_script::{
+    Algo, BvhCommand, Command, CourseBrdf, CourseSplit, DirectSampling, MaterialCommand, PathSetting, Tracer,
+    course_roughness, our_roughness,
+};
 
-use super::brdf::{CourseBrdf, course_roughness, our_roughness};
-use super::parse::{Algo, BvhCommand, Command, CourseSplit, DirectSampling, MaterialCommand, PathSetting, Tracer};
 use rtgi_image::ToneOperator;
 use rtgi_job::{Denoise, Given, ImageSize, RenderRequest, SceneSource, Structure, Tone};
 use rtgi_render::recipe::CameraChoice;
@@ -236,7 +238,7 @@ impl Session {
         if !trimmed.is_empty() && trimmed != "history" {
             self.history.push(trimmed.to_owned());
         }
-        let command = super::parse::parse(line).map_err(|e| anyhow!(e))?;
+        let command = rtgi_script::parse(line).map_err(|e| anyhow!(e))?;
         self.clock.now += 1;
         self.apply(command)
     }

@@ -9,23 +9,37 @@ use rtgi_scene::{Material, SurfaceModel};
 
 /// A BRDF by the course's name.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub(crate) enum CourseBrdf {
+pub enum CourseBrdf {
+    /// `lambert`: diffuse.
     Lambert,
+    /// `mirror` (also `specular`): a perfect mirror.
     Mirror,
+    /// `dielectric-specular`: smooth glass, reflecting and refracting.
     DielectricSpecular,
+    /// `thin-dielectric-specular`: a thin sheet of glass, refracting without bending.
     ThinDielectricSpecular,
+    /// `phong`: a glossy Phong lobe.
     Phong,
+    /// `layered-phong`: a diffuse base under a Phong lobe.
     LayeredPhong,
+    /// `gtr2`: a GGX microfacet lobe.
     Gtr2,
+    /// `layered-gtr2`: a diffuse base under a GGX lobe.
     LayeredGtr2,
 }
 
+/// A BRDF name the course does not have.
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+#[error("No such brdf defined: {0} (one of {names})", names = CourseBrdf::NAMES)]
+pub struct UnknownBrdf(pub String);
+
 impl CourseBrdf {
     /// The names, for messages.
-    pub(crate) const NAMES: &'static str =
+    pub const NAMES: &'static str =
         "lambert, mirror, dielectric-specular, thin-dielectric-specular, phong, layered-phong, gtr2, layered-gtr2";
 
-    pub(crate) fn from_name(name: &str) -> Result<Self, String> {
+    /// The BRDF the course calls `name` (and `specular`, an older name of `mirror`).
+    pub fn from_name(name: &str) -> Result<Self, UnknownBrdf> {
         Ok(match name {
             "lambert" => CourseBrdf::Lambert,
             "mirror" | "specular" => CourseBrdf::Mirror,
@@ -35,11 +49,12 @@ impl CourseBrdf {
             "layered-phong" => CourseBrdf::LayeredPhong,
             "gtr2" => CourseBrdf::Gtr2,
             "layered-gtr2" => CourseBrdf::LayeredGtr2,
-            _ => return Err(format!("No such brdf defined: {name} (one of {})", Self::NAMES)),
+            _ => return Err(UnknownBrdf(name.to_owned())),
         })
     }
 
-    pub(crate) fn name(self) -> &'static str {
+    /// The course's name of it.
+    pub fn name(self) -> &'static str {
         match self {
             CourseBrdf::Lambert => "lambert",
             CourseBrdf::Mirror => "mirror",
@@ -54,7 +69,7 @@ impl CourseBrdf {
 
     /// How the material rtgi renders for this BRDF reflects differently
     /// from the course's model; `None` where it is the same model.
-    pub(crate) fn difference(self) -> Option<&'static str> {
+    pub fn difference(self) -> Option<&'static str> {
         match self {
             CourseBrdf::Lambert
             | CourseBrdf::Mirror
@@ -81,7 +96,7 @@ impl CourseBrdf {
 
     /// Makes `material` reflect as this BRDF with the course's `albedo`
     /// and `roughness` (the GGX width), keeping its index of refraction.
-    pub(crate) fn realise(self, albedo: Vec3, roughness: f32, material: &mut Material) {
+    pub fn realise(self, albedo: Vec3, roughness: f32, material: &mut Material) {
         let ior = material.ior;
         let rough = our_roughness(roughness);
         let normal_incidence = ((ior - 1.0) / (ior + 1.0)).powi(2);
@@ -111,12 +126,12 @@ impl CourseBrdf {
 /// Our roughness (perceptual, the square root of the GGX width) for the
 /// course's roughness (the GGX width itself, as its MTL import
 /// sqrt(2 / (Ns + 2)) gives it, and as ours gives alpha).
-pub(crate) fn our_roughness(course: f32) -> f32 {
+pub fn our_roughness(course: f32) -> f32 {
     course.max(0.0).sqrt()
 }
 
 /// The course's roughness for ours.
-pub(crate) fn course_roughness(ours: f32) -> f32 {
+pub fn course_roughness(ours: f32) -> f32 {
     ours * ours
 }
 
@@ -130,7 +145,7 @@ mod tests {
             assert_eq!(CourseBrdf::from_name(name).unwrap().name(), name);
         }
         assert_eq!(CourseBrdf::from_name("specular").unwrap(), CourseBrdf::Mirror);
-        assert!(CourseBrdf::from_name("velvet").unwrap_err().starts_with("No such brdf defined: velvet"));
+        assert!(CourseBrdf::from_name("velvet").unwrap_err().to_string().starts_with("No such brdf defined: velvet"));
     }
 
     #[test]

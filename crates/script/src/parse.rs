@@ -1,231 +1,66 @@
-//! The course framework's command language, one line at a time: each line
-//! becomes a [`Command`] or an error saying what the command expects. The
-//! parser knows only the syntax; what the commands do is the session's
-//! business ([`super::session`]).
-
-use std::path::PathBuf;
+//! Text to [`Command`]s, one line at a time: a line becomes a command or a
+//! [`ParseError`] saying what the command expects. The parser knows only
+//! the syntax and the ranges the course allows; whether a command makes
+//! sense now (a `run` before a `commit`, say) is the interpreter's to say.
 
 use rtgi_accel::AccelKind;
 use rtgi_math::{Mat4, Vec3};
 use rtgi_render::BounceSampling;
 
-use super::brdf::CourseBrdf;
-use rtgi_job::MAX_IMAGE_SIDE as MAX_SIDE;
+use crate::brdf::CourseBrdf;
+use crate::command::{Algo, BvhCommand, Command, CourseSplit, DirectSampling, MaterialCommand, PathSetting, Tracer};
 
-/// One line of a script.
-#[derive(Clone, Debug, PartialEq)]
-pub(crate) enum Command {
-    /// A blank line or a comment (`#`, `//`).
-    Nothing,
-    /// `at [X Y Z]`: the camera's position, or print it.
-    At(Option<Vec3>),
-    /// `look [X Y Z]`: the camera's direction, or print it.
-    Look(Option<Vec3>),
-    /// `up [X Y Z]`: the scene's up (and the camera's, unless `camup` set it), or print it.
-    Up(Option<Vec3>),
-    /// `camup [X Y Z]`: the camera's up, or print it.
-    CamUp(Option<Vec3>),
-    /// `print-cam`.
-    PrintCam,
-    /// `load FILE [NAME]`: adds a file's meshes to the scene.
-    Load { file: PathBuf, name: Option<String> },
-    /// `modelpath DIR`: a folder `load` also looks in.
-    ModelPath(PathBuf),
-    /// `modelmatrix` with 16 numbers, column by column as the framework's
-    /// glm reads them (the translation last): the transform of later loads.
-    ModelMatrix(Mat4),
-    /// `modeltrafo ...`: multiplies the transform of later loads.
-    ModelTrafo(Mat4),
-    /// `resolution W H`.
-    Resolution(u32, u32),
-    /// `sppx N`: samples per pixel.
-    Sppx(u32),
-    /// `outfile FILE`: where `run` writes.
-    Outfile(PathBuf),
-    /// `commit`: builds the acceleration structure over the scene.
-    Commit,
-    /// `run`: renders and writes the image.
-    Run,
-    /// `raytracer NAME ...`.
-    Raytracer(Tracer),
-    /// `bvh ...`: the BVH plug-in's settings and reports.
-    Bvh(BvhCommand),
-    /// `algo NAME`.
-    Algo(Algo),
-    /// `is uniform|cosine|light|brdf`: how `algo direct` samples.
-    Is(DirectSampling),
-    /// `path ...`: the path tracers' settings.
-    Path(PathSetting),
-    /// `material ...`.
-    Material(MaterialCommand),
-    /// `default-brdf NAME`: the BRDF of materials loaded later.
-    DefaultBrdf(CourseBrdf),
-    /// `pointlight [replace] pos X Y Z col R G B`.
-    PointLight { replace: bool, position: Vec3, colour: Vec3 },
-    /// `skylight load FILE SCALE`.
-    SkylightLoad { file: PathBuf, scale: f32 },
-    /// `skylight scale S`.
-    SkylightScale(f32),
-    /// `echo TEXT`.
-    Echo(String),
-    /// `stats print`.
-    StatsPrint,
-    /// `stats clear`.
-    StatsClear,
-    /// `mem-stats`.
-    MemStats,
-    /// `history`.
-    History,
-    /// `quit` or `exit`.
-    Quit,
-    /// `omp on|off`: all cores, or one thread.
-    Omp(bool),
-    /// `platform [NAME]`: only `cpu` and `none` (the same here) exist.
-    Platform(Option<String>),
-    /// `denoise on|off`.
-    Denoise(bool),
-    /// `disable FEATURE`: `with FEATURE { }` blocks are then skipped.
-    Disable(String),
-    /// `with gl|cuda|optix {`: a block for a feature.
-    With(String),
-    /// `}`: the end of a `with` block.
-    EndBlock,
-    /// A command of the framework's for something rtgi does not have (the
-    /// preview window, wavefront steps, the sky's debug output): said in
-    /// one line, and the script goes on.
-    Unavailable { command: &'static str, feature: &'static str },
-    /// `algo primary-wf|direct-wf`: a wavefront algorithm, rendered by its
-    /// CPU counterpart.
-    WavefrontAlgo { name: &'static str, instead: Algo },
+/// The widest and tallest image `resolution` accepts: a render's own
+/// bound ([`rtgi_job::MAX_IMAGE_SIDE`]), beyond which a typo (an extra
+/// zero) would ask for gigabytes of memory and hours of rendering.
+pub const MAX_RESOLUTION: u32 = rtgi_job::MAX_IMAGE_SIDE;
+
+/// A line that is not a command of the language: which command it names
+/// and what that command expects instead. Its message is what is wrong;
+/// the caller, who knows the file and the line's number, says where.
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+#[error("{problem}")]
+pub struct ParseError {
+    command: String,
+    problem: String,
 }
 
-/// `raytracer NAME`.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub(crate) enum Tracer {
-    /// `seq`: the linear scan.
-    Seq,
-    /// `naive-bvh`: object median, one triangle a leaf.
-    NaiveBvh,
-    /// `bbvh [om|sm|sah [NPLANES]]` (and the framework's `indexed`/`esc`
-    /// layouts, which change nothing here): the binary BVH.
-    Bbvh(Option<(CourseSplit, Option<u32>)>),
-    /// `embree` (and `embree-alpha`).
-    Embree,
-    /// One of ours by its own name: `bvh4`, `bvh8`, `sah`, `sah-sweep`, ...
-    Ours(AccelKind),
-}
+impl ParseError {
+    /// The command's name as the line spells it (the first word), known or not.
+    pub fn command(&self) -> &str {
+        &self.command
+    }
 
-/// The course's split methods.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub(crate) enum CourseSplit {
-    ObjectMedian,
-    SpatialMedian,
-    Sah,
-}
-
-/// `bvh ...`.
-#[derive(Clone, Debug, PartialEq)]
-pub(crate) enum BvhCommand {
-    /// `bvh om|sm|sah [NPLANES]`.
-    Split(CourseSplit, Option<u32>),
-    /// `bvh triangles single|multiple N`: the most triangles a leaf holds.
-    LeafSize(u32),
-    /// `bvh statistics`.
-    Statistics,
-    /// `bvh export DEPTH FILE.obj`.
-    Export { depth: usize, file: PathBuf },
-}
-
-/// `algo NAME`.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub(crate) enum Algo {
-    Primary,
-    Info,
-    Local,
-    Direct,
-    DirectMis,
-    SimplePt,
-    Pt,
-}
-
-impl Algo {
-    /// The name the course gives it.
-    pub(crate) fn name(self) -> &'static str {
-        match self {
-            Algo::Primary => "primary",
-            Algo::Info => "info",
-            Algo::Local => "local",
-            Algo::Direct => "direct",
-            Algo::DirectMis => "direct/mis",
-            Algo::SimplePt => "simple-pt",
-            Algo::Pt => "pt",
-        }
+    /// What is wrong, as the message says it.
+    pub fn problem(&self) -> &str {
+        &self.problem
     }
 }
 
-/// `is uniform|cosine|light|brdf`.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub(crate) enum DirectSampling {
-    Uniform,
-    Cosine,
-    Light,
-    Brdf,
-    /// Light and BRDF samples weighed (older scripts of the course say
-    /// `is mis` for what `algo direct/mis` does).
-    Mis,
-}
-
-impl DirectSampling {
-    pub(crate) fn name(self) -> &'static str {
-        match self {
-            DirectSampling::Uniform => "uniform",
-            DirectSampling::Cosine => "cosine",
-            DirectSampling::Light => "light",
-            DirectSampling::Brdf => "brdf",
-            DirectSampling::Mis => "mis",
-        }
-    }
-}
-
-/// `path ...`.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub(crate) enum PathSetting {
-    /// `path len N`: rays a path traces at most.
-    Length(u32),
-    /// `path rr-start N`: bounces before Russian roulette.
-    RouletteStart(u32),
-    /// `path bounce uniform|cosine|brdf`.
-    Bounce(BounceSampling),
-    /// `path mis on|off`.
-    Mis(bool),
-}
-
-/// `material ...`.
-#[derive(Clone, Debug, PartialEq)]
-pub(crate) enum MaterialCommand {
-    List,
-    Select(String),
-    Blacklist(String),
-    Albedo(Vec3),
-    Emissive(Vec3),
-    Roughness(f32),
-    Ior(f32),
-    /// `texture FILE` or `texture drop` (`None`).
-    Texture(Option<PathBuf>),
-    Brdf(CourseBrdf),
-    Show,
-}
-
-/// Parses one line. The error says what the command expects; the caller
-/// adds the file, the line and the command's name.
-pub(crate) fn parse(line: &str) -> Result<Command, String> {
+/// Parses one line. Blank lines and comments (`#`, `//`) are
+/// [`Command::Nothing`]; anything else is a command or an error naming it.
+///
+/// ```
+/// use rtgi_script::{Command, parse};
+/// use rtgi_math::Vec3;
+///
+/// assert_eq!(parse("at 0 1 2")?, Command::At(Some(Vec3::new(0.0, 1.0, 2.0))));
+/// let error = parse("sppx many").unwrap_err();
+/// assert_eq!((error.command(), error.to_string().as_str()), ("sppx", "expects one positive whole number (got 'many')"));
+/// # Ok::<(), rtgi_script::ParseError>(())
+/// ```
+pub fn parse(line: &str) -> Result<Command, ParseError> {
     let line = line.trim();
-    let mut words = line.split_whitespace();
-    let Some(name) = words.next() else { return Ok(Command::Nothing) };
+    let Some(name) = line.split_whitespace().next() else { return Ok(Command::Nothing) };
+    command(name, line).map_err(|problem| ParseError { command: name.to_owned(), problem })
+}
+
+/// The command `name`, the first word of `line`; the error says what it expects.
+fn command(name: &str, line: &str) -> Result<Command, String> {
     if name.starts_with('#') || name.starts_with("//") {
         return Ok(Command::Nothing);
     }
-    let words: Vec<&str> = words.collect();
+    let words: Vec<&str> = line.split_whitespace().skip(1).collect();
     // The text after the command's name, as typed (names may hold spaces).
     let rest = line[name.len()..].trim();
     let none = |command: Command| if words.is_empty() { Ok(command) } else { Err("takes no arguments".to_owned()) };
@@ -254,8 +89,8 @@ pub(crate) fn parse(line: &str) -> Result<Command, String> {
         "modeltrafo" => model_trafo(&words).map(Command::ModelTrafo),
         "resolution" => match words[..] {
             [w, h] => match (positive_int(w), positive_int(h)) {
-                (Some(w), Some(h)) if w <= MAX_SIDE && h <= MAX_SIDE => Ok(Command::Resolution(w, h)),
-                _ => Err(format!("expects two whole numbers from 1 to {MAX_SIDE}, W H (got '{rest}')")),
+                (Some(w), Some(h)) if w <= MAX_RESOLUTION && h <= MAX_RESOLUTION => Ok(Command::Resolution(w, h)),
+                _ => Err(format!("expects two whole numbers from 1 to {MAX_RESOLUTION}, W H (got '{rest}')")),
             },
             _ => Err("expects two positive whole numbers, W H".to_owned()),
         },
@@ -280,7 +115,7 @@ pub(crate) fn parse(line: &str) -> Result<Command, String> {
         "path" => path(&words).map(Command::Path),
         "material" => material(&words, rest).map(Command::Material),
         "default-brdf" => match words[..] {
-            [name] => CourseBrdf::from_name(name).map(Command::DefaultBrdf),
+            [name] => CourseBrdf::from_name(name).map_err(|e| e.to_string()).map(Command::DefaultBrdf),
             _ => Err(format!("expects one BRDF name: {}", CourseBrdf::NAMES)),
         },
         "pointlight" => point_light(&words),
@@ -602,7 +437,7 @@ fn material(words: &[&str], rest: &str) -> Result<MaterialCommand, String> {
             _ => Err("texture expects one file name (no spaces) or 'drop'".to_owned()),
         },
         "brdf" => match args {
-            [name] => CourseBrdf::from_name(name).map(MaterialCommand::Brdf),
+            [name] => CourseBrdf::from_name(name).map_err(|e| e.to_string()).map(MaterialCommand::Brdf),
             _ => Err(format!("brdf expects one BRDF name: {}", CourseBrdf::NAMES)),
         },
         "show" if args.is_empty() => Ok(MaterialCommand::Show),
@@ -697,7 +532,8 @@ mod tests {
             ("path len 1025", "from 1 to 1024"),
         ] {
             let error = parse(line).unwrap_err();
-            assert!(error.contains(expected), "{line}: {error}");
+            assert!(error.to_string().contains(expected), "{line}: {error}");
+            assert_eq!(error.command(), line.split_whitespace().next().unwrap(), "{line}");
         }
     }
 }
