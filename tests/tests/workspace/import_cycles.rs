@@ -15,7 +15,7 @@ const KNOWN: &[(&str, &[&str])] = &[
     // The scalar triangle tests and the SIMD kernels share hit types both ways.
     ("crates/accel", &["simd::packet_triangles", "simd::triangles", "triangle"]),
     // The options live in cli.rs and their behaviour in common.rs (issue 48).
-    ("apps/rtgi", &["cli", "common", "gallery_cmd", "merge_cmd", "rays_cmd", "render_cmd", "script", "trace_cmd"]),
+    ("apps/rtgi", &["cli", "common", "gallery_cmd", "merge_cmd", "rays_cmd", "render_cmd", "script"]),
 ];
 
 /// Every module of the crate at `crate_dir` (its `src`), by path (`simd::triangles`), with its source.
