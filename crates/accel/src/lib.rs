@@ -114,6 +114,7 @@ pub mod ray_file;
 pub mod simd;
 mod slab;
 mod triangle;
+mod triangle_hit;
 mod triangle_source;
 pub mod verify;
 mod wide;
@@ -141,7 +142,8 @@ pub use indexed_mesh::{IndexedMesh, IndexedMeshError};
 pub use kind::{AccelKind, BuildError, BuildParams, SahAxes};
 pub use linear::LinearScan;
 pub use primitive::{Primitive, PrimitiveHit, intersect_primitive};
-pub use triangle::{Intersector, TriangleHit};
+pub use triangle::Intersector;
+pub use triangle_hit::TriangleHit;
 pub use triangle_source::TriangleSource;
 pub use wide::{Bvh4, Bvh8, Bvh8Quantised, QuantisedNode, WideBvh, WideNode};
 

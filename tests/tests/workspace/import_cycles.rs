@@ -12,8 +12,6 @@ use rtgi_tests::workspace_root;
 
 /// The circles not yet cut, as sorted lists of module paths, by crate.
 const KNOWN: &[(&str, &[&str])] = &[
-    // The scalar triangle tests and the SIMD kernels share hit types both ways.
-    ("crates/accel", &["simd::packet_triangles", "simd::triangles", "triangle"]),
     // The options live in cli.rs and their behaviour in common.rs (issue 48).
     ("apps/rtgi", &["cli", "common", "gallery_cmd", "merge_cmd", "rays_cmd", "render_cmd", "script"]),
 ];
