@@ -1,12 +1,11 @@
 //! The command line: the commands (each command's options live in its own
 //! file, the groups they share in `options.rs`) and one-line parse errors.
 
-use std::path::PathBuf;
 use std::process::ExitCode;
 
-use clap::{Args, Parser, Subcommand};
+use clap::{Parser, Subcommand};
 
-use crate::options::{AccelArgs, OutputArgs, ThreadArgs, threads_from_environment};
+use crate::options::threads_from_environment;
 
 #[derive(Debug, Parser)]
 #[command(name = "rtgi", version, about = "Ray tracing and global illumination toolkit")]
@@ -38,7 +37,7 @@ pub(crate) enum Command {
     /// Render a scene to an image (.png or .exr)
     Render(crate::render_cmd::RenderArgs),
     /// Trace a batch of rays from a binary file and write their hits
-    Trace(TraceArgs),
+    Trace(crate::trace_cmd::TraceArgs),
     /// Write a ray file for 'rtgi trace': camera rays of a scene's view, random rays in its
     /// bounds, or rays leaving its surfaces
     Rays(crate::rays_cmd::RaysArgs),
@@ -71,49 +70,6 @@ pub(crate) enum Command {
     Script(crate::script::ScriptArgs),
     /// Open a prompt that takes the course framework's commands (after running any scripts given)
     Repl(crate::script::ScriptArgs),
-}
-
-/// `rtgi trace`: rays in, hits out, for tests and comparisons with other ray tracers.
-///
-/// Files are little-endian without a header. A ray is 8 × f32: origin x y z,
-/// direction x y z, t_min, t_max. A hit is 16 bytes: t (f32; +inf for a
-/// miss), triangle (u32; 0xFFFFFFFF for a miss), beta (f32), gamma (f32).
-/// With --any-hit, triangle is 0 when the ray is occluded and 0xFFFFFFFF when
-/// not, and t, beta and gamma are 0. Triangles are numbered in file order
-/// (an OBJ polygon becomes a fan of triangles, in order). The rays are read,
-/// traced and written in chunks, so a file of any size (or a stream) fits
-/// in memory; a ray with a NaN or infinite origin or direction, a zero
-/// direction or a NaN bound is refused, naming its index.
-#[derive(Debug, Args)]
-#[command(mut_arg("output", |arg| arg.visible_alias("out").help(
-    "Binary file of hits to write, 16 bytes each [default: RAYS.hits.bin, after the ray file, in the current folder]"
-)))]
-pub(crate) struct TraceArgs {
-    /// Scene file (.obj, .gltf, .glb or .toml)
-    pub(crate) scene: PathBuf,
-
-    /// Binary file of rays (32 bytes each)
-    #[arg(long)]
-    pub(crate) rays: PathBuf,
-
-    #[command(flatten)]
-    pub(crate) output: OutputArgs,
-
-    /// Answer whether each ray is occluded (any hit) instead of its closest hit
-    #[arg(long)]
-    pub(crate) any_hit: bool,
-
-    /// Trace cut-outs (alpha-masked and blended materials) as solid surfaces; by default
-    /// rays pass through their holes as in renders, and blended surfaces count where their
-    /// alpha exceeds one half
-    #[arg(long)]
-    pub(crate) no_alpha: bool,
-
-    #[command(flatten)]
-    pub(crate) accel: AccelArgs,
-
-    #[command(flatten)]
-    pub(crate) threads: ThreadArgs,
 }
 
 impl Command {

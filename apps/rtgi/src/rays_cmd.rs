@@ -4,13 +4,13 @@ use std::path::PathBuf;
 
 use anyhow::Result;
 use clap::{Args, ValueEnum};
+use rtgi_accel::ray_file::{RAY_BYTES, RayWriter};
 use rtgi_math::Ray;
 use rtgi_render::rays::{box_rays, primary_rays, surface_rays};
 
 use crate::common::{LoadedScene, choose_camera, load_scene, refuse_inputs_as_outputs, write_atomically};
 use crate::options::{AccelArgs, CameraArgs, OutputArgs, SeedArgs};
 use crate::output::outln;
-use crate::trace_cmd::RAY_BYTES;
 
 /// Which rays `rtgi rays` writes.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
@@ -78,12 +78,9 @@ pub(crate) fn run(args: &RaysArgs) -> Result<()> {
         RayKind::Random => box_rays(&scene, args.count as usize, args.seed.value),
         RayKind::Surface => surface_rays(&scene, args.count as usize, args.seed.value),
     };
-    let mut bytes = Vec::with_capacity(rays.len() * RAY_BYTES);
-    for ray in &rays {
-        let numbers = ray.origin.to_array().into_iter().chain(ray.direction.to_array()).chain([ray.t_min, ray.t_max]);
-        bytes.extend(numbers.flat_map(f32::to_le_bytes));
-    }
-    write_atomically(&output, &bytes)?;
+    let mut bytes = RayWriter::new(Vec::with_capacity(rays.len() * RAY_BYTES));
+    bytes.write_rays(&rays)?;
+    write_atomically(&output, &bytes.into_inner())?;
     outln!("wrote       {} ({} {:?} rays)", output.display(), rays.len(), args.kind)?;
     Ok(())
 }

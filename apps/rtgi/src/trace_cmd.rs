@@ -1,23 +1,64 @@
+//! `rtgi trace`: rays from a file, through the chosen structure, hits to a
+//! file (the format is `rtgi_accel::ray_file`'s).
+
 use std::fs::File;
-use std::io::{BufWriter, ErrorKind, Read, Write};
+use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use anyhow::{Context, Result, bail};
+use clap::Args;
 use rayon::prelude::*;
-use rtgi_accel::Accel;
-use rtgi_math::{Ray, Vec3};
+use rtgi_accel::ray_file::{self, HitWriter, RayReader};
+use rtgi_accel::{Accel, Hit, Ray};
 use rtgi_render::{AlphaTest, has_alpha};
 
-use crate::cli::TraceArgs;
 use crate::common::{LoadedScene, check_output_folder, load_scene, refuse_inputs_as_outputs};
+use crate::options::{AccelArgs, OutputArgs, ThreadArgs};
 
-/// Bytes of one ray in a ray file: 8 little-endian f32.
-pub(crate) const RAY_BYTES: usize = 32;
-/// Bytes of one hit in a hit file: t, triangle, beta, gamma.
-pub(crate) const HIT_BYTES: usize = 16;
-/// The triangle index of a miss.
-pub(crate) const MISS: u32 = u32::MAX;
+/// `rtgi trace`: rays in, hits out, for tests and comparisons with other ray tracers.
+///
+/// Files are little-endian without a header. A ray is 8 × f32: origin x y z,
+/// direction x y z, t_min, t_max. A hit is 16 bytes: t (f32; +inf for a
+/// miss), triangle (u32; 0xFFFFFFFF for a miss), beta (f32), gamma (f32).
+/// With --any-hit, triangle is 0 when the ray is occluded and 0xFFFFFFFF when
+/// not, and t, beta and gamma are 0. Triangles are numbered in file order
+/// (an OBJ polygon becomes a fan of triangles, in order). The rays are read,
+/// traced and written in chunks, so a file of any size (or a stream) fits
+/// in memory; a ray with a NaN or infinite origin or direction, a zero
+/// direction or a NaN bound is refused, naming its index.
+#[derive(Debug, Args)]
+#[command(mut_arg("output", |arg| arg.visible_alias("out").help(
+    "Binary file of hits to write, 16 bytes each [default: RAYS.hits.bin, after the ray file, in the current folder]"
+)))]
+pub(crate) struct TraceArgs {
+    /// Scene file (.obj, .gltf, .glb or .toml)
+    pub(crate) scene: PathBuf,
+
+    /// Binary file of rays (32 bytes each)
+    #[arg(long)]
+    pub(crate) rays: PathBuf,
+
+    #[command(flatten)]
+    pub(crate) output: OutputArgs,
+
+    /// Answer whether each ray is occluded (any hit) instead of its closest hit
+    #[arg(long)]
+    pub(crate) any_hit: bool,
+
+    /// Trace cut-outs (alpha-masked and blended materials) as solid surfaces; by default
+    /// rays pass through their holes as in renders, and blended surfaces count where their
+    /// alpha exceeds one half
+    #[arg(long)]
+    pub(crate) no_alpha: bool,
+
+    #[command(flatten)]
+    pub(crate) accel: AccelArgs,
+
+    #[command(flatten)]
+    pub(crate) threads: ThreadArgs,
+}
+
 /// The uniform number a blended surface's alpha is compared with: a ray
 /// file has no samples to average stochastic transparency over, so a
 /// blended surface counts where its alpha exceeds one half.
@@ -37,9 +78,10 @@ pub(crate) fn run(args: &TraceArgs) -> Result<()> {
     check_output_folder(&out)?;
     // The first chunk is read before the scene, so that a file that is no
     // ray file at all (`/dev/zero`, a picture) is refused at once.
-    let mut input = RayReader::open(&args.rays)?;
+    let mut input = open_rays(&args.rays)?;
+    let read_error = || args.rays.display().to_string();
     let mut rays = Vec::with_capacity(CHUNK_RAYS);
-    let mut more = input.next_chunk(&mut rays)?;
+    let mut more = input.next_chunk(&mut rays).with_context(read_error)?;
     let LoadedScene { scene, load_ms, .. } = load_scene(Some(&args.scene))?;
 
     let pool = args.threads.pool()?;
@@ -52,19 +94,19 @@ pub(crate) fn run(args: &TraceArgs) -> Result<()> {
         |triangle, beta, gamma| alpha_test.as_ref().is_none_or(|t| t.accepts(triangle, beta, gamma, BLEND_THRESHOLD));
     let filter: Option<&(dyn Fn(u32, f32, f32) -> bool + Sync)> = alpha_test.is_some().then_some(&accept);
 
-    let mut output = PartialFile::create(&out)?;
-    let mut hits = Vec::with_capacity(CHUNK_RAYS);
+    let mut output = HitWriter::new(PartialFile::create(&out)?);
+    let write_error = || format!("{}: cannot write", out.display());
     let (mut ray_count, mut hit_count, mut trace_s) = (0usize, 0usize, 0.0);
     while more {
         let trace_start = Instant::now();
-        pool.install(|| trace_chunk(accel.as_ref(), &rays, args.any_hit, filter, &mut hits));
+        let answers = pool.install(|| trace_chunk(accel.as_ref(), &rays, args.any_hit, filter));
         trace_s += trace_start.elapsed().as_secs_f64();
         ray_count += rays.len();
-        hit_count += hits.iter().filter(|h| h[4..8] != MISS.to_le_bytes()).count();
-        output.write_all(hits.as_flattened())?;
-        more = input.next_chunk(&mut rays)?;
+        hit_count += answers.hits();
+        answers.write_to(&mut output).with_context(write_error)?;
+        more = input.next_chunk(&mut rays).with_context(read_error)?;
     }
-    output.commit()?;
+    output.into_inner().commit()?;
 
     eprintln!("load   {load_ms:.1} ms ({} triangles)", scene.triangles.len());
     eprintln!("build  {build_ms:.1} ms ({})", accel.build_stats().variant);
@@ -92,144 +134,67 @@ pub(crate) fn run(args: &TraceArgs) -> Result<()> {
     Ok(())
 }
 
+/// The answers of one chunk of rays, in their order.
+enum Answers {
+    Closest(Vec<Option<Hit>>),
+    Occluded(Vec<bool>),
+}
+
+impl Answers {
+    /// Rays that hit something.
+    fn hits(&self) -> usize {
+        match self {
+            Answers::Closest(hits) => hits.iter().filter(|h| h.is_some()).count(),
+            Answers::Occluded(occluded) => occluded.iter().filter(|&&o| o).count(),
+        }
+    }
+
+    fn write_to<W: Write>(&self, out: &mut HitWriter<W>) -> std::io::Result<()> {
+        match self {
+            Answers::Closest(hits) => out.write_closest(hits),
+            Answers::Occluded(occluded) => out.write_occluded(occluded),
+        }
+    }
+}
+
 /// Traces `rays` through the batch queries, `BATCH_RAYS` at a time in
-/// parallel, with the hit filter if there is one (cut-outs), and puts
-/// their encoded hits in `hits`, in the same order.
+/// parallel, with the hit filter if there is one (cut-outs).
 fn trace_chunk(
     accel: &dyn Accel,
     rays: &[Ray],
     any_hit: bool,
     filter: Option<&(dyn Fn(u32, f32, f32) -> bool + Sync)>,
-    hits: &mut Vec<[u8; HIT_BYTES]>,
-) {
-    hits.clear();
-    hits.resize(rays.len(), [0; HIT_BYTES]);
-    rays.par_chunks(BATCH_RAYS).zip(hits.par_chunks_mut(BATCH_RAYS)).for_each(|(batch, encoded)| {
-        if any_hit {
-            let mut occluded = vec![false; batch.len()];
-            match filter {
-                Some(accept) => accel.occluded_batch_filtered(batch, &mut occluded, accept),
-                None => accel.occluded_batch(batch, &mut occluded),
-            }
-            for (out, &o) in encoded.iter_mut().zip(&occluded) {
-                *out = encode_hit(0.0, if o { 0 } else { MISS }, 0.0, 0.0);
-            }
-        } else {
-            let mut closest = vec![None; batch.len()];
-            match filter {
-                Some(accept) => accel.intersect_batch_filtered(batch, &mut closest, accept),
-                None => accel.intersect_batch(batch, &mut closest),
-            }
-            for (out, hit) in encoded.iter_mut().zip(&closest) {
-                *out = match hit {
-                    Some(h) => encode_hit(h.t, h.triangle, h.beta, h.gamma),
-                    None => encode_hit(f32::INFINITY, MISS, 0.0, 0.0),
-                };
-            }
-        }
-    });
-}
-
-/// Reads a ray file a chunk at a time, checking every record.
-struct RayReader {
-    path: PathBuf,
-    file: File,
-    /// Records read so far: the index of the next one.
-    records: usize,
-    buffer: Vec<u8>,
-}
-
-impl RayReader {
-    /// Opens a ray file; a regular file whose size is no multiple of a
-    /// record is refused here, before any work (a stream, at its end).
-    fn open(path: &Path) -> Result<Self> {
-        let file = File::open(path).with_context(|| format!("{}: cannot read", path.display()))?;
-        let metadata = file.metadata().with_context(|| format!("{}: cannot read", path.display()))?;
-        if metadata.is_dir() {
-            bail!("{}: is a directory, not a ray file", path.display());
-        }
-        if metadata.is_file() {
-            check_size(path, metadata.len())?;
-        }
-        Ok(RayReader { path: path.to_owned(), file, records: 0, buffer: vec![0; CHUNK_RAYS * RAY_BYTES] })
-    }
-
-    /// Replaces `rays` with the next chunk of the file; false at its end
-    /// (and `rays` empty).
-    fn next_chunk(&mut self, rays: &mut Vec<Ray>) -> Result<bool> {
-        rays.clear();
-        let mut filled = 0;
-        while filled < self.buffer.len() {
-            match self.file.read(&mut self.buffer[filled..]) {
-                Ok(0) => break,
-                Ok(n) => filled += n,
-                Err(e) if e.kind() == ErrorKind::Interrupted => {}
-                Err(e) => return Err(e).with_context(|| format!("{}: cannot read", self.path.display())),
-            }
-        }
-        if !filled.is_multiple_of(RAY_BYTES) {
-            // Only at the end of the file: the buffer holds whole records.
-            check_size(&self.path, (self.records * RAY_BYTES + filled) as u64)?;
-        }
-        for record in self.buffer[..filled].chunks_exact(RAY_BYTES) {
-            let ray = decode_ray(record).with_context(|| {
-                format!(
-                    "{}: not a ray file: ray {} (bytes {} to {}) is not a valid ray",
-                    self.path.display(),
-                    self.records,
-                    self.records * RAY_BYTES,
-                    (self.records + 1) * RAY_BYTES - 1
-                )
-            })?;
-            rays.push(ray);
-            self.records += 1;
-        }
-        Ok(!rays.is_empty())
+) -> Answers {
+    let batches = rays.par_chunks(BATCH_RAYS);
+    if any_hit {
+        let mut occluded = vec![false; rays.len()];
+        batches.zip(occluded.par_chunks_mut(BATCH_RAYS)).for_each(|(batch, out)| match filter {
+            Some(accept) => accel.occluded_batch_filtered(batch, out, accept),
+            None => accel.occluded_batch(batch, out),
+        });
+        Answers::Occluded(occluded)
+    } else {
+        let mut closest = vec![None; rays.len()];
+        batches.zip(closest.par_chunks_mut(BATCH_RAYS)).for_each(|(batch, out)| match filter {
+            Some(accept) => accel.intersect_batch_filtered(batch, out, accept),
+            None => accel.intersect_batch(batch, out),
+        });
+        Answers::Closest(closest)
     }
 }
 
-fn check_size(path: &Path, bytes: u64) -> Result<()> {
-    if !bytes.is_multiple_of(RAY_BYTES as u64) {
-        bail!(
-            "{}: not a ray file: its size, {bytes} bytes, is not a multiple of {RAY_BYTES} \
-             (a ray is 8 little-endian f32: origin, direction, t_min, t_max)",
-            path.display()
-        );
+/// Opens a ray file; a regular file whose size is no multiple of a record
+/// is refused here, before any work (a stream, at its end).
+fn open_rays(path: &Path) -> Result<RayReader<File>> {
+    let file = File::open(path).with_context(|| format!("{}: cannot read", path.display()))?;
+    let metadata = file.metadata().with_context(|| format!("{}: cannot read", path.display()))?;
+    if metadata.is_dir() {
+        bail!("{}: is a directory, not a ray file", path.display());
     }
-    Ok(())
-}
-
-/// The ray in one record: refused when it could only answer nonsense (a
-/// NaN or infinite origin or direction, a zero direction, a NaN bound). An
-/// empty range (`t_min > t_max`) is a ray that misses, and is kept.
-fn decode_ray(record: &[u8]) -> Result<Ray> {
-    let f: [f32; 8] = std::array::from_fn(|i| {
-        f32::from_le_bytes([record[4 * i], record[4 * i + 1], record[4 * i + 2], record[4 * i + 3]])
-    });
-    let ray = Ray::with_range(Vec3::new(f[0], f[1], f[2]), Vec3::new(f[3], f[4], f[5]), f[6], f[7]);
-    let v = |v: Vec3| format!("({}, {}, {})", v.x, v.y, v.z);
-    if !ray.origin.is_finite() {
-        bail!("its origin {} is not finite", v(ray.origin));
+    if metadata.is_file() {
+        ray_file::ray_count(metadata.len()).with_context(|| path.display().to_string())?;
     }
-    if !ray.direction.is_finite() {
-        bail!("its direction {} is not finite", v(ray.direction));
-    }
-    if ray.direction == Vec3::ZERO {
-        bail!("its direction is zero");
-    }
-    if ray.t_min.is_nan() || ray.t_max.is_nan() {
-        bail!("its range [{}, {}] is not a number", ray.t_min, ray.t_max);
-    }
-    Ok(ray)
-}
-
-fn encode_hit(t: f32, triangle: u32, beta: f32, gamma: f32) -> [u8; HIT_BYTES] {
-    let mut out = [0u8; HIT_BYTES];
-    out[0..4].copy_from_slice(&t.to_le_bytes());
-    out[4..8].copy_from_slice(&triangle.to_le_bytes());
-    out[8..12].copy_from_slice(&beta.to_le_bytes());
-    out[12..16].copy_from_slice(&gamma.to_le_bytes());
-    out
+    Ok(RayReader::new(file, CHUNK_RAYS))
 }
 
 /// An output file written as it is produced, through a temporary file
@@ -261,11 +226,6 @@ impl PartialFile {
         Ok(PartialFile { path: path.to_owned(), temporary, file: Some(BufWriter::new(file)) })
     }
 
-    fn write_all(&mut self, bytes: &[u8]) -> Result<()> {
-        let file = self.file.as_mut().expect("written only before commit");
-        file.write_all(bytes).with_context(|| format!("{}: cannot write", self.path.display()))
-    }
-
     /// Puts the complete file in place of `path`.
     fn commit(mut self) -> Result<()> {
         let file = self.file.take().expect("committed once");
@@ -275,6 +235,16 @@ impl PartialFile {
             None => file.map(drop),
         }
         .with_context(|| format!("{}: cannot write", self.path.display()))
+    }
+}
+
+impl Write for PartialFile {
+    fn write(&mut self, bytes: &[u8]) -> std::io::Result<usize> {
+        self.file.as_mut().expect("written only before commit").write(bytes)
+    }
+
+    fn flush(&mut self) -> std::io::Result<()> {
+        self.file.as_mut().expect("written only before commit").flush()
     }
 }
 

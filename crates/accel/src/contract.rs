@@ -32,9 +32,9 @@
 
 use rtgi_math::{Ray, Vec3, Vec3A};
 
-use crate::simd::triangles::LaneHits;
 use crate::slab::{BoxRay, RobustSlabs, SlabTest};
-use crate::triangle::{TriangleHit, TriangleTest, with_triangle_test};
+use crate::triangle::{TriangleTest, with_triangle_test};
+use crate::triangle_hit::{LaneHits, TriangleHit};
 use crate::{Accel, BuildStats, Counter, Hit, Intersector, NoCounter, TraversalCounters};
 
 /// Whether a triangle can ever be hit: all corners finite and a non-zero

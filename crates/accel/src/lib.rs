@@ -1,7 +1,7 @@
 //! Closest-hit and any-hit ray queries over a set of triangles, and over
 //! primitives of the user's own.
 //!
-//! This crate knows nothing about files, materials or shading: it is given
+//! This crate knows nothing about scene files, materials or shading: it is given
 //! triangle corner positions, in an order of the caller's choosing (a soup
 //! of corners, or an [`IndexedMesh`] of shared positions and index triples
 //! borrowed as they are: any [`TriangleSource`]), and
@@ -42,6 +42,10 @@
 //! let hit = bvh.intersect(&Ray::new(Vec3::new(0.75, 0.25, 1.0), -Vec3::Z)).unwrap();
 //! assert_eq!((hit.t, hit.triangle), (1.0, 0));
 //! ```
+//!
+//! Batches of rays from other programs, and their hits, travel as binary
+//! files read and written by [`ray_file`] (rays a chunk at a time, so a
+//! file of any size or a stream fits in memory).
 //!
 //! Primitives of the user's own (spheres, boxes, curves) implement
 //! [`Primitive`] (a box, optionally a centroid, and a ray test returning
@@ -106,9 +110,11 @@ mod indexed_mesh;
 mod kind;
 mod linear;
 mod primitive;
+pub mod ray_file;
 pub mod simd;
 mod slab;
 mod triangle;
+mod triangle_hit;
 mod triangle_source;
 pub mod verify;
 mod wide;
@@ -136,7 +142,8 @@ pub use indexed_mesh::{IndexedMesh, IndexedMeshError};
 pub use kind::{AccelKind, BuildError, BuildParams, SahAxes};
 pub use linear::LinearScan;
 pub use primitive::{Primitive, PrimitiveHit, intersect_primitive};
-pub use triangle::{Intersector, TriangleHit};
+pub use triangle::Intersector;
+pub use triangle_hit::TriangleHit;
 pub use triangle_source::TriangleSource;
 pub use wide::{Bvh4, Bvh8, Bvh8Quantised, QuantisedNode, WideBvh, WideNode};
 

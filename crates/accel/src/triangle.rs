@@ -6,18 +6,7 @@ use crate::exact;
 use crate::simd::arith;
 use crate::simd::packet_triangles::WatertightPacket;
 use crate::simd::triangles::{self, BlockHits, TriangleBlock};
-
-/// Where a ray hits a triangle: distance and barycentric coordinates of
-/// the second and third corners (the first corner's is `1 - beta - gamma`).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct TriangleHit {
-    /// Distance along the ray, in multiples of its direction.
-    pub t: f32,
-    /// Barycentric coordinate of the second corner.
-    pub beta: f32,
-    /// Barycentric coordinate of the third corner.
-    pub gamma: f32,
-}
+use crate::triangle_hit::TriangleHit;
 
 /// The ray/triangle tests on offer.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
@@ -171,27 +160,6 @@ impl TriangleTest for MollerTrumbore {
 
 pub(crate) struct Watertight;
 
-impl Watertight {
-    /// Section 3 of Woop et al.: `kz` is the dimension where the direction
-    /// is largest in magnitude; `kx`, `ky` follow cyclically and swap when
-    /// `d[kz] < 0`, so that the winding of triangles is preserved. Returns
-    /// `[kx, ky, kz]`.
-    #[inline(always)]
-    pub(crate) fn axes(direction: Vec3A) -> [usize; 3] {
-        let d = direction.to_array();
-        let a = direction.abs().to_array();
-        let kz = if a[0] >= a[1] && a[0] >= a[2] {
-            0
-        } else if a[1] >= a[2] {
-            1
-        } else {
-            2
-        };
-        let (kx, ky) = ((kz + 1) % 3, (kz + 2) % 3);
-        if d[kz] < 0.0 { [ky, kx, kz] } else { [kx, ky, kz] }
-    }
-}
-
 /// The ray in the watertight test's frame: the axis where the direction is
 /// largest becomes z, and a shear maps the direction onto +z.
 pub(crate) struct WatertightRay {
@@ -206,12 +174,12 @@ pub(crate) struct WatertightRay {
 impl TriangleTest for Watertight {
     type Ray = WatertightRay;
 
-    /// The axes of [`Watertight::axes`] and the shear that maps the
+    /// The axes of [`arith::watertight_axes`] and the shear that maps the
     /// direction onto +z.
     #[inline(always)]
     fn prepare(origin: Vec3A, direction: Vec3A) -> Self::Ray {
         let d = direction.to_array();
-        let [kx, ky, kz] = Watertight::axes(direction);
+        let [kx, ky, kz] = arith::watertight_axes(d);
         WatertightRay { origin, direction, axes: [kx, ky, kz], shear: [d[kx] / d[kz], d[ky] / d[kz], 1.0 / d[kz]] }
     }
 

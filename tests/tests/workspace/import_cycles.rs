@@ -11,28 +11,7 @@ use std::path::Path;
 use rtgi_tests::workspace_root;
 
 /// The circles not yet cut, as sorted lists of module paths, by crate.
-const KNOWN: &[(&str, &[&str])] = &[
-    // The scalar triangle tests and the SIMD kernels share hit types both ways.
-    ("crates/accel", &["simd::packet_triangles", "simd::triangles", "triangle"]),
-    // The options live in cli.rs and their behaviour in common.rs (issue 48); the commands that own
-    // their Args join it while they still take shared option groups from cli.rs.
-    (
-        "apps/rtgi",
-        &[
-            "bench_cmd",
-            "cli",
-            "common",
-            "effects_cmd",
-            "experiment_cmd",
-            "gallery_cmd",
-            "merge_cmd",
-            "rays_cmd",
-            "render_cmd",
-            "script",
-            "trace_cmd",
-        ],
-    ),
-];
+const KNOWN: &[(&str, &[&str])] = &[];
 
 /// Every module of the crate at `crate_dir` (its `src`), by path (`simd::triangles`), with its source.
 fn modules(crate_dir: &Path) -> BTreeMap<String, String> {
@@ -63,40 +42,109 @@ fn modules(crate_dir: &Path) -> BTreeMap<String, String> {
     found
 }
 
-/// The modules each module names through `crate::` or `super::`, outside
-/// comments and its tests.
+/// The paths a use tree names, from the text after `prefix::` (as `a::b`,
+/// `a::{b, c::{d, e}}` or `a::b as c`): every leaf path, its groups expanded.
+fn use_paths(text: &str) -> Vec<Vec<String>> {
+    fn tree(chars: &mut std::iter::Peekable<std::str::Chars<'_>>, base: &[String], out: &mut Vec<Vec<String>>) {
+        let mut path = base.to_vec();
+        let mut word = String::new();
+        loop {
+            match chars.peek().copied() {
+                Some(c) if c.is_ascii_alphanumeric() || c == '_' => {
+                    word.push(c);
+                    chars.next();
+                }
+                Some(':') => {
+                    chars.next();
+                    if chars.peek() == Some(&':') {
+                        chars.next();
+                    }
+                    if !word.is_empty() {
+                        path.push(std::mem::take(&mut word));
+                    }
+                }
+                Some('{') => {
+                    chars.next();
+                    loop {
+                        while chars.peek().is_some_and(|c| c.is_whitespace() || *c == ',') {
+                            chars.next();
+                        }
+                        if chars.peek().is_none_or(|c| *c == '}') {
+                            chars.next();
+                            return;
+                        }
+                        tree(chars, &path, out);
+                    }
+                }
+                Some(c) if c.is_whitespace() => {
+                    // `as name`, or the end of a path in code.
+                    chars.next();
+                    if !word.is_empty() {
+                        path.push(std::mem::take(&mut word));
+                    }
+                    while chars.peek().is_some_and(|c| *c != ',' && *c != '}' && *c != ';') {
+                        chars.next();
+                    }
+                    out.push(path);
+                    return;
+                }
+                _ => {
+                    if !word.is_empty() {
+                        path.push(word);
+                    }
+                    out.push(path);
+                    return;
+                }
+            }
+        }
+    }
+    let mut out = Vec::new();
+    tree(&mut text.chars().peekable(), &[], &mut out);
+    out
+}
+
+/// The modules each module names through `crate::` or `super::` paths
+/// (use groups expanded, `super::super::` climbed), outside comments and
+/// its tests. A module's own children are its parts: declaring,
+/// re-exporting or listing them (`mod.rs` as a facade, a registry of knobs)
+/// is not an import, so a child's `super::` back to its parent is no circle;
+/// two siblings that name each other are.
 fn dependencies(modules: &BTreeMap<String, String>) -> BTreeMap<String, BTreeSet<String>> {
     let mut graph = BTreeMap::new();
     for (name, source) in modules {
         let code = source.split("#[cfg(test)]").next().unwrap_or("");
+        let code: String = code
+            .lines()
+            .filter(|l| !l.trim_start().starts_with("//"))
+            .map(|l| l.split(" // ").next().unwrap_or(l))
+            .collect::<Vec<_>>()
+            .join("\n");
+        let mut parent: Vec<String> = name.split("::").map(str::to_owned).collect();
+        parent.pop();
         let mut named = BTreeSet::new();
-        for line in code.lines().filter(|l| !l.trim_start().starts_with("//")) {
-            for (prefix, base) in [
-                ("crate::", Vec::new()),
-                ("super::", {
-                    let mut parent: Vec<&str> = name.split("::").collect();
-                    parent.pop();
-                    parent
-                }),
-            ] {
-                for (at, _) in line.match_indices(prefix) {
-                    // `$crate::` in macros names the crate too.
-                    let path: Vec<&str> = line[at + prefix.len()..]
-                        .split(|c: char| !(c.is_ascii_alphanumeric() || c == '_' || c == ':'))
-                        .next()
-                        .unwrap_or("")
-                        .split("::")
-                        .collect();
-                    let mut full: Vec<&str> = base.clone();
-                    full.extend(path);
-                    // The longest prefix that is a module.
-                    if let Some(module) =
-                        (1..=full.len()).rev().map(|k| full[..k].join("::")).find(|m| modules.contains_key(m))
-                        && &module != name
-                    {
-                        named.insert(module);
-                    }
+        let mut name_paths = |base: &[String], text: &str| {
+            for path in use_paths(text) {
+                let mut full: Vec<String> = base.to_vec();
+                full.extend(path);
+                // The longest prefix that is a module.
+                if let Some(module) =
+                    (1..=full.len()).rev().map(|k| full[..k].join("::")).find(|m| modules.contains_key(m))
+                    && &module != name
+                {
+                    named.insert(module);
                 }
+            }
+        };
+        for (prefix, base) in [("crate::", Vec::new()), ("super::", parent.clone())] {
+            for (at, _) in code.match_indices(prefix) {
+                // `$crate::` in macros names the crate too; `super::super::` climbs twice.
+                let mut rest = &code[at + prefix.len()..];
+                let mut base = base.clone();
+                while prefix == "super::" && rest.starts_with("super::") {
+                    base.pop();
+                    rest = &rest["super::".len()..];
+                }
+                name_paths(&base, rest);
             }
         }
         graph.insert(name.clone(), named);
@@ -186,14 +234,23 @@ fn a_circle_is_found_through_crate_and_super_paths() {
         ("d::e", "use super::f::X;"),
         ("d::f", "use crate::d::e::Y;"),
         ("g", "use crate::a;"),
+        // Grouped imports, across lines, and a grandparent's sibling.
+        ("h::i", "use super::{\n    j::{self, Z},\n    k as other,\n};"),
+        ("h::j", "pub(crate) fn z() {}"),
+        ("h::k", "use crate::h::{m::deep::W};"),
+        ("h::m::deep", "fn w() { super::super::i::f() }"),
+        // A parent naming its children, and a child its parent: no circle.
+        ("n", "pub use o::P;\nmod o;"),
+        ("n::o", "use super::Q;"),
     ]
     .into_iter()
     .map(|(k, v)| (k.to_owned(), v.to_owned()))
     .collect();
     let found = circles(&dependencies(&modules));
-    let expected: BTreeSet<Vec<String>> = [vec!["a", "b", "c"], vec!["d::e", "d::f"]]
-        .into_iter()
-        .map(|c| c.into_iter().map(String::from).collect())
-        .collect();
+    let expected: BTreeSet<Vec<String>> =
+        [vec!["a", "b", "c"], vec!["d::e", "d::f"], vec!["h::i", "h::k", "h::m::deep"]]
+            .into_iter()
+            .map(|c| c.into_iter().map(String::from).collect())
+            .collect();
     assert_eq!(found, expected);
 }

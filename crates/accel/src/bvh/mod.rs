@@ -14,6 +14,7 @@ mod sah;
 mod spatial;
 mod split;
 mod traverse;
+mod tree;
 mod validate;
 
 pub use primitives::PrimitiveBvh;
@@ -109,7 +110,7 @@ impl BvhNode {
 /// copied anywhere: [`Bvh`] copies them into leaf order, the wide builds
 /// straight into their blocks.
 pub(crate) struct BinaryTree {
-    pub(crate) tree: build::Tree,
+    pub(crate) tree: tree::Tree,
     /// For each position of the leaf order, the triangle's index in the source.
     pub(crate) triangle_ids: Vec<u32>,
     /// Triangles left out because no ray can hit them ([`is_hittable`]).

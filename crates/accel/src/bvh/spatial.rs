@@ -36,10 +36,10 @@
 
 use rayon::prelude::*;
 
-use super::build::{HEURISTIC_DEPTH_LIMIT, Slot, Tree, layout};
 use super::median::object_median;
 use super::sah;
-use super::split::{BuildRef, Context, PrimRef, RangeBounds, Split};
+use super::split::{BuildRef, Context, HEURISTIC_DEPTH_LIMIT, PrimRef, RangeBounds, Split};
+use super::tree::{Slot, Tree, layout};
 use crate::boxa::BoxA;
 
 /// Spatial splits are tried where the object split's children overlap by

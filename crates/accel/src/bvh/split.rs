@@ -1,14 +1,21 @@
 //! What the split methods share: the primitives they reorder
 //! ([`BuildRef`]: [`PrimRef`] for triangles, [`CentredPrimRef`] for user
 //! primitives with centroids of their own), the bounds of a range of them ([`RangeBounds`]), the
-//! split they return ([`Split`]), and the read-only inputs of a build
-//! ([`Context`]). `build.rs`, `median.rs` and `sah.rs` all import this
-//! file, and none of them imports another's types.
+//! split they return ([`Split`]), the read-only inputs of a build
+//! ([`Context`]), and the depth below which the chosen method splits
+//! ([`HEURISTIC_DEPTH_LIMIT`]). `build.rs`, `spatial.rs`, `median.rs` and
+//! `sah.rs` all import this file, and it imports none of them.
 
 use rayon::prelude::*;
 use rtgi_math::{Vec3A, Vec4};
 
 use crate::boxa::BoxA;
+
+/// Below this depth the chosen method splits; deeper, the object median
+/// does, which halves the count at every level. Together these bound the
+/// depth by 64 + 32, within the traversal's fixed stack of
+/// `traverse::STACK_SIZE` entries.
+pub(crate) const HEURISTIC_DEPTH_LIMIT: usize = 64;
 
 /// How a node's primitives are divided between its two children.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

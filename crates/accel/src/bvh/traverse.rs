@@ -14,7 +14,7 @@ use crate::{Counter, Hit};
 
 /// Entries of the largest traversal stack. A stack holds at most one entry
 /// per level of the tree, and builds never exceed 64 + 32 levels (see
-/// `build::HEURISTIC_DEPTH_LIMIT`), so it cannot overflow. Shallower trees
+/// `split::HEURISTIC_DEPTH_LIMIT`), so it cannot overflow. Shallower trees
 /// use smaller stacks (see [`Bvh::closest`]): the stack is an array that is
 /// zeroed for every ray, and zeroing 512 bytes costs a tenth of the time of
 /// a primary ray on the bunny.

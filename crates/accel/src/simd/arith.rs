@@ -99,6 +99,26 @@ pub(crate) fn watertight_shear<L: Lanes>(relative: [[L; 3]; 3], shear: [f32; 3])
     [relative.map(|c| c[0] - sx * c[2]), relative.map(|c| c[1] - sy * c[2]), relative.map(|c| c[2] * sz)]
 }
 
+/// Section 3 of Woop et al.: `kz` is the dimension where the direction
+/// is largest in magnitude; `kx`, `ky` follow cyclically and swap when
+/// `d[kz] < 0`, so that the winding of triangles is preserved. Returns
+/// `[kx, ky, kz]`. The scalar test and the packet test choose their axes
+/// here, so a packet shares the permutation its rays would each choose.
+#[inline(always)]
+pub(crate) fn watertight_axes(direction: [f32; 3]) -> [usize; 3] {
+    let d = direction;
+    let a = direction.map(f32::abs);
+    let kz = if a[0] >= a[1] && a[0] >= a[2] {
+        0
+    } else if a[1] >= a[2] {
+        1
+    } else {
+        2
+    };
+    let (kx, ky) = ((kz + 1) % 3, (kz + 2) % 3);
+    if d[kz] < 0.0 { [ky, kx, kz] } else { [kx, ky, kz] }
+}
+
 /// The scaled barycentrics `(U, V, W)`: the 2D edge functions of the
 /// sheared corners. A shared edge gives exactly negated values in the two
 /// triangles (products commute and `x - y = -(y - x)` exactly).

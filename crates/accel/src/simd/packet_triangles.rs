@@ -15,19 +15,18 @@
 //! [`WatertightPacket::intersect_portable`] is its twin in plain Rust, lane
 //! by lane, which the tests hold it to.
 
-use rtgi_math::{Ray, Vec3A, Vec4};
+use rtgi_math::{Ray, Vec4};
 
 use super::arith;
 use super::packet::{Lanes, PACKET};
-use super::triangles::LaneHits;
-use crate::triangle::Watertight;
+use crate::triangle_hit::LaneHits;
 
 /// What one triangle against a packet's sixteen rays found.
 pub(crate) type PacketHits = LaneHits<Lanes>;
 
-/// The rays of a packet prepared for [`Watertight`] against one triangle
+/// The rays of a packet prepared for [`Watertight`](crate::triangle::Watertight) against one triangle
 /// at a time: they share the permutation of axes, and each lane holds its
-/// ray's permuted origin, shear and `t_min`, as [`Watertight::prepare`]
+/// ray's permuted origin, shear and `t_min`, as `Watertight::prepare`
 /// computes them. Lanes past the end repeat the first ray (the traversal
 /// drops their answers).
 #[derive(Clone, Copy, Debug)]
@@ -41,11 +40,11 @@ pub(crate) struct WatertightPacket {
 impl WatertightPacket {
     /// The packet of `rays` (1 to [`PACKET`] valid rays), or `None` when
     /// their permutations of axes differ. The shears are divided four
-    /// lanes at a time, as [`Watertight::prepare`] divides them one by one.
+    /// lanes at a time, as `Watertight::prepare` divides them one by one.
     #[inline(always)]
     pub(crate) fn new(rays: &[Ray]) -> Option<Self> {
         debug_assert!(!rays.is_empty() && rays.len() <= PACKET);
-        let axes = Watertight::axes(Vec3A::from(rays[0].direction));
+        let axes = arith::watertight_axes(rays[0].direction.to_array());
         let mut packet = WatertightPacket {
             axes,
             origin: [Lanes([0.0; PACKET]); 3],
@@ -56,7 +55,7 @@ impl WatertightPacket {
         let mut direction = [Lanes([0.0; PACKET]); 3];
         for lane in 0..PACKET {
             let ray = rays.get(lane).unwrap_or(&rays[0]);
-            let [kx, ky, kz] = Watertight::axes(Vec3A::from(ray.direction));
+            let [kx, ky, kz] = arith::watertight_axes(ray.direction.to_array());
             if kx != axes[0] || ky != axes[1] || kz != axes[2] {
                 return None;
             }
@@ -81,7 +80,7 @@ impl WatertightPacket {
     /// The triangle `corners` (on the original axes) against every ray,
     /// each with its own `t_max`, lane by lane with the scalar test's
     /// arithmetic: lanes in `exact` hold the bits
-    /// [`Watertight::intersect`] computes for their ray, and lanes in
+    /// `Watertight::intersect` computes for their ray, and lanes in
     /// `rescan` are those it decides in exact arithmetic.
     pub(crate) fn intersect_portable(&self, t_max: &Lanes, corners: [[f32; 3]; 3]) -> PacketHits {
         let mut hits = PacketHits {
@@ -120,7 +119,8 @@ impl WatertightPacket {
 mod tests {
     use super::*;
     use crate::simd::{Isa, Kernel, SimdLevel, dispatch, limit_simd_level};
-    use crate::triangle::TriangleTest;
+    use crate::triangle::{TriangleTest, Watertight};
+    use rtgi_math::Vec3A;
     use rtgi_math::{Rng, Vec3};
 
     /// One triangle against a packet at the active level.

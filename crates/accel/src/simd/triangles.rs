@@ -11,7 +11,7 @@ use rtgi_math::glam::BVec4A;
 use rtgi_math::{Vec3A, Vec4};
 
 use super::arith;
-use crate::triangle::TriangleHit;
+use crate::triangle_hit::LaneHits;
 
 /// Four triangles, structure-of-arrays: `corners[c][axis]` holds the
 /// coordinate along `axis` of corner `c` of the four triangles. Lanes
@@ -71,37 +71,8 @@ impl TriangleBlock {
     }
 }
 
-/// What a test of several lanes found (one ray against a block's four
-/// triangles, [`BlockHits`], or one triangle against a packet's sixteen
-/// rays, [`PacketHits`]): bit `i` of `exact` says that lane `i` was hit,
-/// at `t[i]` with barycentrics `beta[i]`, `gamma[i]` ([`LaneHits::hit`]);
-/// bit `i` of `rescan` that the scalar test must decide lane `i`.
-#[derive(Clone, Copy, Debug)]
-pub(crate) struct LaneHits<L> {
-    pub(crate) exact: u32,
-    pub(crate) rescan: u32,
-    pub(crate) t: L,
-    /// The barycentrics are `beta_scaled / scale` and `gamma_scaled /
-    /// scale`, divided only for the lanes that are hit (the watertight
-    /// test's scaled barycentrics and determinant; Möller-Trumbore's
-    /// barycentrics over 1, which divides exactly).
-    pub(crate) beta_scaled: L,
-    pub(crate) gamma_scaled: L,
-    pub(crate) scale: L,
-}
-
 /// One ray against the four triangles of a block.
 pub(crate) type BlockHits = LaneHits<Vec4>;
-
-impl<L: std::ops::Index<usize, Output = f32>> LaneHits<L> {
-    /// The hit in lane `lane` of [`LaneHits::exact`]: the bits the scalar
-    /// test computes for that lane's ray and triangle.
-    #[inline(always)]
-    pub(crate) fn hit(&self, lane: usize) -> TriangleHit {
-        let scale = self.scale[lane];
-        TriangleHit { t: self.t[lane], beta: self.beta_scaled[lane] / scale, gamma: self.gamma_scaled[lane] / scale }
-    }
-}
 
 impl BlockHits {
     /// Every lane that holds a triangle left to the scalar test: for tests
