@@ -1,11 +1,10 @@
 //! Commands that let users see their BVH: its boxes, and what traversal costs.
 
-use std::fmt::Write as _;
 use std::path::PathBuf;
 
 use anyhow::{Result, bail};
 use clap::Args;
-use rtgi_accel::{Accel, AccelKind, BuildParams, Bvh, Bvh4, Bvh8};
+use rtgi_accel::boxes_obj;
 use rtgi_image::{HdrImage, OutputFormat, ToneMap, check_writable, heat_colour};
 use rtgi_render::render_traversal_cost;
 
@@ -77,61 +76,14 @@ pub(crate) fn boxes(args: &BvhBoxesArgs) -> Result<()> {
     }
     let LoadedScene { scene, .. } = load_scene(args.scene.as_deref())?;
     let kind = args.accel.accel;
-    let (obj, count) = boxes_obj(kind, &scene.triangle_positions(), &args.accel.build.params_for(kind), &args.levels)?;
+    let Some((obj, count)) =
+        boxes_obj(kind, &scene.triangle_positions(), &args.accel.build.params_for(kind), &args.levels)
+    else {
+        bail!("{kind}: only BVH variants have boxes to export");
+    };
     write_atomically(&output, obj.as_bytes())?;
     outln!("wrote {count} boxes of levels {:?} to {}", args.levels, output.display())?;
     Ok(())
-}
-
-/// The boxes of a BVH's nodes at `levels` (the root is 0) as an OBJ file,
-/// a group `level_N` for each level, and how many boxes it holds.
-pub(crate) fn boxes_obj(
-    kind: AccelKind,
-    triangles: &[[rtgi_math::Vec3; 3]],
-    params: &BuildParams,
-    levels: &[usize],
-) -> Result<(String, usize)> {
-    let Some(method) = kind.split_method() else {
-        bail!("{kind}: only BVH variants have boxes to export");
-    };
-    let (boxes, stats) = match kind.node_width() {
-        Some(4) => {
-            let bvh = Bvh4::new(triangles, method, params);
-            (bvh.boxes_at_depths(levels), bvh.build_stats().clone())
-        }
-        Some(8) => {
-            let bvh = Bvh8::new(triangles, method, params);
-            (bvh.boxes_at_depths(levels), bvh.build_stats().clone())
-        }
-        _ => {
-            let bvh = Bvh::new(triangles, method, params);
-            (bvh.boxes_at_depths(levels), bvh.build_stats().clone())
-        }
-    };
-    let mut obj = format!(
-        "# BVH boxes of levels {:?}, {} ({} build, {} nodes, depth {}), written by rtgi\n",
-        levels,
-        kind,
-        method.name(),
-        stats.nodes,
-        stats.depth
-    );
-    let mut current_level = None;
-    for (index, (level, aabb)) in boxes.iter().enumerate() {
-        if current_level != Some(*level) {
-            let _ = writeln!(obj, "g level_{level}");
-            current_level = Some(*level);
-        }
-        for corner in 0..8 {
-            let pick = |bit: usize, axis: usize| if corner & bit == 0 { aabb.min[axis] } else { aabb.max[axis] };
-            let _ = writeln!(obj, "v {} {} {}", pick(1, 0), pick(2, 1), pick(4, 2));
-        }
-        let base = 8 * index + 1;
-        for face in [[0, 2, 3, 1], [4, 5, 7, 6], [0, 1, 5, 4], [2, 6, 7, 3], [0, 4, 6, 2], [1, 3, 7, 5]] {
-            let _ = writeln!(obj, "f {} {} {} {}", base + face[0], base + face[1], base + face[2], base + face[3]);
-        }
-    }
-    Ok((obj, boxes.len()))
 }
 
 /// Renders nodes visited (or triangles tested) per pixel in false colour.

@@ -100,6 +100,7 @@
 pub struct ReadmeDoctests;
 
 mod boxa;
+mod boxes_obj;
 mod bvh;
 mod contract;
 mod counters;
@@ -119,6 +120,7 @@ mod triangle_source;
 pub mod verify;
 mod wide;
 
+pub use boxes_obj::boxes_obj;
 pub use bvh::{Bvh, BvhNode, PrimitiveBvh, SplitMethod, Traversal};
 
 /// The peer libraries this build can measure beside our structures, each

@@ -7,8 +7,8 @@
 //! repository); `rtgi script` and `rtgi repl` interpret the language with
 //! rtgi's renderer.
 //!
-//! This crate is the language without the interpreter, pure code that
-//! reads nothing and prints nothing, so that it can be fuzzed:
+//! This crate is the language and its interpreter. The language is pure
+//! code that reads nothing and prints nothing, so that it can be fuzzed:
 //!
 //! - [`parse`] turns a line into a [`Command`], or a [`ParseError`] naming
 //!   the command and what it expects (the caller knows the file and the
@@ -17,6 +17,14 @@
 //!   and names resolved;
 //! - [`CourseBrdf`] realises the course's BRDF names as rtgi's material
 //!   fields and says where they reflect differently.
+//!
+//! The interpreter, [`Session`], holds what the commands set up (camera,
+//! scene and material edits, tracer, committed structure, algorithm) and
+//! turns each `run` into an `rtgi_job` render request. It loads the files
+//! the script names but prints nothing: what it says, notes and renders goes
+//! through a [`Frontend`] the caller implements (the `rtgi` app prints and
+//! renders with progress bars; a test records). Its errors are
+//! [`SessionError`]s.
 //!
 //! ```
 //! use rtgi_script::{Command, Tracer, CourseSplit, parse};
@@ -37,8 +45,14 @@ pub struct ReadmeDoctests;
 
 mod brdf;
 mod command;
+mod error;
+mod frontend;
 mod parse;
+mod session;
 
 pub use brdf::{CourseBrdf, UnknownBrdf, course_roughness, our_roughness};
 pub use command::{Algo, BvhCommand, Command, CourseSplit, DirectSampling, MaterialCommand, PathSetting, Tracer};
+pub use error::SessionError;
+pub use frontend::{Frontend, FrontendError, Run};
 pub use parse::{MAX_RESOLUTION, ParseError, parse};
+pub use session::{Flow, RunRecord, Session, SessionOptions};

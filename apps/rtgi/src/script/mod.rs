@@ -5,19 +5,26 @@
 //! - the language itself, each line parsed into a command and the course's
 //!   BRDF names as our materials, is the `rtgi-script` library (pure code,
 //!   fuzzed there);
-//! - [`session`] holds what the commands set up and runs them, rendering
-//!   through `rtgi render`'s own code;
-//! - this file reads scripts line by line and runs the prompt.
-
-mod session;
+//! - so is the interpreter, [`rtgi_script::Session`]: what the commands set
+//!   up, and a `run` as the render request of `rtgi render`;
+//! - this file is its front end: it reads scripts line by line and runs the
+//!   prompt, prints what the session says, and renders a `run` through
+//!   `rtgi render`'s own code (its progress, summary, warnings and signals),
+//!   after printing the `rtgi render` command that writes the same bytes.
 
 use std::path::PathBuf;
+use std::time::Instant;
 
 use anyhow::{Result, bail};
 use clap::Args;
+use rtgi_job::{Rendered, Warning};
+use rtgi_script::{Flow, Frontend, FrontendError, Run, Session, SessionError, SessionOptions};
 
-use crate::options::{SeedArgs, ThreadArgs};
-use session::{Flow, Session, SessionOptions};
+use crate::command_line::{CommandLine, shell_words};
+use crate::options::{SeedArgs, ThreadArgs, load_options};
+use crate::output::outln;
+use crate::phrasing::{Phrasing, warn};
+use crate::render_cmd::{Printer, finish, render};
 
 /// Options of `rtgi script` and `rtgi repl`.
 #[derive(Debug, Args)]
@@ -48,10 +55,11 @@ pub(crate) struct ScriptArgs {
 /// `rtgi script`: runs the scripts, then the prompt if asked (or if there were none).
 pub(crate) fn run(args: &ScriptArgs) -> Result<()> {
     let mut session = Session::new(SessionOptions {
-        output: Some(args.output.clone()),
+        output: args.output.clone(),
         seed: args.seed.value,
         threads: args.threads.count()?,
         model_paths: args.model_paths.clone(),
+        load: load_options(),
     });
     for script in &args.scripts {
         match run_file(&mut session, script) {
@@ -85,11 +93,11 @@ fn run_file(session: &mut Session, script: &std::path::Path) -> Result<Flow> {
     let mut block = None;
     for (index, line) in text.lines().enumerate() {
         let skipping = session.in_skipped_block();
-        match session.execute(line) {
+        match session.execute(line, &mut Terminal) {
             Ok(Flow::Continue) => {}
             Ok(Flow::Quit) => return Ok(Flow::Quit),
             Err(error) => {
-                bail!("{}:{}: '{}': {}", script.display(), index + 1, line.trim(), crate::one_line(&error));
+                bail!("{}:{}: '{}': {}", script.display(), index + 1, line.trim(), one_line(error));
             }
         }
         if !skipping && session.in_skipped_block() {
@@ -119,10 +127,10 @@ fn prompt(session: &mut Session) -> Result<()> {
                 if !line.trim().is_empty() {
                     let _ = editor.add_history_entry(line.as_str());
                 }
-                match session.execute(&line) {
+                match session.execute(&line, &mut Terminal) {
                     Ok(Flow::Continue) => {}
                     Ok(Flow::Quit) => return Ok(()),
-                    Err(error) => eprintln!("error: '{}': {}", line.trim(), crate::one_line(&error)),
+                    Err(error) => eprintln!("error: '{}': {}", line.trim(), one_line(error)),
                 }
                 crate::output::flush()?;
             }
@@ -130,4 +138,51 @@ fn prompt(session: &mut Session) -> Result<()> {
             Err(error) => return Err(error.into()),
         }
     }
+}
+
+/// A session's error and its causes on one line, as every error of the app is said.
+fn one_line(error: SessionError) -> String {
+    crate::one_line(&error.into())
+}
+
+/// The terminal as a session's front end: what the session says on standard
+/// output, notes and warnings on standard error, a `run` rendered as
+/// `rtgi render` renders.
+struct Terminal;
+
+impl Frontend for Terminal {
+    fn say(&mut self, line: &str) -> Result<(), FrontendError> {
+        Ok(outln!("{line}")?)
+    }
+
+    fn note(&mut self, message: &str) {
+        eprintln!("note: {message}");
+    }
+
+    fn warn(&mut self, warning: &Warning) {
+        // A scene's warnings read the same wherever it is loaded.
+        warn(warning, Phrasing::Options, false);
+    }
+
+    fn render(&mut self, run: Run<'_>) -> Result<Rendered, FrontendError> {
+        Ok(render_run(run)?)
+    }
+}
+
+/// Prints the `rtgi render` command that renders what `run` renders (or
+/// its nearest, and what it lacks), renders with the script's phrasing
+/// and says how long it took, as the course's framework does.
+fn render_run(run: Run<'_>) -> Result<Rendered> {
+    let words = run.request.to_command_line();
+    if run.edits.is_empty() {
+        outln!("the same as  rtgi {}", shell_words(&words))?;
+    } else {
+        outln!("like         rtgi {} (with {}, which no option expresses)", shell_words(&words), run.edits.join(", "))?;
+    }
+    let started = Instant::now();
+    let printer = Printer::new(run.request, true, Phrasing::Script);
+    let rendered = render(run.request, Some(run.given), &printer)?;
+    finish(&rendered)?;
+    eprintln!("Took {}", crate::progress::short_duration(started.elapsed().as_secs_f64()));
+    Ok(rendered)
 }
