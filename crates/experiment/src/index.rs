@@ -13,7 +13,7 @@ use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
 
-use crate::knobs::direct::Direct;
+use crate::knobs::direct::DIRECT;
 use crate::pareto;
 use crate::plot::Plot;
 use crate::provenance::Build;
@@ -137,7 +137,7 @@ fn pareto_plots(reports: &[IndexedReport]) -> Vec<(String, Plot, Vec<pareto::Con
     // error against a reference: it has no front. The direct knob renders
     // three scenes of its own, each against its own reference: a front each.
     let on_the_scene = |r: &&IndexedReport| knob(&r.report.knob).is_some_and(|k| k.uses_scene());
-    let direct = reports.iter().filter(|r| r.report.knob == Direct.name());
+    let direct = reports.iter().filter(|r| r.report.knob == DIRECT.name());
     let reports: Vec<&IndexedReport> = reports.iter().filter(on_the_scene).collect();
     let mut scenes: Vec<&str> = Vec::new();
     for r in &reports {

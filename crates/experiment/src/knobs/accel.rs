@@ -422,32 +422,10 @@ pub(super) fn run(
 }
 
 /// The `accel` knob.
-pub(super) struct AccelStructures;
-
-impl super::Knob for AccelStructures {
-    fn name(&self) -> &'static str {
-        "accel"
-    }
-
-    fn about(&self) -> &'static str {
-        "The acceleration structures and their build parameters."
-    }
-
-    fn question(&self) -> &'static str {
-        "what does each acceleration structure cost to build and to trace, and does it change any answer?"
-    }
-
-    fn scenes(&self) -> super::Scenes {
-        super::Scenes::Subject(&[super::CORNELL, super::BUNNY, super::SPONZA, super::CONFERENCE])
-    }
-
-    fn run(
-        &self,
-        subject: &Subject,
-        options: &Options,
-        report: Report,
-        progress: &dyn Fn(&str),
-    ) -> Result<Report, ExperimentError> {
-        run(subject, options, report, progress)
-    }
-}
+pub(super) static ACCEL_STRUCTURES: super::Described = super::Described {
+    name: "accel",
+    about: "The acceleration structures and their build parameters.",
+    question: "what does each acceleration structure cost to build and to trace, and does it change any answer?",
+    scenes: super::Scenes::Subject(&[super::CORNELL, super::BUNNY, super::SPONZA, super::CONFERENCE]),
+    run,
+};

@@ -166,32 +166,10 @@ pub(super) fn run(
 }
 
 /// The `adaptive` knob.
-pub(super) struct Adaptive;
-
-impl super::Knob for Adaptive {
-    fn name(&self) -> &'static str {
-        "adaptive"
-    }
-
-    fn about(&self) -> &'static str {
-        "Adaptive sampling (noise targets) against fixed samples per pixel."
-    }
-
-    fn question(&self) -> &'static str {
-        "does sampling until each pixel meets a noise target beat the same samples everywhere, at equal time?"
-    }
-
-    fn scenes(&self) -> super::Scenes {
-        super::Scenes::Subject(&[super::CORNELL, super::ROOM])
-    }
-
-    fn run(
-        &self,
-        subject: &Subject,
-        options: &Options,
-        report: Report,
-        progress: &dyn Fn(&str),
-    ) -> Result<Report, ExperimentError> {
-        run(subject, options, report, progress)
-    }
-}
+pub(super) static ADAPTIVE: super::Described = super::Described {
+    name: "adaptive",
+    about: "Adaptive sampling (noise targets) against fixed samples per pixel.",
+    question: "does sampling until each pixel meets a noise target beat the same samples everywhere, at equal time?",
+    scenes: super::Scenes::Subject(&[super::CORNELL, super::ROOM]),
+    run,
+};

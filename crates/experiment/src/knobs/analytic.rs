@@ -191,32 +191,11 @@ pub(super) fn run(options: &Options, mut report: Report, progress: &dyn Fn(&str)
 }
 
 /// The `analytic` knob.
-pub(super) struct Analytic;
-
-impl super::Knob for Analytic {
-    fn name(&self) -> &'static str {
-        "analytic"
-    }
-
-    fn about(&self) -> &'static str {
-        "Each estimator's bias against answers known in closed form (white furnaces)."
-    }
-
-    fn question(&self) -> &'static str {
-        "is any estimator (sampler, direct-light strategy, roulette) biased against an answer known exactly?"
-    }
-
-    fn scenes(&self) -> super::Scenes {
-        super::Scenes::Own("white furnaces (built in: closed emitting spheres)")
-    }
-
-    fn run(
-        &self,
-        _subject: &Subject,
-        options: &Options,
-        report: Report,
-        progress: &dyn Fn(&str),
-    ) -> Result<Report, ExperimentError> {
-        run(options, report, progress)
-    }
-}
+pub(super) static ANALYTIC: super::Described = super::Described {
+    name: "analytic",
+    about: "Each estimator's bias against answers known in closed form (white furnaces).",
+    question: "is any estimator (sampler, direct-light strategy, roulette) biased against an answer known exactly?",
+    scenes: super::Scenes::Own("white furnaces (built in: closed emitting spheres)"),
+    // It measures on scenes of its own, not the subject's.
+    run: |_subject, options, report, progress| run(options, report, progress),
+};

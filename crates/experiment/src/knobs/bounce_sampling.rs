@@ -40,33 +40,11 @@ pub(super) fn run(
 }
 
 /// The `bounce-sampling` knob.
-pub(super) struct BounceSamplingKnob;
-
-impl super::Knob for BounceSamplingKnob {
-    fn name(&self) -> &'static str {
-        "bounce-sampling"
-    }
-
-    fn about(&self) -> &'static str {
-        "Where bounce directions come from: the BSDF, the cosine or the uniform hemisphere."
-    }
-
-    fn question(&self) -> &'static str {
-        "which source of bounce directions (BSDF, cosine or uniform hemisphere) reaches the least error in \
-            equal time?"
-    }
-
-    fn scenes(&self) -> super::Scenes {
-        super::Scenes::Subject(&[super::CORNELL, super::GLOSSY])
-    }
-
-    fn run(
-        &self,
-        subject: &Subject,
-        options: &Options,
-        report: Report,
-        progress: &dyn Fn(&str),
-    ) -> Result<Report, ExperimentError> {
-        run(subject, options, report, progress)
-    }
-}
+pub(super) static BOUNCE_SAMPLING_KNOB: super::Described = super::Described {
+    name: "bounce-sampling",
+    about: "Where bounce directions come from: the BSDF, the cosine or the uniform hemisphere.",
+    question: "which source of bounce directions (BSDF, cosine or uniform hemisphere) reaches the least error in \
+            equal time?",
+    scenes: super::Scenes::Subject(&[super::CORNELL, super::GLOSSY]),
+    run,
+};

@@ -179,32 +179,10 @@ pub(super) fn run(
 }
 
 /// The `clamp` knob.
-pub(super) struct Clamp;
-
-impl super::Knob for Clamp {
-    fn name(&self) -> &'static str {
-        "clamp"
-    }
-
-    fn about(&self) -> &'static str {
-        "The indirect-light clamp: bias traded for variance."
-    }
-
-    fn question(&self) -> &'static str {
-        "how much bias does clamping indirect light add for the variance it removes?"
-    }
-
-    fn scenes(&self) -> super::Scenes {
-        super::Scenes::Subject(&[super::CORNELL, super::ROOM, super::CONFERENCE])
-    }
-
-    fn run(
-        &self,
-        subject: &Subject,
-        options: &Options,
-        report: Report,
-        progress: &dyn Fn(&str),
-    ) -> Result<Report, ExperimentError> {
-        run(subject, options, report, progress)
-    }
-}
+pub(super) static CLAMP: super::Described = super::Described {
+    name: "clamp",
+    about: "The indirect-light clamp: bias traded for variance.",
+    question: "how much bias does clamping indirect light add for the variance it removes?",
+    scenes: super::Scenes::Subject(&[super::CORNELL, super::ROOM, super::CONFERENCE]),
+    run,
+};

@@ -121,32 +121,10 @@ pub(super) fn run(
 }
 
 /// The `denoise` knob.
-pub(super) struct Denoise;
-
-impl super::Knob for Denoise {
-    fn name(&self) -> &'static str {
-        "denoise"
-    }
-
-    fn about(&self) -> &'static str {
-        "The edge-avoiding denoiser against the samples' mean."
-    }
-
-    fn question(&self) -> &'static str {
-        "does the denoiser lower the error at equal time, and how much bias does it trade for the noise?"
-    }
-
-    fn scenes(&self) -> super::Scenes {
-        super::Scenes::Subject(&[super::CORNELL, super::SPONZA, super::CONFERENCE])
-    }
-
-    fn run(
-        &self,
-        subject: &Subject,
-        options: &Options,
-        report: Report,
-        progress: &dyn Fn(&str),
-    ) -> Result<Report, ExperimentError> {
-        run(subject, options, report, progress)
-    }
-}
+pub(super) static DENOISE: super::Described = super::Described {
+    name: "denoise",
+    about: "The edge-avoiding denoiser against the samples' mean.",
+    question: "does the denoiser lower the error at equal time, and how much bias does it trade for the noise?",
+    scenes: super::Scenes::Subject(&[super::CORNELL, super::SPONZA, super::CONFERENCE]),
+    run,
+};

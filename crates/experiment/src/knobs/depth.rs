@@ -182,32 +182,10 @@ pub(super) fn run(
 }
 
 /// The `depth` knob.
-pub(super) struct Depth;
-
-impl super::Knob for Depth {
-    fn name(&self) -> &'static str {
-        "depth"
-    }
-
-    fn about(&self) -> &'static str {
-        "Bounces, with Russian roulette on and off."
-    }
-
-    fn question(&self) -> &'static str {
-        "what do bounces cost, and how much light is missing without them?"
-    }
-
-    fn scenes(&self) -> super::Scenes {
-        super::Scenes::Subject(&[super::CORNELL, super::SPONZA])
-    }
-
-    fn run(
-        &self,
-        subject: &Subject,
-        options: &Options,
-        report: Report,
-        progress: &dyn Fn(&str),
-    ) -> Result<Report, ExperimentError> {
-        run(subject, options, report, progress)
-    }
-}
+pub(super) static DEPTH: super::Described = super::Described {
+    name: "depth",
+    about: "Bounces, with Russian roulette on and off.",
+    question: "what do bounces cost, and how much light is missing without them?",
+    scenes: super::Scenes::Subject(&[super::CORNELL, super::SPONZA]),
+    run,
+};

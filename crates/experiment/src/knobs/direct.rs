@@ -282,35 +282,13 @@ pub(super) fn run(
 }
 
 /// The `direct` knob (the index gives its scenes' reports a Pareto plot each).
-pub(crate) struct Direct;
-
-impl super::Knob for Direct {
-    fn name(&self) -> &'static str {
-        "direct"
-    }
-
-    fn about(&self) -> &'static str {
-        "Light, BSDF and MIS sampling of direct light, on scenes built for each."
-    }
-
-    fn question(&self) -> &'static str {
-        "which sampling of direct light (light, BSDF or MIS) gives the least error in equal time, and where?"
-    }
-
-    fn scenes(&self) -> super::Scenes {
-        super::Scenes::Own("scenes/direct-*.toml (built in: small light, large light, glossy)")
-    }
-
-    fn run(
-        &self,
-        subject: &Subject,
-        options: &Options,
-        report: Report,
-        progress: &dyn Fn(&str),
-    ) -> Result<Report, ExperimentError> {
-        run(subject, options, report, progress)
-    }
-}
+pub(crate) static DIRECT: super::Described = super::Described {
+    name: "direct",
+    about: "Light, BSDF and MIS sampling of direct light, on scenes built for each.",
+    question: "which sampling of direct light (light, BSDF or MIS) gives the least error in equal time, and where?",
+    scenes: super::Scenes::Own("scenes/direct-*.toml (built in: small light, large light, glossy)"),
+    run,
+};
 
 #[cfg(test)]
 mod tests {

@@ -237,32 +237,10 @@ pub(super) fn run(
 }
 
 /// The `effects` knob.
-pub(super) struct Effects;
-
-impl super::Knob for Effects {
-    fn name(&self) -> &'static str {
-        "effects"
-    }
-
-    fn about(&self) -> &'static str {
-        "Each decision of the effects planner reversed."
-    }
-
-    fn question(&self) -> &'static str {
-        "what does each effect cost, and does leaving out one the scene does not call for cost accuracy?"
-    }
-
-    fn scenes(&self) -> super::Scenes {
-        super::Scenes::Subject(&[super::CORNELL, super::HELMET])
-    }
-
-    fn run(
-        &self,
-        subject: &Subject,
-        options: &Options,
-        report: Report,
-        progress: &dyn Fn(&str),
-    ) -> Result<Report, ExperimentError> {
-        run(subject, options, report, progress)
-    }
-}
+pub(super) static EFFECTS: super::Described = super::Described {
+    name: "effects",
+    about: "Each decision of the effects planner reversed.",
+    question: "what does each effect cost, and does leaving out one the scene does not call for cost accuracy?",
+    scenes: super::Scenes::Subject(&[super::CORNELL, super::HELMET]),
+    run,
+};

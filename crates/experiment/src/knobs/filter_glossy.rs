@@ -212,33 +212,11 @@ pub(super) fn run(
 }
 
 /// The `filter-glossy` knob.
-pub(super) struct FilterGlossyKnob;
-
-impl super::Knob for FilterGlossyKnob {
-    fn name(&self) -> &'static str {
-        "filter-glossy"
-    }
-
-    fn about(&self) -> &'static str {
-        "Path regularisation (Cycles' \"filter glossy\") against the clamp."
-    }
-
-    fn question(&self) -> &'static str {
-        "does widening mirrors, glass and sharp highlights after a diffuse bounce (path regularisation) \
-            remove the fireflies of caustics at less bias than the clamp, raw and denoised?"
-    }
-
-    fn scenes(&self) -> super::Scenes {
-        super::Scenes::Subject(&[super::CAUSTICS, super::MIRROR, super::CONFERENCE])
-    }
-
-    fn run(
-        &self,
-        subject: &Subject,
-        options: &Options,
-        report: Report,
-        progress: &dyn Fn(&str),
-    ) -> Result<Report, ExperimentError> {
-        run(subject, options, report, progress)
-    }
-}
+pub(super) static FILTER_GLOSSY_KNOB: super::Described = super::Described {
+    name: "filter-glossy",
+    about: "Path regularisation (Cycles' \"filter glossy\") against the clamp.",
+    question: "does widening mirrors, glass and sharp highlights after a diffuse bounce (path regularisation) \
+            remove the fireflies of caustics at less bias than the clamp, raw and denoised?",
+    scenes: super::Scenes::Subject(&[super::CAUSTICS, super::MIRROR, super::CONFERENCE]),
+    run,
+};

@@ -93,32 +93,10 @@ pub(super) fn run(
 }
 
 /// The `image-size` knob.
-pub(super) struct ImageSize;
-
-impl super::Knob for ImageSize {
-    fn name(&self) -> &'static str {
-        "image-size"
-    }
-
-    fn about(&self) -> &'static str {
-        "Render time against the image's pixel count."
-    }
-
-    fn question(&self) -> &'static str {
-        "does render time grow in proportion to the pixels, or does a fixed cost weigh on small images?"
-    }
-
-    fn scenes(&self) -> super::Scenes {
-        super::Scenes::Subject(&[super::CORNELL])
-    }
-
-    fn run(
-        &self,
-        subject: &Subject,
-        options: &Options,
-        report: Report,
-        progress: &dyn Fn(&str),
-    ) -> Result<Report, ExperimentError> {
-        run(subject, options, report, progress)
-    }
-}
+pub(super) static IMAGE_SIZE: super::Described = super::Described {
+    name: "image-size",
+    about: "Render time against the image's pixel count.",
+    question: "does render time grow in proportion to the pixels, or does a fixed cost weigh on small images?",
+    scenes: super::Scenes::Subject(&[super::CORNELL]),
+    run,
+};

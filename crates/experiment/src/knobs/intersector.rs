@@ -407,33 +407,11 @@ fn plots(report: &mut Report) {
 }
 
 /// The `intersector` knob.
-pub(super) struct Intersectors;
-
-impl super::Knob for Intersectors {
-    fn name(&self) -> &'static str {
-        "intersector"
-    }
-
-    fn about(&self) -> &'static str {
-        "The ray/triangle tests: time, and failures on the hard cases of `rtgi verify`."
-    }
-
-    fn question(&self) -> &'static str {
-        "what does each ray/triangle test cost, and how often do rays slip through shared edges or hit the \
-            surface they leave?"
-    }
-
-    fn scenes(&self) -> super::Scenes {
-        super::Scenes::Subject(&[super::CORNELL])
-    }
-
-    fn run(
-        &self,
-        subject: &Subject,
-        options: &Options,
-        report: Report,
-        progress: &dyn Fn(&str),
-    ) -> Result<Report, ExperimentError> {
-        run(subject, options, report, progress)
-    }
-}
+pub(super) static INTERSECTORS: super::Described = super::Described {
+    name: "intersector",
+    about: "The ray/triangle tests: time, and failures on the hard cases of `rtgi verify`.",
+    question: "what does each ray/triangle test cost, and how often do rays slip through shared edges or hit the \
+            surface they leave?",
+    scenes: super::Scenes::Subject(&[super::CORNELL]),
+    run,
+};

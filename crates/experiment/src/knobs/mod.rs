@@ -62,6 +62,47 @@ pub trait Knob: Sync {
     }
 }
 
+/// A knob told by its fields, as each knob's file declares itself: the
+/// measuring is the file's `run`, the rest is what the registry says of it.
+pub(crate) struct Described {
+    name: &'static str,
+    about: &'static str,
+    question: &'static str,
+    scenes: Scenes,
+    run: MeasureFn,
+}
+
+/// A knob's measuring: the subject, the options, the report to fill in and where progress goes.
+type MeasureFn = fn(&Subject, &Options, Report, &dyn Fn(&str)) -> Result<Report, ExperimentError>;
+
+impl Knob for Described {
+    fn name(&self) -> &'static str {
+        self.name
+    }
+
+    fn about(&self) -> &'static str {
+        self.about
+    }
+
+    fn question(&self) -> &'static str {
+        self.question
+    }
+
+    fn scenes(&self) -> Scenes {
+        self.scenes
+    }
+
+    fn run(
+        &self,
+        subject: &Subject,
+        options: &Options,
+        report: Report,
+        progress: &dyn Fn(&str),
+    ) -> Result<Report, ExperimentError> {
+        (self.run)(subject, options, report, progress)
+    }
+}
+
 /// Where a knob measures.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Scenes {
@@ -78,25 +119,25 @@ pub enum Scenes {
 /// Every knob, in the order `rtgi experiment all` runs them: adding a knob
 /// is its file and its line here.
 pub static KNOBS: &[&dyn Knob] = &[
-    &spp::Spp,
-    &depth::Depth,
-    &bounce_sampling::BounceSamplingKnob,
-    &roulette_start::RouletteStart,
-    &accel::AccelStructures,
-    &scaling::Scaling,
-    &traversal::TraversalTest,
-    &packets::Packets,
-    &direct::Direct,
-    &clamp::Clamp,
-    &filter_glossy::FilterGlossyKnob,
-    &adaptive::Adaptive,
-    &denoise::Denoise,
-    &threads::Threads,
-    &image_size::ImageSize,
-    &analytic::Analytic,
-    &effects::Effects,
-    &intersector::Intersectors,
-    &precision::Precision,
+    &spp::SPP,
+    &depth::DEPTH,
+    &bounce_sampling::BOUNCE_SAMPLING_KNOB,
+    &roulette_start::ROULETTE_START,
+    &accel::ACCEL_STRUCTURES,
+    &scaling::SCALING,
+    &traversal::TRAVERSAL_TEST,
+    &packets::PACKETS,
+    &direct::DIRECT,
+    &clamp::CLAMP,
+    &filter_glossy::FILTER_GLOSSY_KNOB,
+    &adaptive::ADAPTIVE,
+    &denoise::DENOISE,
+    &threads::THREADS,
+    &image_size::IMAGE_SIZE,
+    &analytic::ANALYTIC,
+    &effects::EFFECTS,
+    &intersector::INTERSECTORS,
+    &precision::PRECISION,
 ];
 
 /// The knob named `name` (as [`Knob::name`] gives it).

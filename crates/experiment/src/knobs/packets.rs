@@ -124,32 +124,10 @@ pub(super) fn run(
 }
 
 /// The `packets` knob.
-pub(super) struct Packets;
-
-impl super::Knob for Packets {
-    fn name(&self) -> &'static str {
-        "packets"
-    }
-
-    fn about(&self) -> &'static str {
-        "Batch queries (packets of 16 coherent rays) against one ray at a time."
-    }
-
-    fn question(&self) -> &'static str {
-        "what do packets of coherent rays gain over one ray at a time, and do they change any answer?"
-    }
-
-    fn scenes(&self) -> super::Scenes {
-        super::Scenes::Subject(&[super::BUNNY])
-    }
-
-    fn run(
-        &self,
-        subject: &Subject,
-        options: &Options,
-        report: Report,
-        progress: &dyn Fn(&str),
-    ) -> Result<Report, ExperimentError> {
-        run(subject, options, report, progress)
-    }
-}
+pub(super) static PACKETS: super::Described = super::Described {
+    name: "packets",
+    about: "Batch queries (packets of 16 coherent rays) against one ray at a time.",
+    question: "what do packets of coherent rays gain over one ray at a time, and do they change any answer?",
+    scenes: super::Scenes::Subject(&[super::BUNNY]),
+    run,
+};

@@ -22,7 +22,7 @@ use crate::exact::ExactHit;
 use crate::plot::{Corner, Curve, Plot};
 use crate::report::{Point, Report, Series, Table, format_number};
 use crate::stats::Timing;
-use crate::{ExperimentError, Options, Steps, Subject};
+use crate::{ExperimentError, Options, Steps};
 
 /// A family of triangles with one parameter that makes them harder.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -370,33 +370,12 @@ fn plots(report: &mut Report) {
 }
 
 /// The `precision` knob.
-pub(super) struct Precision;
-
-impl super::Knob for Precision {
-    fn name(&self) -> &'static str {
-        "precision"
-    }
-
-    fn about(&self) -> &'static str {
-        "The triangle test in single against double precision: time, and error against the exact answer on near-degenerate and far triangles."
-    }
-
-    fn question(&self) -> &'static str {
-        "how far are t and the barycentrics from the exact answer in single and double precision, on \
-            near-degenerate and far-from-origin triangles, and what does double precision cost?"
-    }
-
-    fn scenes(&self) -> super::Scenes {
-        super::Scenes::Own("generated triangles")
-    }
-
-    fn run(
-        &self,
-        _subject: &Subject,
-        options: &Options,
-        report: Report,
-        progress: &dyn Fn(&str),
-    ) -> Result<Report, ExperimentError> {
-        run(options, report, progress)
-    }
-}
+pub(super) static PRECISION: super::Described = super::Described {
+    name: "precision",
+    about: "The triangle test in single against double precision: time, and error against the exact answer on near-degenerate and far triangles.",
+    question: "how far are t and the barycentrics from the exact answer in single and double precision, on \
+            near-degenerate and far-from-origin triangles, and what does double precision cost?",
+    scenes: super::Scenes::Own("generated triangles"),
+    // It measures on scenes of its own, not the subject's.
+    run: |_subject, options, report, progress| run(options, report, progress),
+};

@@ -49,33 +49,11 @@ pub(super) fn run(
 }
 
 /// The `roulette-start` knob.
-pub(super) struct RouletteStart;
-
-impl super::Knob for RouletteStart {
-    fn name(&self) -> &'static str {
-        "roulette-start"
-    }
-
-    fn about(&self) -> &'static str {
-        "The bounce from which Russian roulette may end paths."
-    }
-
-    fn question(&self) -> &'static str {
-        "from which bounce should Russian roulette end paths: what does an early start save in time and cost \
-            in noise?"
-    }
-
-    fn scenes(&self) -> super::Scenes {
-        super::Scenes::Subject(&[super::CORNELL, super::ROOM])
-    }
-
-    fn run(
-        &self,
-        subject: &Subject,
-        options: &Options,
-        report: Report,
-        progress: &dyn Fn(&str),
-    ) -> Result<Report, ExperimentError> {
-        run(subject, options, report, progress)
-    }
-}
+pub(super) static ROULETTE_START: super::Described = super::Described {
+    name: "roulette-start",
+    about: "The bounce from which Russian roulette may end paths.",
+    question: "from which bounce should Russian roulette end paths: what does an early start save in time and cost \
+            in noise?",
+    scenes: super::Scenes::Subject(&[super::CORNELL, super::ROOM]),
+    run,
+};

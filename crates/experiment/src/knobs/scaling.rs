@@ -12,7 +12,7 @@ use rtgi_math::{Ray, Rng, Vec3, uniform_sphere};
 
 use crate::plot::{BOUND_NOTE, Corner, Curve, Plot, is_bound, rate_or_bound};
 use crate::report::{Point, Report, Series, Table, format_ms, format_number};
-use crate::{ExperimentError, Options, Steps, Subject};
+use crate::{ExperimentError, Options, Steps};
 
 /// A unit sphere of about `count` triangles: `rows` bands of `2 rows`
 /// quads, the poles' quads folded to single triangles.
@@ -234,32 +234,11 @@ pub(super) fn run(options: &Options, mut report: Report, progress: &dyn Fn(&str)
 }
 
 /// The `scaling` knob.
-pub(super) struct Scaling;
-
-impl super::Knob for Scaling {
-    fn name(&self) -> &'static str {
-        "scaling"
-    }
-
-    fn about(&self) -> &'static str {
-        "The naive O(n) search against the BVH, over triangle counts."
-    }
-
-    fn question(&self) -> &'static str {
-        "how does the time per ray grow with the triangle count, for the naive search and for the BVH?"
-    }
-
-    fn scenes(&self) -> super::Scenes {
-        super::Scenes::Own("generated meshes")
-    }
-
-    fn run(
-        &self,
-        _subject: &Subject,
-        options: &Options,
-        report: Report,
-        progress: &dyn Fn(&str),
-    ) -> Result<Report, ExperimentError> {
-        run(options, report, progress)
-    }
-}
+pub(super) static SCALING: super::Described = super::Described {
+    name: "scaling",
+    about: "The naive O(n) search against the BVH, over triangle counts.",
+    question: "how does the time per ray grow with the triangle count, for the naive search and for the BVH?",
+    scenes: super::Scenes::Own("generated meshes"),
+    // It measures on scenes of its own, not the subject's.
+    run: |_subject, options, report, progress| run(options, report, progress),
+};

@@ -177,32 +177,10 @@ pub(super) fn run(
 }
 
 /// The `spp` knob.
-pub(super) struct Spp;
-
-impl super::Knob for Spp {
-    fn name(&self) -> &'static str {
-        "spp"
-    }
-
-    fn about(&self) -> &'static str {
-        "Samples per pixel, for each pixel sampler."
-    }
-
-    fn question(&self) -> &'static str {
-        "how fast does the error fall with samples per pixel, for each pixel sampler, and at equal time?"
-    }
-
-    fn scenes(&self) -> super::Scenes {
-        super::Scenes::Subject(&[super::CORNELL, super::BUNNY, super::ROOM, super::GLOSSY])
-    }
-
-    fn run(
-        &self,
-        subject: &Subject,
-        options: &Options,
-        report: Report,
-        progress: &dyn Fn(&str),
-    ) -> Result<Report, ExperimentError> {
-        run(subject, options, report, progress)
-    }
-}
+pub(super) static SPP: super::Described = super::Described {
+    name: "spp",
+    about: "Samples per pixel, for each pixel sampler.",
+    question: "how fast does the error fall with samples per pixel, for each pixel sampler, and at equal time?",
+    scenes: super::Scenes::Subject(&[super::CORNELL, super::BUNNY, super::ROOM, super::GLOSSY]),
+    run,
+};

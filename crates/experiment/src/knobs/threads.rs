@@ -105,32 +105,10 @@ pub(super) fn run(
 }
 
 /// The `threads` knob.
-pub(super) struct Threads;
-
-impl super::Knob for Threads {
-    fn name(&self) -> &'static str {
-        "threads"
-    }
-
-    fn about(&self) -> &'static str {
-        "Worker threads: render time, and the same bits at every count."
-    }
-
-    fn question(&self) -> &'static str {
-        "what do worker threads buy in render time, and is the image the same bits at every count?"
-    }
-
-    fn scenes(&self) -> super::Scenes {
-        super::Scenes::Subject(&[super::CORNELL])
-    }
-
-    fn run(
-        &self,
-        subject: &Subject,
-        options: &Options,
-        report: Report,
-        progress: &dyn Fn(&str),
-    ) -> Result<Report, ExperimentError> {
-        run(subject, options, report, progress)
-    }
-}
+pub(super) static THREADS: super::Described = super::Described {
+    name: "threads",
+    about: "Worker threads: render time, and the same bits at every count.",
+    question: "what do worker threads buy in render time, and is the image the same bits at every count?",
+    scenes: super::Scenes::Subject(&[super::CORNELL]),
+    run,
+};

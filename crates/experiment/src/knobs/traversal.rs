@@ -146,32 +146,10 @@ pub(super) fn run(
 }
 
 /// The `traversal` knob.
-pub(super) struct TraversalTest;
-
-impl super::Knob for TraversalTest {
-    fn name(&self) -> &'static str {
-        "traversal"
-    }
-
-    fn about(&self) -> &'static str {
-        "The robust slab test of traversal against the textbook one."
-    }
-
-    fn question(&self) -> &'static str {
-        "what does the robust slab test cost, and how many answers does the textbook one change?"
-    }
-
-    fn scenes(&self) -> super::Scenes {
-        super::Scenes::Subject(&[super::BUNNY])
-    }
-
-    fn run(
-        &self,
-        subject: &Subject,
-        options: &Options,
-        report: Report,
-        progress: &dyn Fn(&str),
-    ) -> Result<Report, ExperimentError> {
-        run(subject, options, report, progress)
-    }
-}
+pub(super) static TRAVERSAL_TEST: super::Described = super::Described {
+    name: "traversal",
+    about: "The robust slab test of traversal against the textbook one.",
+    question: "what does the robust slab test cost, and how many answers does the textbook one change?",
+    scenes: super::Scenes::Subject(&[super::BUNNY]),
+    run,
+};
