@@ -54,5 +54,5 @@ pub use brdf::{CourseBrdf, UnknownBrdf, course_roughness, our_roughness};
 pub use command::{Algo, BvhCommand, Command, CourseSplit, DirectSampling, MaterialCommand, PathSetting, Tracer};
 pub use error::SessionError;
 pub use frontend::{Frontend, FrontendError, Run};
-pub use parse::{MAX_RESOLUTION, ParseError, parse};
+pub use parse::{COMMANDS, MAX_RESOLUTION, ParseError, parse};
 pub use session::{Flow, RunRecord, Session, SessionOptions};

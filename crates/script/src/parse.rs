@@ -174,8 +174,8 @@ fn command(name: &str, line: &str) -> Result<Command, String> {
     }
 }
 
-/// Every command's name, for suggestions.
-const COMMANDS: &[&str] = &[
+/// Every command's name (the suggestions of "did you mean" come from here).
+pub const COMMANDS: &[&str] = &[
     "at",
     "look",
     "up",

@@ -11,56 +11,16 @@
 
 use proptest::prelude::*;
 use rtgi_math::Vec3;
-use rtgi_script::{Command, MAX_RESOLUTION, MaterialCommand, parse};
+use rtgi_script::{COMMANDS, Command, MAX_RESOLUTION, MaterialCommand, parse};
 
-/// Every command name of the language, and a few near misses.
-const NAMES: &[&str] = &[
-    "at",
-    "look",
-    "up",
-    "camup",
-    "print-cam",
-    "load",
-    "modelpath",
-    "modelmatrix",
-    "modeltrafo",
-    "resolution",
-    "sppx",
-    "outfile",
-    "commit",
-    "run",
-    "raytracer",
-    "bvh",
-    "algo",
-    "is",
-    "path",
-    "material",
-    "default-brdf",
-    "pointlight",
-    "skylight",
-    "skytest",
-    "echo",
-    "stats",
-    "mem-stats",
-    "history",
-    "quit",
-    "exit",
-    "omp",
-    "platform",
-    "denoise",
-    "disable",
-    "with",
-    "}",
-    "preview-offset",
-    "move-speed",
-    "add-scene-step",
-    "laod",
-    "AT",
-    "é",
-    "#",
-    "//",
-    "{",
-];
+/// Near misses of the language's command names ([`COMMANDS`]), and words
+/// that end or open blocks.
+const NEAR_MISSES: &[&str] = &["laod", "AT", "é", "#", "//", "{", "}"];
+
+/// A command name of the language, or a near miss.
+fn name() -> impl Strategy<Value = &'static str> {
+    prop::sample::select(COMMANDS.iter().chain(NEAR_MISSES).copied().collect::<Vec<_>>())
+}
 
 /// Words the commands look for, and numbers and text on their edges.
 #[rustfmt::skip] // In groups, as the comments say, rather than one a line.
@@ -90,19 +50,16 @@ fn word() -> impl Strategy<Value = String> {
 
 /// A known command (or a near miss) with 0 to 20 edge words, spaced oddly.
 fn line() -> impl Strategy<Value = String> {
-    (
-        prop::sample::select(NAMES),
-        prop::collection::vec(word(), 0..20),
-        prop::sample::select(&[" ", "  ", "\t", " \u{3000}"][..]),
-    )
-        .prop_map(|(name, words, gap)| {
+    (name(), prop::collection::vec(word(), 0..20), prop::sample::select(&[" ", "  ", "\t", " \u{3000}"][..])).prop_map(
+        |(name, words, gap)| {
             let mut line = name.to_owned();
             for w in words {
                 line.push_str(gap);
                 line.push_str(&w);
             }
             line
-        })
+        },
+    )
 }
 
 /// Parses `text` and checks what it returns (a panic fails the case by itself).
@@ -176,7 +133,7 @@ proptest! {
     /// Very long lines: a command with thousands of words, or one word of
     /// thousands of characters (misspelt-command suggestions compare it).
     #[test]
-    fn very_long_lines_parse_or_say_why(name in prop::sample::select(NAMES), w in known_word(), n in 1000usize..20_000) {
+    fn very_long_lines_parse_or_say_why(name in name(), w in known_word(), n in 1000usize..20_000) {
         let many = std::iter::repeat_n(w.as_str(), n / 4).collect::<Vec<_>>().join(" ");
         check(&format!("{name} {many}"))?;
         check(&format!("{name}{}", w.repeat(n / w.len().max(1))))?;
