@@ -11,6 +11,10 @@
 //! Both crates are dev-dependencies, so this module is compiled for the
 //! tests only and the binary carries neither.
 
+// With the embree feature the comparison with the committed files is not
+// compiled (see the test), so what only it uses goes unused there.
+#![cfg_attr(feature = "embree", allow(dead_code))]
+
 use std::path::{Path, PathBuf};
 
 use clap::CommandFactory;
@@ -112,6 +116,10 @@ fn check(name: &str, generated: &str) -> Option<String> {
     ))
 }
 
+// The reference describes the default build, which the README's test
+// command builds; with the embree feature `--accel` lists one more
+// structure (its help says so), and the committed files would differ.
+#[cfg(not(feature = "embree"))]
 #[test]
 fn the_committed_reference_is_the_commands_definitions() {
     let problems: Vec<String> =
