@@ -8,9 +8,8 @@ use std::time::Instant;
 
 use anyhow::{Context, Result, bail};
 use clap::Args;
-use rayon::prelude::*;
 use rtgi_accel::ray_file::{self, HitWriter, RayReader};
-use rtgi_accel::{Accel, Hit, Ray};
+use rtgi_accel::{Accel, BATCH_RAYS, Hit, HitFilter, Ray, intersect_parallel, occluded_parallel};
 use rtgi_render::{AlphaTest, has_alpha};
 
 use crate::common::{LoadedScene, check_output_folder, load_scene, refuse_inputs_as_outputs};
@@ -63,9 +62,6 @@ pub(crate) struct TraceArgs {
 /// file has no samples to average stochastic transparency over, so a
 /// blended surface counts where its alpha exceeds one half.
 const BLEND_THRESHOLD: f32 = 0.5;
-/// Rays given to the batch queries at once: the wide BVHs trace coherent
-/// runs of the file (camera rays in tiles) as packets.
-const BATCH_RAYS: usize = 1024;
 /// Rays read, traced and written at a time (2 MiB of rays, 1 MiB of hits):
 /// memory stays bounded whatever the file's size, and each chunk gives the
 /// worker threads 64 batches. A multiple of `BATCH_RAYS`, so that the
@@ -92,7 +88,7 @@ pub(crate) fn run(args: &TraceArgs) -> Result<()> {
     let alpha_test = (has_alpha(&scene) && !args.no_alpha).then(|| AlphaTest::new(&scene));
     let accept =
         |triangle, beta, gamma| alpha_test.as_ref().is_none_or(|t| t.accepts(triangle, beta, gamma, BLEND_THRESHOLD));
-    let filter: Option<&(dyn Fn(u32, f32, f32) -> bool + Sync)> = alpha_test.is_some().then_some(&accept);
+    let filter: Option<HitFilter<'_>> = alpha_test.is_some().then_some(&accept);
 
     let mut output = HitWriter::new(PartialFile::create(&out)?);
     let write_error = || format!("{}: cannot write", out.display());
@@ -157,28 +153,16 @@ impl Answers {
     }
 }
 
-/// Traces `rays` through the batch queries, `BATCH_RAYS` at a time in
-/// parallel, with the hit filter if there is one (cut-outs).
-fn trace_chunk(
-    accel: &dyn Accel,
-    rays: &[Ray],
-    any_hit: bool,
-    filter: Option<&(dyn Fn(u32, f32, f32) -> bool + Sync)>,
-) -> Answers {
-    let batches = rays.par_chunks(BATCH_RAYS);
+/// Traces `rays` through the batch queries, [`rtgi_accel::BATCH_RAYS`] at
+/// a time in parallel, with the hit filter if there is one (cut-outs).
+fn trace_chunk(accel: &dyn Accel, rays: &[Ray], any_hit: bool, filter: Option<HitFilter<'_>>) -> Answers {
     if any_hit {
         let mut occluded = vec![false; rays.len()];
-        batches.zip(occluded.par_chunks_mut(BATCH_RAYS)).for_each(|(batch, out)| match filter {
-            Some(accept) => accel.occluded_batch_filtered(batch, out, accept),
-            None => accel.occluded_batch(batch, out),
-        });
+        occluded_parallel(accel, rays, &mut occluded, filter);
         Answers::Occluded(occluded)
     } else {
         let mut closest = vec![None; rays.len()];
-        batches.zip(closest.par_chunks_mut(BATCH_RAYS)).for_each(|(batch, out)| match filter {
-            Some(accept) => accel.intersect_batch_filtered(batch, out, accept),
-            None => accel.intersect_batch(batch, out),
-        });
+        intersect_parallel(accel, rays, &mut closest, filter);
         Answers::Closest(closest)
     }
 }
