@@ -197,6 +197,9 @@ mod tests {
         agree(rtgi_render::Effect::ALL, |e| e.name());
         agree(Integrator::ALL, |i| i.name());
         agree(DirectStrategy::ALL, |d| d.name());
+        agree(rtgi_accel::SahAxes::ALL, |a| a.name());
+        agree(rtgi_render::BounceSampling::ALL, |b| b.name());
+        agree(rtgi_job::Denoise::ALL, |d| d.name());
     }
 
     #[test]

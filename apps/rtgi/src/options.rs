@@ -320,11 +320,11 @@ pub(crate) struct AccelArgs {
 #[derive(Debug, Args)]
 pub(crate) struct BuildArgs {
     /// Most triangles in a BVH leaf [default: 4; 8 for the wide BVHs]
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=255))]
+    #[arg(long, value_parser = clap::value_parser!(u32).range(range_of(BuildParams::LEAF_SIZES)))]
     pub(crate) leaf_size: Option<u32>,
 
     /// Bins per axis of the binned SAH build
-    #[arg(long, default_value_t = BuildParams::default().sah_bins as u32, value_parser = clap::value_parser!(u32).range(2..=256))]
+    #[arg(long, default_value_t = BuildParams::default().sah_bins as u32, value_parser = clap::value_parser!(u32).range(range_of(BuildParams::SAH_BINS)))]
     pub(crate) sah_bins: u32,
 
     /// Axes the binned SAH build tries planes on: all three, or only the longest (the course's
@@ -343,6 +343,11 @@ pub(crate) struct BuildArgs {
     /// Slab test of the binary BVHs (the wide BVHs always use the robust one)
     #[arg(long, value_enum, default_value_t = Traversal::default())]
     pub(crate) traversal: Traversal,
+}
+
+/// A library's range of counts as clap's ranges take them.
+fn range_of(range: std::ops::RangeInclusive<usize>) -> std::ops::RangeInclusive<i64> {
+    *range.start() as i64..=*range.end() as i64
 }
 
 impl BuildArgs {

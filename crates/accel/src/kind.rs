@@ -52,12 +52,23 @@ pub enum SahAxes {
 }
 
 impl SahAxes {
+    /// Every choice, in the order help texts list them.
+    pub const ALL: &'static [SahAxes] = &[SahAxes::All, SahAxes::Longest];
+
     /// The name on command lines and in reports (`all`, `longest`).
     pub fn name(self) -> &'static str {
         match self {
             SahAxes::All => "all",
             SahAxes::Longest => "longest",
         }
+    }
+}
+
+impl rtgi_math::NamedChoice for SahAxes {
+    const KIND: &'static str = "set of SAH axes";
+    const ALL: &'static [Self] = SahAxes::ALL;
+    fn name(self) -> &'static str {
+        SahAxes::name(self)
     }
 }
 
@@ -78,6 +89,31 @@ pub struct BuildParams {
     pub intersector: Intersector,
     /// The slab test of the binary BVHs' traversal (the wide BVHs always use the robust one).
     pub traversal: Traversal,
+}
+
+impl BuildParams {
+    /// The leaf sizes a build accepts ([`BuildParams::check`]).
+    pub const LEAF_SIZES: std::ops::RangeInclusive<usize> = 1..=255;
+    /// The bin counts a build accepts ([`BuildParams::check`]); the build clamps others into it.
+    pub const SAH_BINS: std::ops::RangeInclusive<usize> = 2..=256;
+
+    /// Whether the parameters are in their ranges: a leaf size in
+    /// [`BuildParams::LEAF_SIZES`], a bin count in [`BuildParams::SAH_BINS`]
+    /// and a finite traversal cost greater than 0; the error names the
+    /// parameter and its range.
+    pub fn check(&self) -> Result<(), String> {
+        let (leaf, bins) = (Self::LEAF_SIZES, Self::SAH_BINS);
+        if !leaf.contains(&self.max_leaf_size) {
+            return Err(format!("leaf size {}: expected {} to {}", self.max_leaf_size, leaf.start(), leaf.end()));
+        }
+        if !bins.contains(&self.sah_bins) {
+            return Err(format!("SAH bins {}: expected {} to {}", self.sah_bins, bins.start(), bins.end()));
+        }
+        if !(self.traversal_cost.is_finite() && self.traversal_cost > 0.0) {
+            return Err(format!("traversal cost {}: expected a finite number greater than 0", self.traversal_cost));
+        }
+        Ok(())
+    }
 }
 
 impl Default for BuildParams {

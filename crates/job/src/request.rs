@@ -283,6 +283,28 @@ pub enum Denoise {
     Off,
 }
 
+impl Denoise {
+    /// Every choice, in the order help texts list them.
+    pub const ALL: &'static [Denoise] = &[Denoise::Auto, Denoise::On, Denoise::Off];
+
+    /// The name on command lines and in reports (`auto`, `on`, `off`).
+    pub fn name(self) -> &'static str {
+        match self {
+            Denoise::Auto => "auto",
+            Denoise::On => "on",
+            Denoise::Off => "off",
+        }
+    }
+}
+
+impl rtgi_math::NamedChoice for Denoise {
+    const KIND: &'static str = "denoise choice";
+    const ALL: &'static [Self] = Denoise::ALL;
+    fn name(self) -> &'static str {
+        Denoise::name(self)
+    }
+}
+
 /// Which share of a render this job does: a range of every pixel's
 /// samples, a band of rows, or both; the parts go to .accum files that a
 /// merge puts together, bit-identical to the render in one go.

@@ -77,6 +77,14 @@ impl BounceSampling {
     }
 }
 
+impl rtgi_math::NamedChoice for BounceSampling {
+    const KIND: &'static str = "bounce sampling";
+    const ALL: &'static [Self] = BounceSampling::ALL;
+    fn name(self) -> &'static str {
+        BounceSampling::name(self)
+    }
+}
+
 impl std::fmt::Display for BounceSampling {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.write_str(self.name())
