@@ -195,6 +195,10 @@ pub enum JobError {
         /// This job's samples.
         samples: Range<u32>,
     },
+    /// A render in memory ([`crate::render_in_memory`]) asked for a field
+    /// that names a file or makes a part of an image for a merge.
+    #[error("{0} is for renders written to files; a render in memory writes none")]
+    InMemory(Field),
     /// The time limit came before the first sample.
     #[error("no sample finished within the time limit")]
     NoSampleInTime,

@@ -51,7 +51,9 @@ pub use request::{
     ACCUMULATION_EXTENSION, ADAPTIVE_SPP, Checkpoints, DEFAULT_BACKGROUND, DEFAULT_IMAGE_SIDE, Denoise, ImageSize,
     MAX_IMAGE_SIDE, RenderRequest, Sampling, Split, Structure, Tone, default_lighting, is_accumulation, reshaped,
 };
-pub use run::{Given, PREVIEW_FILTER_GLOSSY, Rendered, aov_path, check_output, render, render_given, thread_pool};
+pub use run::{
+    Given, PREVIEW_FILTER_GLOSSY, Rendered, aov_path, check_output, render, render_given, render_in_memory, thread_pool,
+};
 pub use scene_source::{BUILT_IN_NAME, LoadedScene, SceneSource, built_in};
 pub use split::band;
 

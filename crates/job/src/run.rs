@@ -44,6 +44,9 @@ pub struct Rendered {
     pub outcome: RenderOutcome,
     /// The image (denoised if it was) and the tone map of its PNG.
     pub image: Option<(HdrImage, ToneMap)>,
+    /// The arbitrary output variables asked for ([`RenderRequest::aovs`]),
+    /// in the order asked, when the render completed.
+    pub aovs: Vec<(Integrator, HdrImage)>,
     /// How the passes ended.
     pub ending: Ending,
 }
@@ -72,7 +75,7 @@ impl std::fmt::Debug for Given<'_> {
 /// A render that stops early (time limit, cancelled) is `Ok` with the
 /// samples it finished, unless it finished none under a time limit.
 pub fn render(request: &RenderRequest, observer: &dyn Observer, cancel: &CancelToken) -> Result<Rendered, JobError> {
-    render_with(request, None, observer, cancel)
+    render_with(request, None, observer, cancel, Destination::Files)
 }
 
 /// [`render`] of `given`'s scene and structure instead of the request's.
@@ -82,16 +85,50 @@ pub fn render_given(
     observer: &dyn Observer,
     cancel: &CancelToken,
 ) -> Result<Rendered, JobError> {
-    render_with(request, Some(given), observer, cancel)
+    render_with(request, Some(given), observer, cancel, Destination::Files)
+}
+
+/// [`render`] that writes no file: the image and the AOVs asked for are
+/// returned in [`Rendered`] only, and `request.output` is not used. The
+/// image is made as for an EXR output (`Denoise::Auto` keeps the unbiased
+/// mean); the fields that name files (a checkpoint, a file resumed) or
+/// make a part of an image for a merge (a range of samples, a tile) are
+/// refused ([`JobError::InMemory`]). With `given`, its scene and structure
+/// are rendered instead of the request's, as in [`render_given`].
+pub fn render_in_memory(
+    request: &RenderRequest,
+    given: Option<Given<'_>>,
+    observer: &dyn Observer,
+    cancel: &CancelToken,
+) -> Result<Rendered, JobError> {
+    let files = [
+        (request.checkpoints.checkpoint.is_some(), Field::Checkpoint),
+        (request.checkpoints.resume.is_some(), Field::Resume),
+        (request.split.samples.is_some(), Field::Samples),
+        (request.split.tile.is_some(), Field::Tile),
+    ];
+    if let Some((_, field)) = files.into_iter().find(|(asked, _)| *asked) {
+        return Err(JobError::InMemory(field));
+    }
+    render_with(request, given, observer, cancel, Destination::Memory)
+}
+
+/// Where a render's image goes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Destination {
+    /// The request's output file, the AOVs beside it.
+    Files,
+    /// Nowhere but [`Rendered`].
+    Memory,
 }
 
 /// Whether the image is denoised: `Auto` denoises PNG output of the
-/// integrators that simulate light (EXR and accumulations keep the
-/// unbiased mean), `On` any image of those integrators.
-fn denoises(choice: Denoise, simulates_light: bool, output: &Path) -> bool {
-    let png = OutputFormat::from_path(output).is_ok_and(|f| f == OutputFormat::Png);
+/// integrators that simulate light (EXR, accumulations and images kept in
+/// memory, `output` `None`, keep the unbiased mean), `On` any image of those integrators.
+fn denoises(choice: Denoise, simulates_light: bool, output: Option<&Path>) -> bool {
+    let png = output.is_some_and(|output| OutputFormat::from_path(output).is_ok_and(|f| f == OutputFormat::Png));
     simulates_light
-        && !is_accumulation(output)
+        && !output.is_some_and(is_accumulation)
         && match choice {
             Denoise::Auto => png,
             Denoise::On => true,
@@ -144,9 +181,19 @@ pub fn aov_path(output: &Path, kind: Integrator) -> Result<PathBuf, JobError> {
 }
 
 /// Every check that needs no scene: the outputs, the options that cannot
-/// go together, the files that must not be overwritten.
-fn check_request(request: &RenderRequest) -> Result<Vec<(Integrator, PathBuf)>, JobError> {
+/// go together, the files that must not be overwritten. Returns the AOVs
+/// with their files (with no files for a render in memory).
+fn check_request(request: &RenderRequest, destination: Destination) -> Result<Vec<(Integrator, PathBuf)>, JobError> {
     let output = &request.output;
+    if destination == Destination::Memory {
+        for &kind in &request.aovs {
+            aov_path(output, kind)?;
+        }
+        if request.denoise == Denoise::On && !request.lighting.integrator.simulates_light() {
+            return Err(JobError::DenoiseNotLight(request.lighting.integrator));
+        }
+        return Ok(request.aovs.iter().map(|&kind| (kind, PathBuf::new())).collect());
+    }
     check_output(output)?;
     if request.sampling.adaptive().is_some() {
         refuse_split_adaptive(request)?;
@@ -224,9 +271,11 @@ fn render_with(
     given: Option<Given<'_>>,
     observer: &dyn Observer,
     cancel: &CancelToken,
+    destination: Destination,
 ) -> Result<Rendered, JobError> {
     let started = Instant::now();
-    let aov_outputs = check_request(request)?;
+    let writes = destination == Destination::Files;
+    let aov_outputs = check_request(request, destination)?;
     let resumed = request.checkpoints.resume.as_deref().map(Accumulation::read).transpose()?;
     let (width, height, spp) = (request.size.width(), request.size.height(), request.samples_per_pixel());
     check_memory(width, height)?;
@@ -255,7 +304,9 @@ fn render_with(
         .iter()
         .map(|path| (format!("a file of the scene ({})", path.display()), path.as_path()))
         .collect();
-    refuse_inputs_as_outputs(&outputs(request, &aov_outputs), &sources)?;
+    if writes {
+        refuse_inputs_as_outputs(&outputs(request, &aov_outputs), &sources)?;
+    }
 
     let adaptive = request.sampling.adaptive();
     let mut settings = RenderSettings {
@@ -301,7 +352,8 @@ fn render_with(
     }
     let (rows, samples) = request.split.share(settings.height, spp)?;
 
-    let denoising = denoises(request.denoise, settings.integrator.simulates_light(), &request.output);
+    let denoising =
+        denoises(request.denoise, settings.integrator.simulates_light(), writes.then_some(request.output.as_path()));
     // No filter asked for: the preview's when denoised; a threshold of 0 turns it off.
     settings.filter_glossy = match request.lighting.filter_glossy {
         None if denoising => Some(PREVIEW_FILTER_GLOSSY),
@@ -382,7 +434,9 @@ fn render_with(
         Some(image) => recipe::tone_map(request.tone.exposure, request.tone.operator, simulates_light, image),
         None => ToneMap::default(),
     };
-    let wrote_output = if let Done::Progressive(accumulation, ..) = &rendered
+    let wrote_output = if !writes {
+        false
+    } else if let Done::Progressive(accumulation, ..) = &rendered
         && request.writes_accumulation()
     {
         accumulation.write(&request.output)?;
@@ -393,17 +447,20 @@ fn render_with(
     } else {
         false
     };
-    let mut aovs_written = Vec::new();
+    let (mut aovs_written, mut aovs) = (Vec::new(), Vec::new());
     if ending == Ending::Complete {
         for (kind, path) in &aov_outputs {
             let aov_settings = RenderSettings { integrator: *kind, ..settings.clone() };
             let (aov, _) = pool.install(|| rtgi_render::render(&scene, accel, &camera, &aov_settings, &|_| {}));
-            aov.write(path, &tone_map)?;
-            aovs_written.push(OutputSummary {
-                path: path.display().to_string(),
-                kind: kind.to_string(),
-                samples_per_pixel: aov_settings.samples_per_pixel,
-            });
+            if writes {
+                aov.write(path, &tone_map)?;
+                aovs_written.push(OutputSummary {
+                    path: path.display().to_string(),
+                    kind: kind.to_string(),
+                    samples_per_pixel: aov_settings.samples_per_pixel,
+                });
+            }
+            aovs.push((*kind, aov));
         }
     }
     let (mut exposure, mut looks) = (None, None);
@@ -416,17 +473,19 @@ fn render_with(
         if OutputFormat::from_path(&request.output).is_ok_and(|f| f == OutputFormat::Png) {
             exposure = Some(ExposureSummary::new(&tone_map, request.tone.exposure.is_none()));
         }
-        if let Some(image) = &image {
-            looks = legibility(image, &tone_map);
-            match looks {
-                Some(Legibility::AlmostBlack(fraction)) => warn(Warning::AlmostBlack { fraction }),
-                Some(Legibility::AlmostWhite(fraction)) => warn(Warning::AlmostWhite { fraction }),
-                None => {}
-            }
+    }
+    // The image is kept: written, or returned from a render in memory.
+    let kept = if writes { wrote_output } else { image.is_some() };
+    if kept && let Some(image) = &image {
+        looks = legibility(image, &tone_map);
+        match looks {
+            Some(Legibility::AlmostBlack(fraction)) => warn(Warning::AlmostBlack { fraction }),
+            Some(Legibility::AlmostWhite(fraction)) => warn(Warning::AlmostWhite { fraction }),
+            None => {}
         }
     }
     outputs.extend(aovs_written);
-    if ending == Ending::TimeLimit && !wrote_output {
+    if ending == Ending::TimeLimit && !kept {
         return Err(JobError::NoSampleInTime);
     }
 
@@ -476,7 +535,7 @@ fn render_with(
         outputs,
         warnings,
     };
-    Ok(Rendered { outcome, image: image.map(|image| (image, tone_map)), ending })
+    Ok(Rendered { outcome, image: image.map(|image| (image, tone_map)), aovs, ending })
 }
 
 /// Refuses an accumulation resumed that is of another render, or of
