@@ -2,15 +2,14 @@
 //! file (the format is `rtgi_accel::ray_file`'s).
 
 use std::fs::File;
-use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use anyhow::{Context, Result, bail};
 use clap::Args;
-use rayon::prelude::*;
+use rtgi_accel::parallel::{BATCH_RAYS, HitFilter, intersect_all, occluded_all};
 use rtgi_accel::ray_file::{self, HitWriter, RayReader};
-use rtgi_accel::{Accel, Hit, Ray};
+use rtgi_image::write_atomically_with;
 use rtgi_render::{AlphaTest, has_alpha};
 
 use crate::common::{LoadedScene, check_output_folder, load_scene, refuse_inputs_as_outputs};
@@ -63,9 +62,6 @@ pub(crate) struct TraceArgs {
 /// file has no samples to average stochastic transparency over, so a
 /// blended surface counts where its alpha exceeds one half.
 const BLEND_THRESHOLD: f32 = 0.5;
-/// Rays given to the batch queries at once: the wide BVHs trace coherent
-/// runs of the file (camera rays in tiles) as packets.
-const BATCH_RAYS: usize = 1024;
 /// Rays read, traced and written at a time (2 MiB of rays, 1 MiB of hits):
 /// memory stays bounded whatever the file's size, and each chunk gives the
 /// worker threads 64 batches. A multiple of `BATCH_RAYS`, so that the
@@ -92,21 +88,40 @@ pub(crate) fn run(args: &TraceArgs) -> Result<()> {
     let alpha_test = (has_alpha(&scene) && !args.no_alpha).then(|| AlphaTest::new(&scene));
     let accept =
         |triangle, beta, gamma| alpha_test.as_ref().is_none_or(|t| t.accepts(triangle, beta, gamma, BLEND_THRESHOLD));
-    let filter: Option<&(dyn Fn(u32, f32, f32) -> bool + Sync)> = alpha_test.is_some().then_some(&accept);
+    let filter: Option<HitFilter<'_>> = alpha_test.is_some().then_some(&accept);
 
-    let mut output = HitWriter::new(PartialFile::create(&out)?);
-    let write_error = || format!("{}: cannot write", out.display());
+    // Written through a temporary file that replaces `out` only when
+    // complete: a failure leaves no partial file and keeps an earlier one.
     let (mut ray_count, mut hit_count, mut trace_s) = (0usize, 0usize, 0.0);
-    while more {
-        let trace_start = Instant::now();
-        let answers = pool.install(|| trace_chunk(accel.as_ref(), &rays, args.any_hit, filter));
-        trace_s += trace_start.elapsed().as_secs_f64();
-        ray_count += rays.len();
-        hit_count += answers.hits();
-        answers.write_to(&mut output).with_context(write_error)?;
-        more = input.next_chunk(&mut rays).with_context(read_error)?;
+    let mut read_failure = None;
+    let written = write_atomically_with(&out, |sink| {
+        let mut output = HitWriter::new(sink);
+        while more {
+            let trace_start = Instant::now();
+            let accel = accel.as_ref();
+            if args.any_hit {
+                let occluded = pool.install(|| occluded_all(accel, &rays, filter));
+                trace_s += trace_start.elapsed().as_secs_f64();
+                hit_count += occluded.iter().filter(|&&o| o).count();
+                output.write_occluded(&occluded)?;
+            } else {
+                let hits = pool.install(|| intersect_all(accel, &rays, filter));
+                trace_s += trace_start.elapsed().as_secs_f64();
+                hit_count += hits.iter().flatten().count();
+                output.write_closest(&hits)?;
+            }
+            ray_count += rays.len();
+            more = input.next_chunk(&mut rays).map_err(|e| {
+                read_failure = Some(anyhow::Error::new(e).context(read_error()));
+                std::io::Error::other("the ray file could not be read")
+            })?;
+        }
+        Ok(())
+    });
+    if let Some(failure) = read_failure {
+        return Err(failure);
     }
-    output.into_inner().commit()?;
+    written.with_context(|| format!("{}: cannot write", out.display()))?;
 
     eprintln!("load   {load_ms:.1} ms ({} triangles)", scene.triangles.len());
     eprintln!("build  {build_ms:.1} ms ({})", accel.build_stats().variant);
@@ -134,55 +149,6 @@ pub(crate) fn run(args: &TraceArgs) -> Result<()> {
     Ok(())
 }
 
-/// The answers of one chunk of rays, in their order.
-enum Answers {
-    Closest(Vec<Option<Hit>>),
-    Occluded(Vec<bool>),
-}
-
-impl Answers {
-    /// Rays that hit something.
-    fn hits(&self) -> usize {
-        match self {
-            Answers::Closest(hits) => hits.iter().filter(|h| h.is_some()).count(),
-            Answers::Occluded(occluded) => occluded.iter().filter(|&&o| o).count(),
-        }
-    }
-
-    fn write_to<W: Write>(&self, out: &mut HitWriter<W>) -> std::io::Result<()> {
-        match self {
-            Answers::Closest(hits) => out.write_closest(hits),
-            Answers::Occluded(occluded) => out.write_occluded(occluded),
-        }
-    }
-}
-
-/// Traces `rays` through the batch queries, `BATCH_RAYS` at a time in
-/// parallel, with the hit filter if there is one (cut-outs).
-fn trace_chunk(
-    accel: &dyn Accel,
-    rays: &[Ray],
-    any_hit: bool,
-    filter: Option<&(dyn Fn(u32, f32, f32) -> bool + Sync)>,
-) -> Answers {
-    let batches = rays.par_chunks(BATCH_RAYS);
-    if any_hit {
-        let mut occluded = vec![false; rays.len()];
-        batches.zip(occluded.par_chunks_mut(BATCH_RAYS)).for_each(|(batch, out)| match filter {
-            Some(accept) => accel.occluded_batch_filtered(batch, out, accept),
-            None => accel.occluded_batch(batch, out),
-        });
-        Answers::Occluded(occluded)
-    } else {
-        let mut closest = vec![None; rays.len()];
-        batches.zip(closest.par_chunks_mut(BATCH_RAYS)).for_each(|(batch, out)| match filter {
-            Some(accept) => accel.intersect_batch_filtered(batch, out, accept),
-            None => accel.intersect_batch(batch, out),
-        });
-        Answers::Closest(closest)
-    }
-}
-
 /// Opens a ray file; a regular file whose size is no multiple of a record
 /// is refused here, before any work (a stream, at its end).
 fn open_rays(path: &Path) -> Result<RayReader<File>> {
@@ -195,64 +161,4 @@ fn open_rays(path: &Path) -> Result<RayReader<File>> {
         ray_file::ray_count(metadata.len()).with_context(|| path.display().to_string())?;
     }
     Ok(RayReader::new(file, CHUNK_RAYS))
-}
-
-/// An output file written as it is produced, through a temporary file
-/// beside it that replaces it only when complete ([`PartialFile::commit`]):
-/// a failure never leaves a partial file or destroys an earlier one. The
-/// temporary file is named as `common::write_atomically` names its own.
-///
-/// A path that exists and is neither a regular file nor a folder (a FIFO,
-/// `/dev/null`, `/dev/stdout`) is written directly: renaming a file over it
-/// would replace the device or the pipe with a plain file (and for root,
-/// `/dev/null` is in a writable folder).
-struct PartialFile {
-    path: PathBuf,
-    /// The temporary file, renamed to `path` on commit; `None` when
-    /// writing to `path` directly.
-    temporary: Option<PathBuf>,
-    file: Option<BufWriter<File>>,
-}
-
-impl PartialFile {
-    fn create(path: &Path) -> Result<Self> {
-        let special = std::fs::metadata(path).is_ok_and(|m| !m.is_file() && !m.is_dir());
-        let temporary = (!special).then(|| {
-            let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
-            path.with_file_name(format!(".{name}.{}.partial", std::process::id()))
-        });
-        let file = File::create(temporary.as_deref().unwrap_or(path))
-            .with_context(|| format!("{}: cannot write", path.display()))?;
-        Ok(PartialFile { path: path.to_owned(), temporary, file: Some(BufWriter::new(file)) })
-    }
-
-    /// Puts the complete file in place of `path`.
-    fn commit(mut self) -> Result<()> {
-        let file = self.file.take().expect("committed once");
-        let file = file.into_inner().map_err(|e| e.into_error());
-        match &self.temporary {
-            Some(temporary) => file.and_then(|f| f.sync_all()).and_then(|()| std::fs::rename(temporary, &self.path)),
-            None => file.map(drop),
-        }
-        .with_context(|| format!("{}: cannot write", self.path.display()))
-    }
-}
-
-impl Write for PartialFile {
-    fn write(&mut self, bytes: &[u8]) -> std::io::Result<usize> {
-        self.file.as_mut().expect("written only before commit").write(bytes)
-    }
-
-    fn flush(&mut self) -> std::io::Result<()> {
-        self.file.as_mut().expect("written only before commit").flush()
-    }
-}
-
-impl Drop for PartialFile {
-    /// Removes the temporary file unless it was committed (renamed away).
-    fn drop(&mut self) {
-        if let Some(temporary) = &self.temporary {
-            let _ = std::fs::remove_file(temporary);
-        }
-    }
 }

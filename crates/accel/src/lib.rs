@@ -110,6 +110,7 @@ mod exact;
 mod indexed_mesh;
 mod kind;
 mod linear;
+pub mod parallel;
 mod primitive;
 pub mod ray_file;
 pub mod simd;
