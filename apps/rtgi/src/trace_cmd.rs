@@ -7,7 +7,9 @@ use std::time::Instant;
 
 use anyhow::{Context, Result, bail};
 use clap::Args;
-use rtgi_accel::parallel::{BATCH_RAYS, HitFilter, intersect_all, occluded_all};
+use rtgi_accel::parallel::{
+    BATCH_RAYS, GRID_TILE, HitFilter, intersect_all, intersect_grid, occluded_all, occluded_grid,
+};
 use rtgi_accel::ray_file::{self, HitWriter, RayReader};
 use rtgi_image::write_atomically_with;
 use rtgi_render::{AlphaTest, has_alpha};
@@ -51,6 +53,12 @@ pub(crate) struct TraceArgs {
     #[arg(long)]
     pub(crate) no_alpha: bool,
 
+    /// The rays are a camera grid WIDTH rays wide in scanline order (row by row): they are traced in
+    /// 4x4 tiles, which the wide BVHs take as packets of 16, instead of runs along a row; the hits are
+    /// the same, in the file's order
+    #[arg(long, value_name = "WIDTH", value_parser = clap::value_parser!(u32).range(1..=rtgi_job::MAX_IMAGE_SIDE as i64))]
+    pub(crate) grid: Option<u32>,
+
     #[command(flatten)]
     pub(crate) accel: AccelArgs,
 
@@ -64,8 +72,9 @@ pub(crate) struct TraceArgs {
 const BLEND_THRESHOLD: f32 = 0.5;
 /// Rays read, traced and written at a time (2 MiB of rays, 1 MiB of hits):
 /// memory stays bounded whatever the file's size, and each chunk gives the
-/// worker threads 64 batches. A multiple of `BATCH_RAYS`, so that the
-/// batches are the same runs of the file as if it were traced whole.
+/// worker threads 64 batches. Rounded up to whole batches (or with
+/// `--grid`, whole bands of tile rows), so that the batches are the same
+/// runs of the file as if it were traced whole.
 const CHUNK_RAYS: usize = 64 * BATCH_RAYS;
 
 pub(crate) fn run(args: &TraceArgs) -> Result<()> {
@@ -74,9 +83,11 @@ pub(crate) fn run(args: &TraceArgs) -> Result<()> {
     check_output_folder(&out)?;
     // The first chunk is read before the scene, so that a file that is no
     // ray file at all (`/dev/zero`, a picture) is refused at once.
-    let mut input = open_rays(&args.rays)?;
+    // A grid is read in whole bands of tile rows, so that no band is cut.
+    let band = args.grid.map_or(BATCH_RAYS, |width| width as usize * GRID_TILE);
+    let mut input = open_rays(&args.rays, CHUNK_RAYS.div_ceil(band) * band)?;
     let read_error = || args.rays.display().to_string();
-    let mut rays = Vec::with_capacity(CHUNK_RAYS);
+    let mut rays = Vec::new();
     let mut more = input.next_chunk(&mut rays).with_context(read_error)?;
     let LoadedScene { scene, load_ms, .. } = load_scene(Some(&args.scene))?;
 
@@ -99,13 +110,20 @@ pub(crate) fn run(args: &TraceArgs) -> Result<()> {
         while more {
             let trace_start = Instant::now();
             let accel = accel.as_ref();
+            let grid = args.grid.map(|width| width as usize);
             if args.any_hit {
-                let occluded = pool.install(|| occluded_all(accel, &rays, filter));
+                let occluded = pool.install(|| match grid {
+                    Some(width) => occluded_grid(accel, &rays, width, filter),
+                    None => occluded_all(accel, &rays, filter),
+                });
                 trace_s += trace_start.elapsed().as_secs_f64();
                 hit_count += occluded.iter().filter(|&&o| o).count();
                 output.write_occluded(&occluded)?;
             } else {
-                let hits = pool.install(|| intersect_all(accel, &rays, filter));
+                let hits = pool.install(|| match grid {
+                    Some(width) => intersect_grid(accel, &rays, width, filter),
+                    None => intersect_all(accel, &rays, filter),
+                });
                 trace_s += trace_start.elapsed().as_secs_f64();
                 hit_count += hits.iter().flatten().count();
                 output.write_closest(&hits)?;
@@ -151,7 +169,7 @@ pub(crate) fn run(args: &TraceArgs) -> Result<()> {
 
 /// Opens a ray file; a regular file whose size is no multiple of a record
 /// is refused here, before any work (a stream, at its end).
-fn open_rays(path: &Path) -> Result<RayReader<File>> {
+fn open_rays(path: &Path, chunk_rays: usize) -> Result<RayReader<File>> {
     let file = File::open(path).with_context(|| format!("{}: cannot read", path.display()))?;
     let metadata = file.metadata().with_context(|| format!("{}: cannot read", path.display()))?;
     if metadata.is_dir() {
@@ -160,5 +178,5 @@ fn open_rays(path: &Path) -> Result<RayReader<File>> {
     if metadata.is_file() {
         ray_file::ray_count(metadata.len()).with_context(|| path.display().to_string())?;
     }
-    Ok(RayReader::new(file, CHUNK_RAYS))
+    Ok(RayReader::new(file, chunk_rays))
 }
