@@ -68,31 +68,39 @@ pub fn occluded_grid(accel: &dyn Accel, rays: &[Ray], width: usize, filter: Opti
 }
 
 /// Answers `rays` band by band of [`GRID_TILE`] rows of `width`, in
-/// parallel: each band's rays gathered in tile order, answered by `query`,
-/// and the answers put back in the rays' order.
+/// parallel: in each band, runs of tiles ([`BATCH_RAYS`] rays) are gathered
+/// in tile order into a buffer reused from run to run (a fresh buffer per
+/// band cost more than the packets gained: page faults), answered by
+/// `query`, and the answers put back in the rays' order.
 fn by_tiles<T: Copy + Default + Send>(
     rays: &[Ray],
     width: usize,
     answers: &mut [T],
     query: impl Fn(&[Ray], &mut [T]) + Sync,
 ) {
-    let band = width.max(1) * GRID_TILE;
+    let width = width.max(1);
+    let band = width * GRID_TILE;
+    let columns_per_run = (BATCH_RAYS / (GRID_TILE * GRID_TILE)).max(1) * GRID_TILE;
     rays.par_chunks(band).zip(answers.par_chunks_mut(band)).for_each(|(rays, answers)| {
-        let order: Vec<usize> = (0..width.max(1))
-            .step_by(GRID_TILE)
-            .flat_map(|x0| {
-                (0..GRID_TILE)
-                    .flat_map(move |row| (x0..(x0 + GRID_TILE).min(width.max(1))).map(move |x| row * width.max(1) + x))
-            })
-            .filter(|&i| i < rays.len())
-            .collect();
-        let tiled: Vec<Ray> = order.iter().map(|&i| rays[i]).collect();
-        let mut tiled_answers = vec![T::default(); tiled.len()];
-        for (batch, out) in tiled.chunks(BATCH_RAYS).zip(tiled_answers.chunks_mut(BATCH_RAYS)) {
-            query(batch, out);
-        }
-        for (&i, answer) in order.iter().zip(tiled_answers) {
-            answers[i] = answer;
+        let (mut gathered, mut answered, mut order) =
+            (Vec::with_capacity(BATCH_RAYS), Vec::with_capacity(BATCH_RAYS), Vec::with_capacity(BATCH_RAYS));
+        for first_column in (0..width).step_by(columns_per_run) {
+            let end_column = (first_column + columns_per_run).min(width);
+            order.clear();
+            for x0 in (first_column..end_column).step_by(GRID_TILE) {
+                for row in 0..GRID_TILE {
+                    let start = row * width;
+                    order.extend((start + x0..start + (x0 + GRID_TILE).min(end_column)).filter(|&i| i < rays.len()));
+                }
+            }
+            gathered.clear();
+            gathered.extend(order.iter().map(|&i| rays[i]));
+            answered.clear();
+            answered.resize(gathered.len(), T::default());
+            query(&gathered, &mut answered);
+            for (&i, &answer) in order.iter().zip(&answered) {
+                answers[i] = answer;
+            }
         }
     });
 }
