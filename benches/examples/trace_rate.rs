@@ -1,17 +1,19 @@
 //! The Rust side of the Python package's overhead benchmark
 //! (`python/benchmarks/overhead.py`): the rays `Scene.box_rays(count,
-//! seed)` makes, traced through `rtgi_accel::intersect_parallel` (what
+//! seed)` makes, traced through `rtgi_accel::parallel::intersect_all` (what
 //! `rtgi trace` uses) on rayon's global pool, timed `repeats` times after
 //! one warm-up, each time into a new buffer of answers (as the Python call
-//! returns new arrays) and, for comparison, into one buffer reused; and one ray at a time through the same call, for the cost
-//! of a call. Prints one JSON object: the times in milliseconds, the hits
+//! returns new arrays) and, for comparison, into one buffer reused; and one
+//! ray at a time through the same call, for the cost of a call. Prints one JSON object: the times in milliseconds, the hits
 //! and a checksum of the answers, which the Python side compares with its own.
 //!
 //! `cargo run --release -p rtgi-benches --example trace_rate -- SCENE [COUNT] [SEED] [ACCEL] [REPEATS]`
 
 use std::time::Instant;
 
-use rtgi_accel::{AccelKind, Hit, intersect_parallel};
+use rayon::prelude::*;
+use rtgi_accel::parallel::{BATCH_RAYS, intersect_all};
+use rtgi_accel::{AccelKind, Hit};
 use rtgi_render::rays::box_rays;
 use rtgi_scene::Scene;
 
@@ -28,18 +30,20 @@ fn main() {
     let accel = kind.build(&scene.triangle_positions(), &kind.default_params());
     let rays = box_rays(&scene, count, seed);
     // As a caller of the Rust API traces a new batch (and as `Accel.intersect`
-    // must, returning new arrays): the answers' buffer is allocated in the
-    // timed call. And, for comparison, into one buffer reused every time.
+    // must, returning new arrays): `intersect_all` returns a new vector of
+    // answers. And, for comparison, the same runs of the batch query into
+    // one buffer reused every time.
     let mut hits: Vec<Option<Hit>> = Vec::new();
     let mut reused: Vec<Option<Hit>> = vec![None; rays.len()];
     let (mut trace_ms, mut reused_ms) = (Vec::with_capacity(repeats), Vec::with_capacity(repeats));
     for run in 0..=repeats {
         let started = Instant::now();
-        hits = vec![None; rays.len()];
-        intersect_parallel(accel.as_ref(), &rays, &mut hits, None);
+        hits = intersect_all(accel.as_ref(), &rays, None);
         let allocated = started.elapsed().as_secs_f64() * 1e3;
         let started = Instant::now();
-        intersect_parallel(accel.as_ref(), &rays, &mut reused, None);
+        rays.par_chunks(BATCH_RAYS)
+            .zip(reused.par_chunks_mut(BATCH_RAYS))
+            .for_each(|(batch, out)| accel.intersect_batch(batch, out));
         if run > 0 {
             trace_ms.push(allocated);
             reused_ms.push(started.elapsed().as_secs_f64() * 1e3);
@@ -53,11 +57,10 @@ fn main() {
     });
     // One ray per call: the cost of a call of the Rust API.
     let one = &rays[..1];
-    let mut one_hit = [None];
     let calls = 20_000;
     let started = Instant::now();
     for _ in 0..calls {
-        intersect_parallel(accel.as_ref(), one, &mut one_hit, None);
+        std::hint::black_box(intersect_all(accel.as_ref(), one, None));
     }
     let call_us = started.elapsed().as_secs_f64() * 1e6 / calls as f64;
     let hit_count = hits.iter().filter(|h| h.is_some()).count();

@@ -1,5 +1,5 @@
 """Python's overhead: the cost of a call of `Accel.intersect` and the rate
-of 1 M rays, against the Rust API (`rtgi_accel::intersect_parallel`) on the
+of 1 M rays, against the Rust API (`rtgi_accel::parallel::intersect_all`) on the
 same rays, in alternating runs.
 
 The Rust side is the example `benches/examples/trace_rate.rs`; build it and
@@ -103,7 +103,7 @@ def main():
           f"{rust['threads']} threads, {args.rounds} rounds × {args.repeats} traces each side, "
           f"{platform.processor() or platform.machine()}, {time.strftime('%Y-%m-%d')}")
     print()
-    print("| | Python (`Accel.intersect`) | Rust (`intersect_parallel`) | Python / Rust |")
+    print("| | Python (`Accel.intersect`) | Rust (`parallel::intersect_all`) | Python / Rust |")
     print("|---|---|---|---|")
     print(f"| {args.rays:,} rays: ms, median (min–max) | {p[0]:.1f} ({p[1]:.1f}–{p[2]:.1f}) | "
           f"{r[0]:.1f} ({r[1]:.1f}–{r[2]:.1f}) | {p[0] / r[0]:.3f} |")

@@ -1,14 +1,15 @@
 //! `rtgi.Accel`: an acceleration structure over a scene's triangles, and
 //! its ray queries on arrays. Tracing releases the GIL and runs on rayon's
-//! threads, in runs of [`rtgi_accel::BATCH_RAYS`] rays given to the batch
-//! queries, as `rtgi trace` and [`rtgi_accel::intersect_parallel`] trace;
+//! threads, in runs of [`BATCH_RAYS`] rays given to the batch queries, as
+//! `rtgi trace` and [`rtgi_accel::parallel::intersect_all`] trace;
 //! each run's rays are made from the arrays, and its answers written to the
 //! output arrays, by the thread that traces it.
 
 use numpy::PyArray1;
 use pyo3::prelude::*;
 use rayon::prelude::*;
-use rtgi_accel::{AccelKind, BATCH_RAYS, BuildParams, Hit, Ray, Vec3};
+use rtgi_accel::parallel::BATCH_RAYS;
+use rtgi_accel::{AccelKind, BuildParams, Hit, Ray, Vec3};
 use rtgi_job::Structure;
 
 use crate::arrays::{Bounds, PerRay, rows3_f32};

@@ -40,7 +40,7 @@ fn _rtgi(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(tools::experiment, m)?)?;
     m.add_function(wrap_pyfunction!(tools::names, m)?)?;
     m.add("MISS", accel::MISS)?;
-    m.add("BATCH_RAYS", rtgi_accel::BATCH_RAYS)?;
+    m.add("BATCH_RAYS", rtgi_accel::parallel::BATCH_RAYS)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     m.add("EMBREE", cfg!(feature = "embree"))?;
     Ok(())

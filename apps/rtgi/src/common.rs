@@ -41,11 +41,6 @@ pub(crate) fn size_global_pool(threads: Option<u32>) -> Result<()> {
     builder.build_global().context("cannot start worker threads")
 }
 
-/// A pool of `threads` worker threads, or one per core.
-pub(crate) fn thread_pool(threads: Option<u32>) -> Result<rayon::ThreadPool> {
-    Ok(rtgi_job::thread_pool(threads)?)
-}
-
 /// Writes `bytes` to `path` atomically ([`rtgi_image::write_atomically`]):
 /// a failure never leaves a partial file or destroys an earlier one, and a
 /// FIFO or device is written in place.

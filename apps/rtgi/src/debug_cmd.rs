@@ -5,7 +5,7 @@ use std::path::PathBuf;
 use anyhow::{Result, bail};
 use clap::Args;
 use rtgi_accel::boxes_obj;
-use rtgi_image::{HdrImage, OutputFormat, ToneMap, check_writable, heat_colour};
+use rtgi_image::{OutputFormat, ToneMap, check_writable, heat_map};
 use rtgi_render::render_traversal_cost;
 
 use crate::common::{LoadedScene, check_output_folder, choose_camera, load_scene, write_atomically};
@@ -106,15 +106,11 @@ pub(crate) fn heatmap(args: &HeatmapArgs) -> Result<()> {
     let (counts, total) =
         pool.install(|| render_traversal_cost(accel.as_ref(), &camera, args.size.width(), args.size.height(), &|_| {}));
 
-    let channel = |p: rtgi_math::Vec3| if args.triangles { p.y } else { p.x };
-    let maximum = counts.pixels().iter().map(|&p| channel(p)).fold(0.0f32, f32::max);
-    let scale = args.scale.unwrap_or(maximum.max(1.0));
+    let channel = if args.triangles { 1 } else { 0 };
+    let (map, scale, maximum) = heat_map(&counts, channel, args.scale);
     let image = match format {
         OutputFormat::Exr => counts,
-        OutputFormat::Png => {
-            let pixels = counts.pixels().iter().map(|&p| heat_colour(channel(p) / scale)).collect();
-            HdrImage::from_pixels(args.size.width(), args.size.height(), pixels).expect("one colour per pixel")
-        }
+        OutputFormat::Png => map,
     };
     image.write(&output, &ToneMap::default())?;
     let rays = total.rays.max(1) as f64;

@@ -12,8 +12,9 @@ use std::time::Instant;
 use anyhow::{Result, bail};
 use clap::Args;
 use clap::builder::{PossibleValue, PossibleValuesParser, TypedValueParser};
+use rtgi_experiment::plan::Run;
 use rtgi_experiment::provenance::Build;
-use rtgi_experiment::{KNOBS, Knob, Machine, Options, RunRecord, Scenes, Subject};
+use rtgi_experiment::{KNOBS, Knob, Machine, Options, RunRecord, Subject};
 use rtgi_render::{RenderSettings, recipe};
 
 use rtgi_job::MAX_IMAGE_SIDE;
@@ -99,34 +100,6 @@ fn knob_parser() -> impl TypedValueParser<Value = KnobChoice> {
     })
 }
 
-/// Where a report scene is: `project:NAME` in this workspace's `scenes/`,
-/// anything else in the shared scenes; and the name it is reported under.
-fn report_scene(scene: &str) -> (PathBuf, String) {
-    match scene.strip_prefix("project:") {
-        Some(name) => (Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes").join(name), format!("scenes/{name}")),
-        None => {
-            let path = scenes_folder().join(scene);
-            // Named as the shared scenes are documented, not by this machine's absolute path.
-            let name = if std::env::var_os("RTGI_SCENES").is_some() {
-                path.display().to_string()
-            } else {
-                format!("../shared/scenes/{scene}")
-            };
-            (path, name)
-        }
-    }
-}
-
-/// The folder of shared scenes: `$RTGI_SCENES`, else `../shared/scenes`
-/// beside the workspace this program was built in, else beside the current folder.
-fn scenes_folder() -> PathBuf {
-    if let Some(folder) = std::env::var_os("RTGI_SCENES") {
-        return folder.into();
-    }
-    let built_in = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/scenes");
-    if built_in.is_dir() { built_in } else { PathBuf::from("../shared/scenes") }
-}
-
 pub(crate) fn run(args: &ExperimentArgs) -> Result<()> {
     let started = (Instant::now(), rtgi_experiment::provenance::utc_now());
     let knobs: Vec<&dyn Knob> = match args.knob {
@@ -157,41 +130,21 @@ pub(crate) fn run(args: &ExperimentArgs) -> Result<()> {
         cache: (!args.no_cache).then(|| args.cache.clone().unwrap_or_else(|| out_root.join(".references"))),
         reference_spp: args.reference_spp,
     };
-    // (knob, scene, its name in the report, folder) for every run.
-    type Run = (&'static dyn Knob, Option<PathBuf>, Option<String>, PathBuf);
-    let mut runs: Vec<Run> = Vec::new();
-    for &knob in &knobs {
-        let single_folder = match (args.knob, &args.out) {
-            (KnobChoice::One(_), Some(out)) => out.clone(),
-            _ => out_root.join(knob.name()),
-        };
-        let scenes = match knob.scenes() {
-            Scenes::Subject(scenes) if report_mode => scenes,
-            _ => {
-                runs.push((knob, args.scene.clone(), None, single_folder));
-                continue;
-            }
-        };
-        for scene in scenes {
-            let (path, name) = report_scene(scene);
-            if !path.is_file() {
-                eprintln!(
-                    "skipping {knob} on {}: not found (set RTGI_SCENES to the shared scenes' folder)",
-                    path.display()
-                );
-                continue;
-            }
-            let stem = path.file_stem().map_or_else(|| "scene".into(), |s| s.to_string_lossy().to_lowercase());
-            let folder = if scenes.len() > 1 { single_folder.join(stem) } else { single_folder.clone() };
-            runs.push((knob, Some(path), Some(name), folder));
-        }
+    let single_folder = match args.knob {
+        KnobChoice::One(_) => args.out.as_deref(),
+        _ => None,
+    };
+    let (runs, missing) =
+        rtgi_experiment::plan::runs(&knobs, args.scene.as_deref(), &out_root, single_folder, report_mode);
+    for (knob, path) in missing {
+        eprintln!("skipping {knob} on {}: not found (set RTGI_SCENES to the shared scenes' folder)", path.display());
     }
 
     // Every experiment asked for runs and writes its files even when the
     // reader of standard output has gone (`| head`): the first failed write
     // is kept and returned at the end, and nothing more is printed after it.
     let mut printed = Ok(());
-    for (knob, scene, name, folder) in runs {
+    for Run { knob, scene, name, folder } in runs {
         let mut subject = pool.install(|| prepare(args, scene.as_deref(), &pool))?;
         if let Some(name) = name {
             subject.name = name;

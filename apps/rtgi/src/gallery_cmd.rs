@@ -5,7 +5,7 @@ use std::path::PathBuf;
 
 use anyhow::{Context, Result};
 use clap::Args;
-use rtgi_image::{HdrImage, ToneMap};
+use rtgi_image::{ToneMap, contact_sheet};
 use rtgi_job::{ImageSize, RenderRequest, SceneSource, check_output};
 
 use crate::options::{load_options, threads_from_environment};
@@ -60,20 +60,7 @@ pub(crate) fn run(args: &GalleryArgs) -> Result<()> {
     }
     let _ = std::fs::remove_dir_all(&scratch);
 
-    let (w, h, columns) = (args.width, args.height, args.columns.min(pictures.len() as u32).max(1));
-    let rows = (pictures.len() as u32).div_ceil(columns);
-    let mut sheet = HdrImage::new(columns * w + (columns + 1) * GAP, rows * h + (rows + 1) * GAP);
-    sheet.pixels_mut().fill(rtgi_math::Vec3::splat(0.2));
-    for (index, picture) in pictures.iter().enumerate() {
-        let (x0, y0) = (GAP + (index as u32 % columns) * (w + GAP), GAP + (index as u32 / columns) * (h + GAP));
-        let Some((image, tone_map)) = picture else { continue };
-        for y in 0..h.min(image.height()) {
-            for x in 0..w.min(image.width()) {
-                // Tone-mapped here: the sheet is written with the identity map.
-                sheet.set(x0 + x, y0 + y, tone_map.apply(image.get(x, y)));
-            }
-        }
-    }
+    let sheet = contact_sheet(&pictures, args.width, args.height, args.columns, GAP);
     sheet.write(&args.output, &ToneMap::default())?;
     outln!("wrote       {} ({} scenes)", args.output.display(), pictures.len())?;
     Ok(())

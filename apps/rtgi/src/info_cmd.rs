@@ -59,67 +59,9 @@ pub(crate) fn run(args: &InfoArgs) -> Result<()> {
 }
 
 fn print_text(info: &SceneDescription) -> Result<()> {
-    let v = |a: [f32; 3]| format!("({}, {}, {})", a[0], a[1], a[2]);
-    outln!("scene       {}", info.scene)?;
-    outln!("triangles   {}", info.triangles)?;
-    if info.positions < info.vertices {
-        outln!(
-            "vertices    {} ({} distinct positions: corners at one position are split where their normals or \
-             texture coordinates differ)",
-            info.vertices,
-            info.positions
-        )?;
-    } else {
-        outln!("vertices    {}", info.vertices)?;
-    }
-    if let Some([min, max]) = info.bounds {
-        outln!("bounds      {} to {}", v(min), v(max))?;
-    }
-    outln!("materials   {}", info.materials.len())?;
-    for m in &info.materials {
-        outln!(
-            "  {:<24} {:>8} triangles, base colour {}{}, metallic {}, roughness {:.3}, emission {}, {}",
-            m.name,
-            m.triangles,
-            v(m.base_color),
-            if m.textured { " x texture" } else { "" },
-            m.metallic,
-            m.roughness,
-            v(m.emission),
-            m.alpha
-        )?;
-        if !m.layers.is_empty() {
-            outln!("  {:<24} {}", "", m.layers.join("; "))?;
-        }
-    }
-    outln!("textures    {}", info.textures.len())?;
-    for (index, t) in info.textures.iter().enumerate() {
-        outln!("  [{index}] {} ({}x{})", t.name, t.width, t.height)?;
-    }
-    outln!("lights      {}", info.lights.len())?;
-    for l in &info.lights {
-        outln!("  {:<24} {} at {}, colour {}, intensity {}", l.name, l.kind, v(l.position), v(l.color), l.intensity)?;
-    }
-    outln!("cameras     {}", info.cameras.len())?;
-    for (index, c) in info.cameras.iter().enumerate() {
-        outln!(
-            "  [{index}] at {} looking {}, up {}, vertical field of view {:.2}°{}",
-            v(c.position),
-            v(c.direction),
-            v(c.up),
-            c.vertical_fov_degrees,
-            c.aspect.map_or(String::new(), |aspect| format!(", aspect {aspect}"))
-        )?;
-    }
-    if !info.extensions.is_empty() {
-        outln!("extensions  {}", info.extensions.len())?;
-        for e in &info.extensions {
-            let detail = if e.detail.is_empty() { String::new() } else { format!(": {}", e.detail) };
-            outln!("  {:<36} {}{detail}", e.name, e.support)?;
-        }
-    }
+    out!("{info}")?;
     if !info.material_variants.is_empty() {
-        outln!("variants    {} (--variant NAME renders one)", info.material_variants.join(", "))?;
+        outln!("            (--variant NAME renders one)")?;
     }
     out!("{}", info.plan)
 }
@@ -142,10 +84,7 @@ pub(crate) fn compare(args: &CompareArgs) -> Result<()> {
     if args.json {
         outln!("{}", serde_json::to_string_pretty(&d)?)?;
     } else {
-        outln!("rmse          {:.6}", d.rmse)?;
-        outln!("relative mse  {:.6}", d.relative_mse)?;
-        outln!("max abs       {:.6} at pixel ({}, {})", d.max_abs, d.max_at.0, d.max_at.1)?;
-        outln!("mean          {:.6} (reference {:.6})", d.mean, d.reference_mean)?;
+        out!("{d}")?;
     }
     Ok(())
 }

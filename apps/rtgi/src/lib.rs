@@ -19,14 +19,47 @@ mod output;
 mod phrasing;
 mod progress;
 mod rays_cmd;
-#[cfg(test)]
-mod reference;
 mod render_cmd;
 mod script;
 mod trace_cmd;
 mod verify_cmd;
 
 use std::process::ExitCode;
+
+/// The command line's definitions (every command, option and help text),
+/// for generators of its reference (`tests/tests/workspace/cli_reference.rs`).
+pub fn command() -> clap::Command {
+    <cli::Cli as clap::CommandFactory>::command()
+}
+
+/// The `rtgi render` command that makes `request`, as words after `rtgi`
+/// (`render`, then only the options that differ from their defaults):
+/// what a script prints beside its render, so that it can be run again,
+/// split or put on a cluster.
+pub fn render_command_line(request: &rtgi_job::RenderRequest) -> Vec<String> {
+    command_line::CommandLine::to_command_line(request)
+}
+
+/// The request that `words` (after `rtgi`: `render`, the scene, options,
+/// and the global options such as `--variant`) make, as `rtgi render`
+/// would render it; `RTGI_THREADS` is read as `rtgi render` reads it.
+///
+/// # Errors
+/// Words that are no render command line, with clap's message.
+pub fn render_request<T: Into<std::ffi::OsString> + Clone>(
+    words: impl IntoIterator<Item = T>,
+) -> anyhow::Result<rtgi_job::RenderRequest> {
+    let words = std::iter::once(std::ffi::OsString::from("rtgi")).chain(words.into_iter().map(Into::into));
+    let cli = cli::parse(words).map_err(|e| anyhow::anyhow!("{}", e.to_string().trim_end()))?;
+    let cli::Command::Render(args) = cli.command else { anyhow::bail!("not an `rtgi render` command line") };
+    let mut request = args.request()?;
+    // The global options, which `main` keeps in statics for every command.
+    if let rtgi_job::SceneSource::File { options, .. } = &mut request.scene {
+        options.allow_outside_folder = cli.allow_outside_scene;
+        options.gltf_variant = cli.variant;
+    }
+    Ok(request)
+}
 
 /// Runs the command line with the process's arguments; returns the exit code.
 pub fn main() -> ExitCode {

@@ -4,7 +4,7 @@ use std::path::PathBuf;
 
 use anyhow::{Context, Result, bail};
 use clap::Args;
-use rtgi_render::{Accumulation, MergeFilesError};
+use rtgi_render::Accumulation;
 
 use crate::options::ToneArgs;
 use crate::output::outln;
@@ -37,42 +37,18 @@ pub(crate) fn run(args: &MergeArgs) -> Result<()> {
             bail!("-o {}: is also one of the parts; write the result to a new file", args.output.display());
         }
     }
-    let names: Vec<String> = args.parts.iter().map(|p| p.display().to_string()).collect();
-    let merged = Accumulation::merge_files(&args.parts).map_err(|e| {
-        let e = match e {
-            MergeFilesError::File(e) => return anyhow::Error::new(e),
-            MergeFilesError::Merge(e) => e,
-        };
-        // The error numbers the parts; name them.
-        let mut message = e.to_string();
-        message = message.replace("than part 0", &format!("than {}", names[0]));
-        for (index, name) in names.iter().enumerate().rev() {
-            message = message.replace(&format!("part {index} "), &format!("{name} "));
-            message = message.replace(&format!("parts {index} "), &format!("{name} "));
-            message = message.replace(&format!("and {index} "), &format!("and {name} "));
-        }
-        anyhow::anyhow!("cannot merge: {message}")
-    })?;
+    let merged = Accumulation::merge_files(&args.parts)?;
     let identity = merged.identity();
     let complete = merged.is_complete();
     if !complete && !args.allow_incomplete {
-        let (rows, samples) = (merged.rows(), merged.samples());
-        let mut missing = Vec::new();
-        if samples.start > 0 {
-            missing.push(format!("samples {:?}", 0..samples.start));
-        }
-        if samples.end < identity.samples_per_pixel {
-            missing.push(format!("samples {:?}", samples.end..identity.samples_per_pixel));
-        }
-        if rows != (0..identity.height) {
-            missing.push(format!("the rows outside {rows:?} of 0..{}", identity.height));
-        }
         bail!(
-            "incomplete: the {} parts hold samples {samples:?} of 0..{} of every pixel of rows {rows:?}; no part \
-             holds {}. Add the missing parts, or give --allow-incomplete to write what there is",
+            "incomplete: the {} parts hold samples {:?} of 0..{} of every pixel of rows {:?}; no part holds {}. Add \
+             the missing parts, or give --allow-incomplete to write what there is",
             args.parts.len(),
+            merged.samples(),
             identity.samples_per_pixel,
-            missing.join(" or ")
+            merged.rows(),
+            merged.missing().join(" or ")
         );
     }
     if is_accumulation(&args.output) {

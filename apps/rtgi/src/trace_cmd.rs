@@ -2,14 +2,16 @@
 //! file (the format is `rtgi_accel::ray_file`'s).
 
 use std::fs::File;
-use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use anyhow::{Context, Result, bail};
 use clap::Args;
+use rtgi_accel::parallel::{
+    BATCH_RAYS, GRID_TILE, HitFilter, intersect_all, intersect_grid, occluded_all, occluded_grid,
+};
 use rtgi_accel::ray_file::{self, HitWriter, RayReader};
-use rtgi_accel::{Accel, BATCH_RAYS, Hit, HitFilter, Ray, intersect_parallel, occluded_parallel};
+use rtgi_image::write_atomically_with;
 use rtgi_render::{AlphaTest, has_alpha};
 
 use crate::common::{LoadedScene, check_output_folder, load_scene, refuse_inputs_as_outputs};
@@ -51,6 +53,12 @@ pub(crate) struct TraceArgs {
     #[arg(long)]
     pub(crate) no_alpha: bool,
 
+    /// The rays are a camera grid WIDTH rays wide in scanline order (row by row): they are traced in
+    /// 4x4 tiles, which the wide BVHs take as packets of 16, instead of runs along a row; the hits are
+    /// the same, in the file's order
+    #[arg(long, value_name = "WIDTH", value_parser = clap::value_parser!(u32).range(1..=rtgi_job::MAX_IMAGE_SIDE as i64))]
+    pub(crate) grid: Option<u32>,
+
     #[command(flatten)]
     pub(crate) accel: AccelArgs,
 
@@ -64,8 +72,9 @@ pub(crate) struct TraceArgs {
 const BLEND_THRESHOLD: f32 = 0.5;
 /// Rays read, traced and written at a time (2 MiB of rays, 1 MiB of hits):
 /// memory stays bounded whatever the file's size, and each chunk gives the
-/// worker threads 64 batches. A multiple of `BATCH_RAYS`, so that the
-/// batches are the same runs of the file as if it were traced whole.
+/// worker threads 64 batches. Rounded up to whole batches (or with
+/// `--grid`, whole bands of tile rows), so that the batches are the same
+/// runs of the file as if it were traced whole.
 const CHUNK_RAYS: usize = 64 * BATCH_RAYS;
 
 pub(crate) fn run(args: &TraceArgs) -> Result<()> {
@@ -74,9 +83,11 @@ pub(crate) fn run(args: &TraceArgs) -> Result<()> {
     check_output_folder(&out)?;
     // The first chunk is read before the scene, so that a file that is no
     // ray file at all (`/dev/zero`, a picture) is refused at once.
-    let mut input = open_rays(&args.rays)?;
+    // A grid is read in whole bands of tile rows, so that no band is cut.
+    let band = args.grid.map_or(BATCH_RAYS, |width| width as usize * GRID_TILE);
+    let mut input = open_rays(&args.rays, CHUNK_RAYS.div_ceil(band) * band)?;
     let read_error = || args.rays.display().to_string();
-    let mut rays = Vec::with_capacity(CHUNK_RAYS);
+    let mut rays = Vec::new();
     let mut more = input.next_chunk(&mut rays).with_context(read_error)?;
     let LoadedScene { scene, load_ms, .. } = load_scene(Some(&args.scene))?;
 
@@ -90,19 +101,45 @@ pub(crate) fn run(args: &TraceArgs) -> Result<()> {
         |triangle, beta, gamma| alpha_test.as_ref().is_none_or(|t| t.accepts(triangle, beta, gamma, BLEND_THRESHOLD));
     let filter: Option<HitFilter<'_>> = alpha_test.is_some().then_some(&accept);
 
-    let mut output = HitWriter::new(PartialFile::create(&out)?);
-    let write_error = || format!("{}: cannot write", out.display());
+    // Written through a temporary file that replaces `out` only when
+    // complete: a failure leaves no partial file and keeps an earlier one.
     let (mut ray_count, mut hit_count, mut trace_s) = (0usize, 0usize, 0.0);
-    while more {
-        let trace_start = Instant::now();
-        let answers = pool.install(|| trace_chunk(accel.as_ref(), &rays, args.any_hit, filter));
-        trace_s += trace_start.elapsed().as_secs_f64();
-        ray_count += rays.len();
-        hit_count += answers.hits();
-        answers.write_to(&mut output).with_context(write_error)?;
-        more = input.next_chunk(&mut rays).with_context(read_error)?;
+    let mut read_failure = None;
+    let written = write_atomically_with(&out, |sink| {
+        let mut output = HitWriter::new(sink);
+        while more {
+            let trace_start = Instant::now();
+            let accel = accel.as_ref();
+            let grid = args.grid.map(|width| width as usize);
+            if args.any_hit {
+                let occluded = pool.install(|| match grid {
+                    Some(width) => occluded_grid(accel, &rays, width, filter),
+                    None => occluded_all(accel, &rays, filter),
+                });
+                trace_s += trace_start.elapsed().as_secs_f64();
+                hit_count += occluded.iter().filter(|&&o| o).count();
+                output.write_occluded(&occluded)?;
+            } else {
+                let hits = pool.install(|| match grid {
+                    Some(width) => intersect_grid(accel, &rays, width, filter),
+                    None => intersect_all(accel, &rays, filter),
+                });
+                trace_s += trace_start.elapsed().as_secs_f64();
+                hit_count += hits.iter().flatten().count();
+                output.write_closest(&hits)?;
+            }
+            ray_count += rays.len();
+            more = input.next_chunk(&mut rays).map_err(|e| {
+                read_failure = Some(anyhow::Error::new(e).context(read_error()));
+                std::io::Error::other("the ray file could not be read")
+            })?;
+        }
+        Ok(())
+    });
+    if let Some(failure) = read_failure {
+        return Err(failure);
     }
-    output.into_inner().commit()?;
+    written.with_context(|| format!("{}: cannot write", out.display()))?;
 
     eprintln!("load   {load_ms:.1} ms ({} triangles)", scene.triangles.len());
     eprintln!("build  {build_ms:.1} ms ({})", accel.build_stats().variant);
@@ -130,46 +167,9 @@ pub(crate) fn run(args: &TraceArgs) -> Result<()> {
     Ok(())
 }
 
-/// The answers of one chunk of rays, in their order.
-enum Answers {
-    Closest(Vec<Option<Hit>>),
-    Occluded(Vec<bool>),
-}
-
-impl Answers {
-    /// Rays that hit something.
-    fn hits(&self) -> usize {
-        match self {
-            Answers::Closest(hits) => hits.iter().filter(|h| h.is_some()).count(),
-            Answers::Occluded(occluded) => occluded.iter().filter(|&&o| o).count(),
-        }
-    }
-
-    fn write_to<W: Write>(&self, out: &mut HitWriter<W>) -> std::io::Result<()> {
-        match self {
-            Answers::Closest(hits) => out.write_closest(hits),
-            Answers::Occluded(occluded) => out.write_occluded(occluded),
-        }
-    }
-}
-
-/// Traces `rays` through the batch queries, [`rtgi_accel::BATCH_RAYS`] at
-/// a time in parallel, with the hit filter if there is one (cut-outs).
-fn trace_chunk(accel: &dyn Accel, rays: &[Ray], any_hit: bool, filter: Option<HitFilter<'_>>) -> Answers {
-    if any_hit {
-        let mut occluded = vec![false; rays.len()];
-        occluded_parallel(accel, rays, &mut occluded, filter);
-        Answers::Occluded(occluded)
-    } else {
-        let mut closest = vec![None; rays.len()];
-        intersect_parallel(accel, rays, &mut closest, filter);
-        Answers::Closest(closest)
-    }
-}
-
 /// Opens a ray file; a regular file whose size is no multiple of a record
 /// is refused here, before any work (a stream, at its end).
-fn open_rays(path: &Path) -> Result<RayReader<File>> {
+fn open_rays(path: &Path, chunk_rays: usize) -> Result<RayReader<File>> {
     let file = File::open(path).with_context(|| format!("{}: cannot read", path.display()))?;
     let metadata = file.metadata().with_context(|| format!("{}: cannot read", path.display()))?;
     if metadata.is_dir() {
@@ -178,65 +178,5 @@ fn open_rays(path: &Path) -> Result<RayReader<File>> {
     if metadata.is_file() {
         ray_file::ray_count(metadata.len()).with_context(|| path.display().to_string())?;
     }
-    Ok(RayReader::new(file, CHUNK_RAYS))
-}
-
-/// An output file written as it is produced, through a temporary file
-/// beside it that replaces it only when complete ([`PartialFile::commit`]):
-/// a failure never leaves a partial file or destroys an earlier one. The
-/// temporary file is named as `common::write_atomically` names its own.
-///
-/// A path that exists and is neither a regular file nor a folder (a FIFO,
-/// `/dev/null`, `/dev/stdout`) is written directly: renaming a file over it
-/// would replace the device or the pipe with a plain file (and for root,
-/// `/dev/null` is in a writable folder).
-struct PartialFile {
-    path: PathBuf,
-    /// The temporary file, renamed to `path` on commit; `None` when
-    /// writing to `path` directly.
-    temporary: Option<PathBuf>,
-    file: Option<BufWriter<File>>,
-}
-
-impl PartialFile {
-    fn create(path: &Path) -> Result<Self> {
-        let special = std::fs::metadata(path).is_ok_and(|m| !m.is_file() && !m.is_dir());
-        let temporary = (!special).then(|| {
-            let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
-            path.with_file_name(format!(".{name}.{}.partial", std::process::id()))
-        });
-        let file = File::create(temporary.as_deref().unwrap_or(path))
-            .with_context(|| format!("{}: cannot write", path.display()))?;
-        Ok(PartialFile { path: path.to_owned(), temporary, file: Some(BufWriter::new(file)) })
-    }
-
-    /// Puts the complete file in place of `path`.
-    fn commit(mut self) -> Result<()> {
-        let file = self.file.take().expect("committed once");
-        let file = file.into_inner().map_err(|e| e.into_error());
-        match &self.temporary {
-            Some(temporary) => file.and_then(|f| f.sync_all()).and_then(|()| std::fs::rename(temporary, &self.path)),
-            None => file.map(drop),
-        }
-        .with_context(|| format!("{}: cannot write", self.path.display()))
-    }
-}
-
-impl Write for PartialFile {
-    fn write(&mut self, bytes: &[u8]) -> std::io::Result<usize> {
-        self.file.as_mut().expect("written only before commit").write(bytes)
-    }
-
-    fn flush(&mut self) -> std::io::Result<()> {
-        self.file.as_mut().expect("written only before commit").flush()
-    }
-}
-
-impl Drop for PartialFile {
-    /// Removes the temporary file unless it was committed (renamed away).
-    fn drop(&mut self) {
-        if let Some(temporary) = &self.temporary {
-            let _ = std::fs::remove_file(temporary);
-        }
-    }
+    Ok(RayReader::new(file, chunk_rays))
 }

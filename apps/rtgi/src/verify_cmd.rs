@@ -11,7 +11,7 @@ use rtgi_accel::{AccelKind, BuildParams, Intersector};
 
 use crate::common::{check_output_folder, load_scene, write_atomically};
 use crate::options::{AccelList, AccelParser, BuildArgs, SeedArgs, ThreadArgs};
-use crate::output::outln;
+use crate::output::out;
 
 /// `rtgi verify`: the exactness contract, checked on a scene or on the built-in adversarial set.
 #[derive(Debug, Args)]
@@ -116,7 +116,7 @@ pub(crate) fn run(args: &VerifyArgs) -> Result<()> {
     }
     // A reader that stops early (`| head`) must change neither the JSON
     // written nor the exit status that says whether verification failed.
-    let printed = print_report(&report);
+    let printed = out!("{report}");
     if let Some(json) = &args.json {
         write_atomically(json, serde_json::to_string_pretty(&report)?.as_bytes())?;
     }
@@ -156,110 +156,4 @@ impl Heartbeat {
             self.last = Instant::now();
         }
     }
-}
-
-fn print_report(report: &VerifyReport) -> Result<()> {
-    outln!("rtgi verify: {} (seed {})", report.scene, report.seed)?;
-    outln!()?;
-    outln!(
-        "{:<15} {:>10} {:>12} {:>14} {:>14} {:>8} {:>10}",
-        "ray kind",
-        "rays",
-        "linear rays",
-        "closest diff.",
-        "any-hit diff.",
-        "leaks",
-        "self-hits"
-    )?;
-    for row in &report.kinds {
-        let t = &row.tally;
-        outln!(
-            "{:<15} {:>10} {:>12} {:>14} {:>14} {:>8} {:>10}",
-            row.kind,
-            row.rays,
-            row.linear_rays,
-            t.closest_disagreements,
-            t.any_disagreements,
-            t.leaks,
-            t.self_hits
-        )?;
-    }
-    if report.kinds.iter().any(|row| row.peers.is_some()) {
-        outln!()?;
-        outln!("peers by ray kind (peer: differences are not failures)")?;
-        outln!(
-            "{:<15} {:>10} {:>12} {:>14} {:>14} {:>8} {:>10}",
-            "ray kind",
-            "rays",
-            "linear rays",
-            "closest diff.",
-            "any-hit diff.",
-            "leaks",
-            "self-hits"
-        )?;
-        for row in &report.kinds {
-            let t = row.peers.clone().unwrap_or_default();
-            outln!(
-                "{:<15} {:>10} {:>12} {:>14} {:>14} {:>8} {:>10}",
-                row.kind,
-                row.rays,
-                row.linear_rays,
-                t.closest_disagreements,
-                t.any_disagreements,
-                t.leaks,
-                t.self_hits
-            )?;
-        }
-    }
-    outln!()?;
-    outln!(
-        "{:<44} {:>10} {:>14} {:>14} {:>8} {:>10}",
-        "structure",
-        "rays",
-        "closest diff.",
-        "any-hit diff.",
-        "leaks",
-        "self-hits"
-    )?;
-    for s in &report.structures {
-        let t = &s.tally;
-        let leaks = if s.watertight || t.leaks == 0 { t.leaks.to_string() } else { format!("({})", t.leaks) };
-        outln!(
-            "{:<44} {:>10} {:>14} {:>14} {:>8} {:>10}",
-            s.structure,
-            t.rays,
-            t.closest_disagreements,
-            t.any_disagreements,
-            leaks,
-            t.self_hits
-        )?;
-    }
-    outln!()?;
-    outln!(
-        "Disagreements are differences in any bit of the closest hit (triangle, t, beta, gamma) or in the any-hit \
-         answer, against the linear scan (on big scenes the linear scan answers the first rays of each kind; the \
-         rest are compared with the first structure). Leaks are rays aimed inside a closed surface that hit nothing \
-         by the point aimed at; leaks in parentheses are those of a test that does not claim watertightness \
-         (moller-trumbore). Self-hits are rays leaving a triangle that hit it again."
-    )?;
-    if report.structures.iter().any(|s| s.peer) {
-        outln!(
-            "Structures marked (peer) are other people's backends (Embree), not held to the exactness contract: \
-             they break ties between triangles at equal t in their own order and round differently on grazing rays. \
-             peer: differences are not failures, and do not change the exit status."
-        )?;
-    }
-    for s in &report.structures {
-        let t = &s.tally;
-        if s.peer && !t.is_clean() {
-            for example in &t.examples {
-                outln!("  {} (a difference, not a failure): {example}", s.structure)?;
-            }
-        } else if t.closest_disagreements + t.any_disagreements + t.self_hits > 0 || (s.watertight && t.leaks > 0) {
-            for example in &t.examples {
-                outln!("  {}: {example}", s.structure)?;
-            }
-        }
-    }
-    Ok(())
 }

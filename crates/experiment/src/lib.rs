@@ -30,6 +30,8 @@ use rtgi_render::RenderSettings;
 use rtgi_scene::{Camera, Scene};
 
 pub mod analytic;
+pub mod bench;
+pub mod bench_effects;
 pub mod exact;
 pub mod format;
 mod index;
@@ -38,6 +40,7 @@ pub mod machine;
 pub mod measure;
 pub mod panel;
 pub mod pareto;
+pub mod plan;
 pub mod plot;
 pub mod provenance;
 pub mod reference;

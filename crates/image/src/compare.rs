@@ -53,6 +53,16 @@ pub fn compare(test: &HdrImage, reference: &HdrImage) -> Option<Difference> {
     Some(d)
 }
 
+/// The lines `rtgi compare` prints.
+impl std::fmt::Display for Difference {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        writeln!(f, "rmse          {:.6}", self.rmse)?;
+        writeln!(f, "relative mse  {:.6}", self.relative_mse)?;
+        writeln!(f, "max abs       {:.6} at pixel ({}, {})", self.max_abs, self.max_at.0, self.max_at.1)?;
+        writeln!(f, "mean          {:.6} (reference {:.6})", self.mean, self.reference_mean)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -29,12 +29,14 @@ mod atomic;
 mod compare;
 mod exposure;
 mod floats;
+mod sheet;
 mod tonemap;
 mod write;
 
 pub use atomic::{unusable_folder, write_atomically, write_atomically_with};
 pub use compare::{Difference, compare};
 pub use exposure::{Legibility, auto_exposure, legibility};
+pub use sheet::{contact_sheet, heat_map};
 pub use tonemap::{ToneMap, ToneOperator, heat_colour, linear_to_srgb, srgb_to_linear};
 pub use write::{ImageError, MAX_READ_PIXELS, OutputFormat, check_writable};
 

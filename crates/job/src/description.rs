@@ -292,3 +292,82 @@ fn see_through(m: &rtgi_scene::Material) -> String {
     }
     if parts.is_empty() { "opaque".into() } else { parts.join(", ") }
 }
+
+/// The text `rtgi info` prints before the plan.
+impl std::fmt::Display for SceneDescription {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let v = |a: [f32; 3]| format!("({}, {}, {})", a[0], a[1], a[2]);
+        writeln!(f, "scene       {}", self.scene)?;
+        writeln!(f, "triangles   {}", self.triangles)?;
+        if self.positions < self.vertices {
+            writeln!(
+                f,
+                "vertices    {} ({} distinct positions: corners at one position are split where their normals or \
+             texture coordinates differ)",
+                self.vertices, self.positions
+            )?;
+        } else {
+            writeln!(f, "vertices    {}", self.vertices)?;
+        }
+        if let Some([min, max]) = self.bounds {
+            writeln!(f, "bounds      {} to {}", v(min), v(max))?;
+        }
+        writeln!(f, "materials   {}", self.materials.len())?;
+        for m in &self.materials {
+            writeln!(
+                f,
+                "  {:<24} {:>8} triangles, base colour {}{}, metallic {}, roughness {:.3}, emission {}, {}",
+                m.name,
+                m.triangles,
+                v(m.base_color),
+                if m.textured { " x texture" } else { "" },
+                m.metallic,
+                m.roughness,
+                v(m.emission),
+                m.alpha
+            )?;
+            if !m.layers.is_empty() {
+                writeln!(f, "  {:<24} {}", "", m.layers.join("; "))?;
+            }
+        }
+        writeln!(f, "textures    {}", self.textures.len())?;
+        for (index, t) in self.textures.iter().enumerate() {
+            writeln!(f, "  [{index}] {} ({}x{})", t.name, t.width, t.height)?;
+        }
+        writeln!(f, "lights      {}", self.lights.len())?;
+        for l in &self.lights {
+            writeln!(
+                f,
+                "  {:<24} {} at {}, colour {}, intensity {}",
+                l.name,
+                l.kind,
+                v(l.position),
+                v(l.color),
+                l.intensity
+            )?;
+        }
+        writeln!(f, "cameras     {}", self.cameras.len())?;
+        for (index, c) in self.cameras.iter().enumerate() {
+            writeln!(
+                f,
+                "  [{index}] at {} looking {}, up {}, vertical field of view {:.2}°{}",
+                v(c.position),
+                v(c.direction),
+                v(c.up),
+                c.vertical_fov_degrees,
+                c.aspect.map_or(String::new(), |aspect| format!(", aspect {aspect}"))
+            )?;
+        }
+        if !self.extensions.is_empty() {
+            writeln!(f, "extensions  {}", self.extensions.len())?;
+            for e in &self.extensions {
+                let detail = if e.detail.is_empty() { String::new() } else { format!(": {}", e.detail) };
+                writeln!(f, "  {:<36} {}{detail}", e.name, e.support)?;
+            }
+        }
+        if !self.material_variants.is_empty() {
+            writeln!(f, "variants    {}", self.material_variants.join(", "))?;
+        }
+        Ok(())
+    }
+}

@@ -146,6 +146,21 @@ pub enum MergeError {
     Bands(Range<u32>, Range<u32>),
 }
 
+impl MergeError {
+    /// The message with the parts named by `name` (a file, say) instead of their index.
+    pub fn naming(&self, name: &dyn Fn(usize) -> String) -> String {
+        match self {
+            MergeError::DifferentRender { part, differences } => {
+                format!("{} is of another render than {}: {differences}", name(*part), name(0))
+            }
+            MergeError::Overlap { first, second, rows, samples } => {
+                format!("{} and {} both hold samples {samples:?} of rows {rows:?}", name(*first), name(*second))
+            }
+            other => other.to_string(),
+        }
+    }
+}
+
 impl Accumulation {
     /// No samples yet of rows `rows`, the next sample being `first_sample`.
     ///
@@ -200,7 +215,24 @@ impl Accumulation {
 
     /// Whether every row and every sample of the render is in.
     pub fn is_complete(&self) -> bool {
-        self.rows == (0..self.identity.height) && self.samples == (0..self.identity.samples_per_pixel)
+        self.missing().is_empty()
+    }
+
+    /// What a complete render has that this one lacks ("samples 0..16",
+    /// "the rows outside 0..32 of 0..64"); empty when complete.
+    pub fn missing(&self) -> Vec<String> {
+        let (rows, samples, identity) = (self.rows(), self.samples(), self.identity());
+        let mut missing = Vec::new();
+        if samples.start > 0 {
+            missing.push(format!("samples {:?}", 0..samples.start));
+        }
+        if samples.end < identity.samples_per_pixel {
+            missing.push(format!("samples {:?}", samples.end..identity.samples_per_pixel));
+        }
+        if rows != (0..identity.height) {
+            missing.push(format!("the rows outside {rows:?} of 0..{}", identity.height));
+        }
+        missing
     }
 
     pub(crate) fn sums(&self) -> &[PixelSum] {

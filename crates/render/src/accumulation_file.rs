@@ -96,7 +96,7 @@ impl Accumulation {
     /// result's, whatever the number of parts.
     pub fn merge_files(paths: &[PathBuf]) -> Result<Accumulation, MergeFilesError> {
         let spans = paths.iter().map(|path| PartSpan::read(path)).collect::<Result<Vec<_>, _>>()?;
-        let plan = MergePlan::new(&spans)?;
+        let plan = MergePlan::new(&spans).map_err(|error| MergeFilesError::Merge { error, paths: paths.to_vec() })?;
         let mut merged = plan.empty();
         for (path, offset) in paths.iter().zip(&plan.offsets) {
             let mut file = PartFile::open(path)?;
@@ -112,9 +112,14 @@ pub enum MergeFilesError {
     /// A part could not be read.
     #[error(transparent)]
     File(#[from] AccumulationFileError),
-    /// The parts do not make one render.
-    #[error(transparent)]
-    Merge(#[from] MergeError),
+    /// The parts do not make one render; the message names the parts by their files.
+    #[error("cannot merge: {}", error.naming(&|part| paths[part].display().to_string()))]
+    Merge {
+        /// Why, with the parts numbered in the order of `paths`.
+        error: MergeError,
+        /// The parts' files.
+        paths: Vec<PathBuf>,
+    },
 }
 
 impl PartSpan {
@@ -317,7 +322,7 @@ mod tests {
         assert!(streamed.is_complete());
         // The headers are checked before any sums are read: an overlap is refused as in memory.
         let overlap = Accumulation::merge_files(&[paths[0].clone(), paths[0].clone()]).unwrap_err();
-        assert!(matches!(overlap, MergeFilesError::Merge(MergeError::Overlap { .. })), "{overlap:?}");
+        assert!(matches!(overlap, MergeFilesError::Merge { error: MergeError::Overlap { .. }, .. }), "{overlap:?}");
         // A damaged part fails the merge, naming the file.
         let bytes = std::fs::read(&paths[2]).unwrap();
         std::fs::write(&paths[2], &bytes[..bytes.len() - 1]).unwrap();

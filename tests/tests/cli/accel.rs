@@ -59,14 +59,16 @@ fn trace_writes_the_hits_of_every_variant_identically() {
     std::fs::write(&rays_path, encode(&rays)).unwrap();
     let reference = LinearScan::new(&scene.triangle_positions(), rtgi_accel::Intersector::default());
 
-    for accel in rtgi_accel::AccelKind::ALL {
+    // `--grid 24`: the camera rays are a grid 24 wide, traced in tiles; the answers must not change.
+    for (accel, grid) in rtgi_accel::AccelKind::ALL.iter().flat_map(|a| [(a, None), (a, Some("24"))]) {
         for any_hit in [false, true] {
-            let out = dir.join(format!("{accel}-{any_hit}.bin"));
+            let out = dir.join(format!("{accel}-{any_hit}{}.bin", grid.map_or("", |_| "-grid")));
             let mut args =
                 vec!["trace", BOX, "--rays", path_str(&rays_path), "--out", path_str(&out), "--accel", accel.name()];
             if any_hit {
                 args.push("--any-hit");
             }
+            args.extend(grid.map(|width| ["--grid", width]).into_iter().flatten());
             let run = rtgi(&args);
             assert!(run.success, "{run:?}");
             assert!(run.stderr.contains("Mrays/s") && run.stderr.contains("build"), "{}", run.stderr);

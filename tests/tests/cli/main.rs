@@ -6,6 +6,7 @@
 
 mod accel;
 mod basics;
+mod command_line;
 mod embree;
 mod first_look;
 mod hostile;

@@ -4,6 +4,7 @@
 //!
 //! One test binary for the theme, a module a file.
 
+mod cli_reference;
 mod deploy;
 mod experiment;
 mod experiment_index;

@@ -186,3 +186,84 @@ pub fn check_case(
     report.kinds = kinds.into_values().collect();
     Ok(())
 }
+
+/// The tables `rtgi verify` prints: by ray kind (and the peers' by ray
+/// kind), by structure, what the columns mean, and the examples of failures.
+impl std::fmt::Display for VerifyReport {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        writeln!(f, "rtgi verify: {} (seed {})", self.scene, self.seed)?;
+        let kind_table = |f: &mut std::fmt::Formatter<'_>, tally: &dyn Fn(&KindRow) -> Tally| {
+            writeln!(f)?;
+            writeln!(
+                f,
+                "{:<15} {:>10} {:>12} {:>14} {:>14} {:>8} {:>10}",
+                "ray kind", "rays", "linear rays", "closest diff.", "any-hit diff.", "leaks", "self-hits"
+            )?;
+            for row in &self.kinds {
+                let t = tally(row);
+                writeln!(
+                    f,
+                    "{:<15} {:>10} {:>12} {:>14} {:>14} {:>8} {:>10}",
+                    row.kind,
+                    row.rays,
+                    row.linear_rays,
+                    t.closest_disagreements,
+                    t.any_disagreements,
+                    t.leaks,
+                    t.self_hits
+                )?;
+            }
+            Ok(())
+        };
+        kind_table(f, &|row| row.tally.clone())?;
+        if self.kinds.iter().any(|row| row.peers.is_some()) {
+            writeln!(f)?;
+            write!(f, "peers by ray kind (peer: differences are not failures)")?;
+            kind_table(f, &|row| row.peers.clone().unwrap_or_default())?;
+        }
+        writeln!(f)?;
+        writeln!(
+            f,
+            "{:<44} {:>10} {:>14} {:>14} {:>8} {:>10}",
+            "structure", "rays", "closest diff.", "any-hit diff.", "leaks", "self-hits"
+        )?;
+        for s in &self.structures {
+            let t = &s.tally;
+            let leaks = if s.watertight || t.leaks == 0 { t.leaks.to_string() } else { format!("({})", t.leaks) };
+            writeln!(
+                f,
+                "{:<44} {:>10} {:>14} {:>14} {:>8} {:>10}",
+                s.structure, t.rays, t.closest_disagreements, t.any_disagreements, leaks, t.self_hits
+            )?;
+        }
+        writeln!(f)?;
+        writeln!(
+            f,
+            "Disagreements are differences in any bit of the closest hit (triangle, t, beta, gamma) or in the any-hit \
+             answer, against the linear scan (on big scenes the linear scan answers the first rays of each kind; the \
+             rest are compared with the first structure). Leaks are rays aimed inside a closed surface that hit nothing \
+             by the point aimed at; leaks in parentheses are those of a test that does not claim watertightness \
+             (moller-trumbore). Self-hits are rays leaving a triangle that hit it again."
+        )?;
+        if self.structures.iter().any(|s| s.peer) {
+            writeln!(
+                f,
+                "Structures marked (peer) are other people's backends (Embree), not held to the exactness contract: \
+                 they break ties between triangles at equal t in their own order and round differently on grazing \
+                 rays. peer: differences are not failures, and do not change the exit status."
+            )?;
+        }
+        for s in &self.structures {
+            let t = &s.tally;
+            let failed =
+                t.closest_disagreements + t.any_disagreements + t.self_hits > 0 || (s.watertight && t.leaks > 0);
+            let note = if s.peer { " (a difference, not a failure)" } else { "" };
+            if (s.peer && !t.is_clean()) || (!s.peer && failed) {
+                for example in &t.examples {
+                    writeln!(f, "  {}{note}: {example}", s.structure)?;
+                }
+            }
+        }
+        Ok(())
+    }
+}

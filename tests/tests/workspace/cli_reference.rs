@@ -5,11 +5,11 @@
 //! `--help` says; `RTGI_BLESS=1` rewrites them:
 //!
 //! ```sh
-//! RTGI_BLESS=1 cargo test -p rtgi --lib reference
+//! RTGI_BLESS=1 cargo test -p rtgi-tests --test workspace cli_reference
 //! ```
 //!
-//! Both crates are dev-dependencies, so this module is compiled for the
-//! tests only and the binary carries neither.
+//! Both generators are dev-dependencies of the tests, so the binary carries
+//! neither; the definitions come from [`rtgi::command`].
 
 // With the embree feature the comparison with the committed files is not
 // compiled (see the test), so what only it uses goes unused there.
@@ -17,20 +17,16 @@
 
 use std::path::{Path, PathBuf};
 
-use clap::CommandFactory;
-
-use crate::cli::Cli;
-
-/// Where the reference lives, from the app's folder.
+/// Where the reference lives, from the tests' folder.
 fn reference_dir() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../docs/reference")
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../docs/reference")
 }
 
 /// The command as the reference describes it. clap asks the terminal's
 /// width when it wraps help; the reference must not depend on where it was
 /// generated, so the width is fixed.
 fn command() -> clap::Command {
-    Cli::command().term_width(100)
+    rtgi::command().term_width(100)
 }
 
 /// `docs/reference/cli.md`: every command with its arguments, options,
@@ -51,8 +47,8 @@ fn cli_markdown() -> String {
     // The generator's title comes first; the note goes after it.
     let (title, rest) = body.split_once('\n').unwrap_or((&body, ""));
     format!(
-        "{title}\n\n<!-- Generated from apps/rtgi/src/cli.rs by apps/rtgi/src/reference.rs: do not edit; \
-         RTGI_BLESS=1 cargo test -p rtgi --lib reference rewrites it. -->\n\nThis reference is generated from \
+        "{title}\n\n<!-- Generated from apps/rtgi/src/cli.rs by tests/tests/workspace/cli_reference.rs: do not \
+         edit; RTGI_BLESS=1 cargo test -p rtgi-tests --test workspace cli_reference rewrites it. -->\n\nThis reference is generated from \
          the command's definitions, so it says what `rtgi --help` says. The [guide](../guide/README.md) \
          explains the commands with examples; `man docs/reference/rtgi.1` is the same reference as a man \
          page.\n{rest}"
@@ -127,7 +123,7 @@ fn the_committed_reference_is_the_commands_definitions() {
     assert!(
         problems.is_empty(),
         "{}\nthe reference is generated, never edited by hand: rewrite it with \
-         RTGI_BLESS=1 cargo test -p rtgi --lib reference",
+         RTGI_BLESS=1 cargo test -p rtgi-tests --test workspace cli_reference",
         problems.join("\n")
     );
 }
