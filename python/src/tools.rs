@@ -12,7 +12,7 @@ use rtgi_image::ToneOperator;
 use rtgi_job::{Denoise, LoadedScene, SceneSource, Structure};
 use rtgi_math::NamedChoice;
 use rtgi_render::recipe::{self, CameraChoice};
-use rtgi_render::{BounceSampling, DirectStrategy, Integrator, PixelSampler, RenderSettings};
+use rtgi_render::{BounceSampling, DirectStrategy, Integrator, PixelSampler};
 
 use crate::errors::{job_error, request, request_error, scene_error, to_python};
 use crate::render::RENDER_ARGUMENTS;
@@ -133,11 +133,6 @@ pub fn verify<'py>(
     Ok(dict)
 }
 
-/// Samples per pixel of an experiment's base settings, as `rtgi
-/// experiment` takes them: a default render's of a light-transport
-/// integrator, which decide the sampler.
-const BASE_SAMPLES: u32 = 16;
-
 /// Runs an experiment: the knob's measurement of time against error, as
 /// `rtgi experiment KNOB` makes it, returned as Python objects (its JSON:
 /// `knob`, `question`, `tables`, `series`, `findings`, provenance) instead
@@ -169,9 +164,8 @@ pub fn experiment<'py>(
     if repeats == 0 {
         return Err(request_error("repeats", "expected at least 1"));
     }
-    let side = if quick { 32 } else { 128 };
-    let (width, height) = (width.unwrap_or(side), height.unwrap_or(side));
-    for (argument, value) in [("width", width), ("height", height)] {
+    let base = Subject::base_settings(quick, width, height);
+    for (argument, value) in [("width", base.width), ("height", base.height)] {
         if !(1..=rtgi_job::MAX_IMAGE_SIDE).contains(&value) {
             return Err(request_error(argument, format!("{value}: expected 1 to {}", rtgi_job::MAX_IMAGE_SIDE)));
         }
@@ -186,13 +180,7 @@ pub fn experiment<'py>(
     let report = py.detach(|| {
         pool.install(|| {
             let mut scene = loaded.scene.clone();
-            let mut settings = RenderSettings {
-                width,
-                height,
-                samples_per_pixel: BASE_SAMPLES,
-                sampler: recipe::default_sampler(BASE_SAMPLES),
-                ..RenderSettings::default()
-            };
+            let mut settings = base;
             // As `rtgi experiment` prepares its subject: `rtgi render`'s lighting, structure and camera.
             recipe::apply_lighting(&rtgi_job::default_lighting(), &mut scene, &mut settings).map_err(request)?;
             let accel = structure.kind.try_build(&scene.triangle_positions(), &structure.params()).map_err(request)?;

@@ -15,7 +15,6 @@ use clap::builder::{PossibleValue, PossibleValuesParser, TypedValueParser};
 use rtgi_experiment::plan::Run;
 use rtgi_experiment::provenance::Build;
 use rtgi_experiment::{KNOBS, Knob, Machine, Options, RunRecord, Subject};
-use rtgi_render::{RenderSettings, recipe};
 
 use rtgi_job::MAX_IMAGE_SIDE;
 
@@ -181,25 +180,12 @@ pub(crate) fn run(args: &ExperimentArgs) -> Result<()> {
     printed
 }
 
-/// Samples per pixel of the subject's base settings: those of a default
-/// `rtgi render` of a light-transport integrator, which decide the sampler
-/// (knobs that vary the samples keep it).
-const BASE_SAMPLES: u32 = 16;
-
 /// Loads the scene (the built-in Cornell box when `None`) and prepares it
 /// exactly as `rtgi render` does ([`prepare_render`]: lighting, structure,
 /// camera, the lamp of an enclosed camera), at the experiment's size.
 fn prepare(args: &ExperimentArgs, scene: Option<&Path>, pool: &rayon::ThreadPool) -> Result<Subject> {
     let LoadedScene { mut scene, name, .. } = load_scene(scene)?;
-    let side = if args.quick { 32 } else { 128 };
-    let (width, height) = (args.width.unwrap_or(side), args.height.unwrap_or(side));
-    let mut settings = RenderSettings {
-        width,
-        height,
-        samples_per_pixel: BASE_SAMPLES,
-        sampler: recipe::default_sampler(BASE_SAMPLES),
-        ..RenderSettings::default()
-    };
+    let mut settings = Subject::base_settings(args.quick, args.width, args.height);
     let (accel, prepared) = prepare_render(&mut scene, &mut settings, &args.lighting, &args.camera, &args.accel, pool)?;
     if let Some(light) = &prepared.room_light {
         let p = light.position;

@@ -147,6 +147,28 @@ pub enum ExperimentError {
     Unsuitable(String),
 }
 
+/// Samples per pixel of a subject's base settings: those of a default
+/// `rtgi render` of a light-transport integrator, which decide the sampler
+/// (knobs that vary the samples keep it).
+pub const BASE_SAMPLES: u32 = 16;
+
+impl Subject {
+    /// The render settings of a subject before its lighting and camera are
+    /// applied: `width` × `height` (32 × 32 when `quick`, else 128 × 128,
+    /// where not given), [`BASE_SAMPLES`] and their default sampler. Every
+    /// front end (`rtgi experiment`, the Python package) starts from these.
+    pub fn base_settings(quick: bool, width: Option<u32>, height: Option<u32>) -> RenderSettings {
+        let side = if quick { 32 } else { 128 };
+        RenderSettings {
+            width: width.unwrap_or(side),
+            height: height.unwrap_or(side),
+            samples_per_pixel: BASE_SAMPLES,
+            sampler: rtgi_render::recipe::default_sampler(BASE_SAMPLES),
+            ..RenderSettings::default()
+        }
+    }
+}
+
 /// Runs `knob` on `subject`; `progress` receives a line per step, with the
 /// time spent and an estimate of the time left.
 pub fn run(
