@@ -5,7 +5,7 @@
 use std::sync::Arc;
 
 use pyo3::prelude::*;
-use rtgi_accel::verify::{Case, RayKind, VerifyReport, adversarial_cases, check_case};
+use rtgi_accel::verify::{self as verifier, VerifyReport, check_case};
 use rtgi_accel::{AccelKind, Intersector, SahAxes, Traversal};
 use rtgi_experiment::{KNOBS, Options, Subject};
 use rtgi_image::ToneOperator;
@@ -87,38 +87,10 @@ pub fn verify<'py>(
     }
     let loaded = scene_argument(py, scene, SceneSource::BuiltIn)?;
     let report = py.detach(|| {
-        let kinds_per_case = RayKind::ALL.len() + 1;
-        let (name, cases): (String, Vec<(Case, usize)>) = match &loaded {
-            Some(loaded) => {
-                let case = Case {
-                    name: loaded.name.clone(),
-                    triangles: loaded.scene.triangle_positions(),
-                    special_rays: vec![],
-                };
-                (loaded.name.clone(), vec![(case, rays.div_ceil(RayKind::ALL.len()))])
-            }
-            None => {
-                let count = adversarial_cases(0, seed).len();
-                let per_kind = rays.div_ceil(count * kinds_per_case).max(1);
-                let cases = adversarial_cases(per_kind, seed).into_iter().map(|c| (c, per_kind)).collect();
-                ("built-in adversarial scenes".to_owned(), cases)
-            }
-        };
-        let wanted = |kind: &AccelKind| chosen.contains(kind) && *kind != AccelKind::Linear;
-        let mut configurations: Vec<_> = if exhaustive {
-            AccelKind::all_configurations().into_iter().filter(|(kind, _)| wanted(kind)).collect()
-        } else {
-            AccelKind::ALL.iter().filter(|k| wanted(k)).map(|&kind| (kind, kind.default_params())).collect()
-        };
-        configurations.extend(AccelKind::PEERS.iter().filter(|k| wanted(k)).map(|&kind| (kind, kind.default_params())));
-        let mut intersectors: Vec<Intersector> = Intersector::ALL
-            .iter()
-            .copied()
-            .filter(|&i| configurations.iter().any(|(_, p)| p.intersector == i))
-            .collect();
-        if intersectors.is_empty() {
-            intersectors.push(Intersector::default());
-        }
+        let scene = loaded.as_ref().map(|loaded| (loaded.name.clone(), loaded.scene.triangle_positions()));
+        let (name, cases) = verifier::cases(scene, rays, seed);
+        let configurations = verifier::configurations(&chosen, exhaustive, |kind| kind.default_params());
+        let intersectors = verifier::reference_intersectors(&configurations, Intersector::default());
         let mut report = VerifyReport::new(name, seed);
         for (case, per_kind) in &cases {
             let rays = case.rays(*per_kind, seed);

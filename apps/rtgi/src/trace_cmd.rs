@@ -103,6 +103,7 @@ pub(crate) fn run(args: &TraceArgs) -> Result<()> {
 
     // Written through a temporary file that replaces `out` only when
     // complete: a failure leaves no partial file and keeps an earlier one.
+    let grid = args.grid.map(|width| width as usize);
     let (mut ray_count, mut hit_count, mut trace_s) = (0usize, 0usize, 0.0);
     let mut read_failure = None;
     let written = write_atomically_with(&out, |sink| {
@@ -110,7 +111,6 @@ pub(crate) fn run(args: &TraceArgs) -> Result<()> {
         while more {
             let trace_start = Instant::now();
             let accel = accel.as_ref();
-            let grid = args.grid.map(|width| width as usize);
             if args.any_hit {
                 let occluded = pool.install(|| match grid {
                     Some(width) => occluded_grid(accel, &rays, width, filter),

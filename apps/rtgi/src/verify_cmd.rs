@@ -6,8 +6,7 @@ use std::time::Instant;
 
 use anyhow::{Result, bail};
 use clap::Args;
-use rtgi_accel::verify::{Case, RayKind, VerifyReport, adversarial_cases, check_case};
-use rtgi_accel::{AccelKind, BuildParams, Intersector};
+use rtgi_accel::verify::{self, VerifyReport, check_case};
 
 use crate::common::{check_output_folder, load_scene, write_atomically};
 use crate::options::{AccelList, AccelParser, BuildArgs, SeedArgs, ThreadArgs};
@@ -58,31 +57,16 @@ pub(crate) fn run(args: &VerifyArgs) -> Result<()> {
     }
     // Rays are shared evenly among the scenes and, in each, among the kinds:
     // the generic ones and (for the built-in scenes) the scene's own.
-    let kinds_per_case = RayKind::ALL.len() + 1;
-    let (scene_name, cases) = match &args.scene {
+    let scene = match &args.scene {
         Some(path) => {
             let loaded = load_scene(Some(path))?;
-            let per_kind = (args.rays as usize).div_ceil(RayKind::ALL.len());
-            let case =
-                Case { name: loaded.name.clone(), triangles: loaded.scene.triangle_positions(), special_rays: vec![] };
-            (loaded.name, vec![(case, per_kind)])
+            Some((loaded.name, loaded.scene.triangle_positions()))
         }
-        None => {
-            let count = adversarial_cases(0, args.seed.value).len();
-            let per_kind = (args.rays as usize).div_ceil(count * kinds_per_case).max(1);
-            let cases = adversarial_cases(per_kind, args.seed.value).into_iter().map(|c| (c, per_kind)).collect();
-            ("built-in adversarial scenes".to_owned(), cases)
-        }
+        None => None,
     };
-    let configurations = configurations(args);
-    // The linear scan of each intersector the structures use; with the
-    // linear scan alone, that of the chosen intersector (checked for leaks
-    // and self-hits).
-    let mut intersectors: Vec<Intersector> =
-        Intersector::ALL.iter().copied().filter(|&i| configurations.iter().any(|(_, p)| p.intersector == i)).collect();
-    if intersectors.is_empty() {
-        intersectors.push(args.build.intersector);
-    }
+    let (scene_name, cases) = verify::cases(scene, args.rays as usize, args.seed.value);
+    let configurations = verify::configurations(&args.accel.0, args.exhaustive, |kind| args.build.params_for(kind));
+    let intersectors = verify::reference_intersectors(&configurations, args.build.intersector);
     let pool = args.threads.pool()?;
     let start = Instant::now();
 
@@ -124,20 +108,6 @@ pub(crate) fn run(args: &VerifyArgs) -> Result<()> {
         bail!("the structures do not all answer exactly as the linear scan, or rays leaked (see the table)");
     }
     printed
-}
-
-/// The structures to check, each with its build parameters; the peers
-/// chosen (which have no build parameters to vary) come last.
-fn configurations(args: &VerifyArgs) -> Vec<(AccelKind, BuildParams)> {
-    let chosen = |kind: &AccelKind| args.accel.0.contains(kind) && *kind != AccelKind::Linear;
-    let mut configurations: Vec<(AccelKind, BuildParams)> = if args.exhaustive {
-        AccelKind::all_configurations().into_iter().filter(|(kind, _)| chosen(kind)).collect()
-    } else {
-        AccelKind::ALL.iter().filter(|k| chosen(k)).map(|&kind| (kind, args.build.params_for(kind))).collect()
-    };
-    configurations
-        .extend(AccelKind::PEERS.iter().filter(|k| chosen(k)).map(|&kind| (kind, args.build.params_for(kind))));
-    configurations
 }
 
 /// A progress line on standard error when a check has been quiet for a

@@ -17,11 +17,13 @@
 //! ```
 
 mod cases;
+mod plan;
 mod rays;
 mod report;
 pub mod shapes;
 
 pub use cases::{Case, Solid, adversarial_cases, hollow_needles, needle, solids};
+pub use plan::{cases, configurations, reference_intersectors};
 pub use rays::RayKind;
 pub use report::{KindRow, StructureRow, VerifyReport, check_case, label};
 
