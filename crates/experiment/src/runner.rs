@@ -52,9 +52,14 @@ pub(crate) fn measure_with(
 const MAX_PANEL_SPP: f64 = 65_536.0;
 /// Renders an equal-time entry may take to meet the budget within the tolerance.
 const EQUAL_TIME_ATTEMPTS: usize = 8;
+/// Runs a fixed count is timed over in an equal-time panel, the median
+/// recorded: panels are renders of a tenth of a second and up, where one
+/// run can be 10% off on a shared machine.
+const EQUAL_TIME_RUNS: usize = 3;
 
-/// Renders each configuration once (seed 0) with as many samples per pixel
-/// as fit `budget_ms`: the entries of an equal-time panel. The count starts
+/// Renders each configuration (seed 0) with as many samples per pixel as
+/// fit `budget_ms`: the entries of an equal-time panel. A fixed count's
+/// time is the median of [`EQUAL_TIME_RUNS`] runs. The count starts
 /// from the configuration's measured milliseconds per sample and is
 /// corrected from each render's own time (fixed costs and caches make the
 /// time per sample of a long render differ from a short one's) until the
@@ -105,8 +110,15 @@ pub(crate) fn equal_time(
                 let (image, time_ms, seconds) = best.expect("at least one attempt");
                 return entry(image, time_ms, format!("{label}, --time {seconds:.3} s"));
             }
+            // A count's time is the median of its runs (the image is the
+            // same bits each time): one run slowed by the machine then
+            // neither misses the window nor becomes the entry's time.
             let render_at = |spp: u32| {
-                render_timed(subject, &RenderSettings { samples_per_pixel: spp, seed: 0, ..settings.clone() })
+                let settings = RenderSettings { samples_per_pixel: spp, seed: 0, ..settings.clone() };
+                let (image, first_ms) = render_timed(subject, &settings);
+                let mut times = vec![first_ms];
+                times.extend((1..EQUAL_TIME_RUNS).map(|_| render_timed(subject, &settings).1));
+                (image, crate::verdict::median(&times))
             };
             let first = (budget_ms / ms_per_sample.max(1e-9)).round().clamp(1.0, MAX_PANEL_SPP) as u32;
             // The first render after another configuration's pays for cold
