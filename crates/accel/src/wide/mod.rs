@@ -93,7 +93,7 @@ impl<const W: usize, N: NodeLayout<W>> WideBvh<W, N> {
 /// Inserts `entry` among the first `count` entries of `sorted`, kept in
 /// decreasing order of `enter` (far to near, so that the nearest is last).
 #[inline(always)]
-fn insert_far_to_near<T: Copy>(sorted: &mut [T], count: usize, entry: T, enter: impl Fn(&T) -> f32) {
+fn insert_far_to_near<T: Copy, K: PartialOrd>(sorted: &mut [T], count: usize, entry: T, enter: impl Fn(&T) -> K) {
     let mut at = count;
     while at > 0 && enter(&sorted[at - 1]) < enter(&entry) {
         sorted[at] = sorted[at - 1];

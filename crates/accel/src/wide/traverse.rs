@@ -39,9 +39,27 @@ impl<const INLINE: usize> TraversalStack<INLINE> {
         self.spill.clear();
     }
 
+    /// A child and its entry distance as one stack entry: the distance's
+    /// bits above the child's, so that entries of distances `≥ +0` compare
+    /// as integers as their distances do.
+    #[inline(always)]
+    pub(crate) fn entry(child: ChildRef, enter: f32) -> u64 {
+        (enter.to_bits() as u64) << 32 | child.to_bits() as u64
+    }
+
+    /// The child of an [`TraversalStack::entry`].
+    #[inline(always)]
+    pub(crate) fn child_of(entry: u64) -> ChildRef {
+        ChildRef::from_bits(entry as u32)
+    }
+
     #[inline(always)]
     pub(crate) fn push(&mut self, (child, enter): (ChildRef, f32)) {
-        let entry = (enter.to_bits() as u64) << 32 | child.to_bits() as u64;
+        self.push_entry(Self::entry(child, enter));
+    }
+
+    #[inline(always)]
+    pub(crate) fn push_entry(&mut self, entry: u64) {
         if self.len < INLINE {
             self.entries[self.len] = entry;
             self.len += 1;
@@ -62,6 +80,12 @@ impl<const INLINE: usize> TraversalStack<INLINE> {
         };
         Some((ChildRef::from_bits(entry as u32), f32::from_bits((entry >> 32) as u32)))
     }
+}
+
+/// Two stack entries, nearer first (see [`TraversalStack::entry`]).
+#[inline(always)]
+fn order(a: u64, b: u64) -> (u64, u64) {
+    (a.min(b), a.max(b))
 }
 
 /// Entries kept on the call stack: enough for every tree but degenerate ones.
@@ -139,31 +163,57 @@ impl<const W: usize, N: NodeLayout<W>> WideBvh<W, N> {
                         current = children[first];
                         continue;
                     }
-                    let second = (entered & (entered - 1)).trailing_zeros() as usize;
-                    if entered.count_ones() == 2 {
-                        let (near, far) = if enter[second] < enter[first] { (second, first) } else { (first, second) };
-                        let far_entry = (children[far], enter[far]);
-                        self.prefetch(far_entry.0);
-                        stack.push(far_entry);
-                        current = children[near];
-                        continue;
-                    }
-                    // Children entered, sorted far to near: the nearest is
-                    // visited now, the others are pushed, nearest last.
-                    let mut sorted = [(ChildRef::NONE, 0.0f32); W];
-                    let mut count = 0;
-                    let mut lanes = entered;
-                    while lanes != 0 {
+                    // Children entered, nearest first, as stack entries
+                    // (`TraversalStack::entry`), whose order as integers is
+                    // their entry distances' order: sorted by minima and
+                    // maxima that compile to conditional moves, since which
+                    // child is nearer is a coin toss the branch predictor
+                    // loses. (Entries behind the origin, of rays whose range
+                    // starts there, sort as far: that changes the order of
+                    // visits, never the answer.)
+                    let entry = |lane: usize| TraversalStack::<S>::entry(children[lane], enter[lane]);
+                    let mut lanes = entered & (entered - 1);
+                    let mut next = || {
                         let lane = lanes.trailing_zeros() as usize;
                         lanes &= lanes - 1;
-                        insert_far_to_near(&mut sorted, count, (children[lane], enter[lane]), |e| e.1);
-                        count += 1;
-                    }
-                    for &entry in &sorted[..count - 1] {
-                        self.prefetch(entry.0);
-                        stack.push(entry);
-                    }
-                    current = sorted[count - 1].0;
+                        entry(lane)
+                    };
+                    let (a, b) = order(entry(first), next());
+                    let nearest = match entered.count_ones() as usize {
+                        2 => {
+                            self.push_prefetched(stack, b);
+                            a
+                        }
+                        3 => {
+                            let (b, c) = order(b, next());
+                            let (a, b) = order(a, b);
+                            self.push_prefetched(stack, c);
+                            self.push_prefetched(stack, b);
+                            a
+                        }
+                        4 => {
+                            let (c, d) = order(next(), next());
+                            let (a, c) = order(a, c);
+                            let (b, d) = order(b, d);
+                            let (b, c) = order(b, c);
+                            self.push_prefetched(stack, d);
+                            self.push_prefetched(stack, c);
+                            self.push_prefetched(stack, b);
+                            a
+                        }
+                        count => {
+                            let mut sorted = [0u64; W];
+                            [sorted[0], sorted[1]] = [b, a];
+                            for at in 2..count {
+                                insert_far_to_near(&mut sorted, at, next(), |&e| e);
+                            }
+                            for &far in &sorted[..count - 1] {
+                                self.push_prefetched(stack, far);
+                            }
+                            sorted[count - 1]
+                        }
+                    };
+                    current = TraversalStack::<S>::child_of(nearest);
                     continue;
                 }
             }
@@ -179,6 +229,13 @@ impl<const W: usize, N: NodeLayout<W>> WideBvh<W, N> {
                 }
             }
         }
+    }
+
+    /// Pushes a stack entry, first asking for its child's memory.
+    #[inline(always)]
+    fn push_prefetched<const S: usize>(&self, stack: &mut TraversalStack<S>, entry: u64) {
+        self.prefetch(TraversalStack::<S>::child_of(entry));
+        stack.push_entry(entry);
     }
 
     /// Starts loading the memory of a child that will be visited soon.
