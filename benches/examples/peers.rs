@@ -4,7 +4,9 @@
 //! `cargo run --release -p rtgi-benches --example peers [-- SCENE.obj]`.
 //! The peers are obvhs' BVH2 and, built with `--features embree`, Intel
 //! Embree 3 through `rtcIntersect1` (one ray at a time, [`Accel::intersect`])
-//! and `rtcIntersect16` (packets of 16, [`Accel::intersect_batch`]).
+//! and `rtcIntersect16` (packets of 16, [`Accel::intersect_batch`]), and
+//! `rtcIntersect1` once more on a scene built with Embree's robust flag,
+//! whose traversal is the counterpart of our robust slab test.
 //!
 //! Follows the method of `../shared/notes/peers.md`: 1024×1024 primary rays
 //! framing the bounding sphere with a 40° field of view, and 1,000,000
@@ -72,6 +74,13 @@ fn main() {
     #[cfg(feature = "embree")]
     let embree =
         AccelKind::Embree.try_build(&triangles, &AccelKind::Embree.default_params()).unwrap_or_else(|e| panic!("{e}"));
+    // Embree's robust mode, whose traversal is the counterpart of ours:
+    // how much of a gap is the price of robustness.
+    #[cfg(feature = "embree")]
+    let build_embree_robust =
+        || rtgi_accel::EmbreeBackend::robust(triangles.as_slice()).unwrap_or_else(|e| panic!("{e}"));
+    #[cfg(feature = "embree")]
+    let embree_robust = build_embree_robust();
     #[cfg_attr(not(feature = "embree"), allow(unused_mut))]
     let batched = |accel: &dyn Accel, rays: &[Ray]| {
         let mut hits: Vec<Option<Hit>> = vec![None; rays.len()];
@@ -134,11 +143,19 @@ fn main() {
             build: Box::new(build_embree),
             trace: Box::new(|rays| batched(embree.as_ref(), rays)),
         });
+        contenders.push(Contender {
+            name: "embree robust 1",
+            build: Box::new(|| drop(build_embree_robust())),
+            trace: Box::new(|rays| one_at_a_time(&embree_robust, rays)),
+        });
     }
     let names: Vec<&str> = contenders.iter().map(|c| c.name).collect();
     println!("'16': the batch API (Accel::intersect_batch) on consecutive rays, 4×4 tiles of the primary rays");
     if names.iter().any(|n| n.starts_with("embree")) {
-        println!("embree 1: rtcIntersect1 (Accel::intersect); embree 16: rtcIntersect16 packets");
+        println!(
+            "embree 1: rtcIntersect1 (Accel::intersect); embree 16: rtcIntersect16 packets; \
+             embree robust 1: rtcIntersect1 on a scene with RTC_SCENE_FLAG_ROBUST"
+        );
     }
     // The columns once more, unambiguous for scripts (benches/targets.sh):
     // in the tables, names wider than a column push the rest along.

@@ -167,6 +167,21 @@ impl EmbreeBackend {
     /// If Embree fails to create its device or to build the scene (out of
     /// memory, an unsupported CPU).
     pub fn new(triangles: &(impl TriangleSource + ?Sized)) -> Result<Self, EmbreeError> {
+        Self::build(triangles, false)
+    }
+
+    /// As [`EmbreeBackend::new`], with Embree's robust traversal
+    /// (`RTC_SCENE_FLAG_ROBUST`), which avoids optimisations that can miss
+    /// boxes rays graze: the counterpart of our robust slab test, to tell
+    /// how much of a difference in speed is the price of robustness.
+    ///
+    /// # Errors
+    /// As [`EmbreeBackend::new`].
+    pub fn robust(triangles: &(impl TriangleSource + ?Sized)) -> Result<Self, EmbreeError> {
+        Self::build(triangles, true)
+    }
+
+    fn build(triangles: &(impl TriangleSource + ?Sized), robust: bool) -> Result<Self, EmbreeError> {
         let start = Instant::now();
         // Embree gets a soup of its own: its buffers are filled from it below.
         let (kept, ids): (Vec<[Vec3; 3]>, Vec<u32>) =
@@ -186,7 +201,7 @@ impl EmbreeBackend {
         // SAFETY: `device` is valid; the counter outlives it (see `Drop`)
         // and `count_memory` only reads through the pointer atomically.
         unsafe { sys::rtcSetDeviceMemoryMonitorFunction(device, Some(count_memory), counter as *mut c_void) };
-        backend.commit(&kept)?;
+        backend.commit(&kept, robust)?;
         let embree_bytes = usize::try_from(backend.memory.load(Ordering::Relaxed)).unwrap_or(0);
         backend.stats = BuildStats {
             variant: "embree".into(),
@@ -230,7 +245,7 @@ impl EmbreeBackend {
 
     /// Creates, fills and commits the scene: one triangle geometry whose
     /// primitive `i` is `kept[i]` (three vertices of its own, no sharing).
-    fn commit(&mut self, kept: &[[Vec3; 3]]) -> Result<(), EmbreeError> {
+    fn commit(&mut self, kept: &[[Vec3; 3]], robust: bool) -> Result<(), EmbreeError> {
         let device = self.device;
         let check = |step: &'static str| {
             // SAFETY: `device` is a valid device handle (checked in `new`).
@@ -248,10 +263,13 @@ impl EmbreeBackend {
         }
         // SAFETY: `scene` is valid and not yet committed. The context
         // filter flag lets the filtered queries pass a filter in their
-        // intersection context; unfiltered queries pass none. Medium is
+        // intersection context; unfiltered queries pass none. The robust
+        // flag is asked for by `robust`. Medium is
         // Embree's default build quality, set to say so.
         unsafe {
-            sys::rtcSetSceneFlags(self.scene, sys::RTCSceneFlags::CONTEXT_FILTER_FUNCTION);
+            let flags = sys::RTCSceneFlags::CONTEXT_FILTER_FUNCTION;
+            let flags = if robust { sys::RTCSceneFlags(flags.0 | sys::RTCSceneFlags::ROBUST.0) } else { flags };
+            sys::rtcSetSceneFlags(self.scene, flags);
             sys::rtcSetSceneBuildQuality(self.scene, BUILD_QUALITY);
         }
         if !kept.is_empty() {
