@@ -115,10 +115,15 @@ pub(crate) fn equal_time(
             // neither misses the window nor becomes the entry's time.
             let render_at = |spp: u32| {
                 let settings = RenderSettings { samples_per_pixel: spp, seed: 0, ..settings.clone() };
-                let (image, first_ms) = render_timed(subject, &settings);
-                let mut times = vec![first_ms];
-                times.extend((1..EQUAL_TIME_RUNS).map(|_| render_timed(subject, &settings).1));
-                (image, crate::verdict::median(&times))
+                let mut image = None;
+                let timing = crate::measure::time_each(
+                    EQUAL_TIME_RUNS,
+                    |_| render(subject, &settings),
+                    |made| {
+                        image.get_or_insert(made);
+                    },
+                );
+                (image.expect("at least one run"), timing.median_ms)
             };
             let first = (budget_ms / ms_per_sample.max(1e-9)).round().clamp(1.0, MAX_PANEL_SPP) as u32;
             // The first render after another configuration's pays for cold

@@ -53,13 +53,9 @@ impl<const INLINE: usize> TraversalStack<INLINE> {
         ChildRef::from_bits(entry as u32)
     }
 
+    /// Pushes an [`TraversalStack::entry`].
     #[inline(always)]
-    pub(crate) fn push(&mut self, (child, enter): (ChildRef, f32)) {
-        self.push_entry(Self::entry(child, enter));
-    }
-
-    #[inline(always)]
-    pub(crate) fn push_entry(&mut self, entry: u64) {
+    pub(crate) fn push(&mut self, entry: u64) {
         if self.len < INLINE {
             self.entries[self.len] = entry;
             self.len += 1;
@@ -157,8 +153,7 @@ impl<const W: usize, N: NodeLayout<W>> WideBvh<W, N> {
                         while lanes != 0 {
                             let lane = lanes.trailing_zeros() as usize;
                             lanes &= lanes - 1;
-                            self.prefetch(children[lane]);
-                            stack.push((children[lane], enter[lane]));
+                            self.push_prefetched(stack, TraversalStack::<S>::entry(children[lane], enter[lane]));
                         }
                         current = children[first];
                         continue;
@@ -235,7 +230,7 @@ impl<const W: usize, N: NodeLayout<W>> WideBvh<W, N> {
     #[inline(always)]
     fn push_prefetched<const S: usize>(&self, stack: &mut TraversalStack<S>, entry: u64) {
         self.prefetch(TraversalStack::<S>::child_of(entry));
-        stack.push_entry(entry);
+        stack.push(entry);
     }
 
     /// Starts loading the memory of a child that will be visited soon.
