@@ -7,8 +7,10 @@ use std::time::Instant;
 
 use anyhow::{Context, Result, bail};
 use clap::Args;
+use rtgi_accel::TraversalCounters;
 use rtgi_accel::parallel::{
-    BATCH_RAYS, GRID_TILE, HitFilter, intersect_all, intersect_grid, occluded_all, occluded_grid,
+    BATCH_RAYS, GRID_TILE, HitFilter, count_work, intersect_all, intersect_each, intersect_grid, occluded_all,
+    occluded_each, occluded_grid,
 };
 use rtgi_accel::ray_file::{self, HitWriter, RayReader};
 use rtgi_image::write_atomically_with;
@@ -59,6 +61,16 @@ pub(crate) struct TraceArgs {
     #[arg(long, value_name = "WIDTH", value_parser = clap::value_parser!(u32).range(1..=rtgi_job::MAX_IMAGE_SIDE as i64))]
     pub(crate) grid: Option<u32>,
 
+    /// Trace ray by ray through the single-ray query instead of the batch queries (for Embree,
+    /// rtcIntersect1 instead of its packets of 16); the hits are the same
+    #[arg(long, conflicts_with = "grid")]
+    pub(crate) single_ray: bool,
+
+    /// Also count the work per ray (nodes whose boxes were tested, ray/triangle tests), in a
+    /// second pass that is not timed; Embree reports neither
+    #[arg(long)]
+    pub(crate) stats: bool,
+
     #[command(flatten)]
     pub(crate) accel: AccelArgs,
 
@@ -97,6 +109,12 @@ pub(crate) fn run(args: &TraceArgs) -> Result<()> {
     let build_ms = build_start.elapsed().as_secs_f64() * 1e3;
 
     let alpha_test = (has_alpha(&scene) && !args.no_alpha).then(|| AlphaTest::new(&scene));
+    if args.stats && alpha_test.is_some() {
+        bail!(
+            "{}: --stats counts queries without cut-outs, and this scene has some: add --no-alpha to trace and count it solid",
+            args.scene.display()
+        );
+    }
     let accept =
         |triangle, beta, gamma| alpha_test.as_ref().is_none_or(|t| t.accepts(triangle, beta, gamma, BLEND_THRESHOLD));
     let filter: Option<HitFilter<'_>> = alpha_test.is_some().then_some(&accept);
@@ -105,6 +123,7 @@ pub(crate) fn run(args: &TraceArgs) -> Result<()> {
     // complete: a failure leaves no partial file and keeps an earlier one.
     let grid = args.grid.map(|width| width as usize);
     let (mut ray_count, mut hit_count, mut trace_s) = (0usize, 0usize, 0.0);
+    let mut work = TraversalCounters::default();
     let mut read_failure = None;
     let written = write_atomically_with(&out, |sink| {
         let mut output = HitWriter::new(sink);
@@ -114,6 +133,7 @@ pub(crate) fn run(args: &TraceArgs) -> Result<()> {
             if args.any_hit {
                 let occluded = pool.install(|| match grid {
                     Some(width) => occluded_grid(accel, &rays, width, filter),
+                    None if args.single_ray => occluded_each(accel, &rays, filter),
                     None => occluded_all(accel, &rays, filter),
                 });
                 trace_s += trace_start.elapsed().as_secs_f64();
@@ -122,11 +142,15 @@ pub(crate) fn run(args: &TraceArgs) -> Result<()> {
             } else {
                 let hits = pool.install(|| match grid {
                     Some(width) => intersect_grid(accel, &rays, width, filter),
+                    None if args.single_ray => intersect_each(accel, &rays, filter),
                     None => intersect_all(accel, &rays, filter),
                 });
                 trace_s += trace_start.elapsed().as_secs_f64();
                 hit_count += hits.iter().flatten().count();
                 output.write_closest(&hits)?;
+            }
+            if args.stats {
+                work += pool.install(|| count_work(accel, &rays, args.any_hit));
             }
             ray_count += rays.len();
             more = input.next_chunk(&mut rays).map_err(|e| {
@@ -164,6 +188,19 @@ pub(crate) fn run(args: &TraceArgs) -> Result<()> {
         ray_count as f64 / trace_s.max(1e-9) * 1e-6,
         pool.current_num_threads()
     );
+    if args.stats {
+        let per_ray = |total: u64| total as f64 / ray_count.max(1) as f64;
+        if args.accel.accel.is_peer() {
+            eprintln!("stats  {} reports no nodes or triangle tests", accel.build_stats().variant);
+        } else {
+            eprintln!(
+                "stats  {:.2} nodes, {:.2} triangle tests per ray (counted in a second pass, not timed; {} kernels)",
+                per_ray(work.nodes_visited),
+                per_ray(work.triangles_tested),
+                rtgi_accel::simd::active_simd_level()
+            );
+        }
+    }
     Ok(())
 }
 

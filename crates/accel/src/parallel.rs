@@ -6,7 +6,7 @@
 
 use rayon::prelude::*;
 
-use crate::{Accel, Hit, Ray};
+use crate::{Accel, Hit, Ray, TraversalCounters};
 
 /// Rays given to one batch query: runs of this many consecutive rays.
 pub const BATCH_RAYS: usize = 1024;
@@ -32,6 +32,62 @@ pub fn occluded_all(accel: &dyn Accel, rays: &[Ray], filter: Option<HitFilter<'_
         None => accel.occluded_batch(batch, out),
     });
     occluded
+}
+
+/// [`intersect_all`] through the single-ray query ([`Accel::intersect`],
+/// or [`Accel::intersect_filtered`] with `filter`), ray by ray: what a
+/// renderer's secondary rays use, and for a peer the API to compare ours
+/// with (Embree's `rtcIntersect1`, where the batch queries are its packets).
+/// The answers are [`intersect_all`]'s.
+pub fn intersect_each(accel: &dyn Accel, rays: &[Ray], filter: Option<HitFilter<'_>>) -> Vec<Option<Hit>> {
+    let mut hits = vec![None; rays.len()];
+    rays.par_chunks(BATCH_RAYS).zip(hits.par_chunks_mut(BATCH_RAYS)).for_each(|(batch, out)| {
+        for (ray, hit) in batch.iter().zip(out) {
+            *hit = match filter {
+                Some(accept) => accel.intersect_filtered(ray, accept),
+                None => accel.intersect(ray),
+            };
+        }
+    });
+    hits
+}
+
+/// [`occluded_all`] through the single-ray query, as [`intersect_each`].
+pub fn occluded_each(accel: &dyn Accel, rays: &[Ray], filter: Option<HitFilter<'_>>) -> Vec<bool> {
+    let mut occluded = vec![false; rays.len()];
+    rays.par_chunks(BATCH_RAYS).zip(occluded.par_chunks_mut(BATCH_RAYS)).for_each(|(batch, out)| {
+        for (ray, answer) in batch.iter().zip(out) {
+            *answer = match filter {
+                Some(accept) => accel.occluded_filtered(ray, accept),
+                None => accel.occluded(ray),
+            };
+        }
+    });
+    occluded
+}
+
+/// The work the single-ray queries of `rays` do: nodes whose boxes were
+/// tested and ray/triangle tests, summed (a peer that reports neither, as
+/// Embree, counts only the rays). Counted ray by ray, in parallel, for
+/// statistics: a counted query is slower than the batch queries above and
+/// sees no cut-outs (every triangle is solid).
+pub fn count_work(accel: &dyn Accel, rays: &[Ray], any_hit: bool) -> TraversalCounters {
+    rays.par_chunks(BATCH_RAYS)
+        .map(|batch| {
+            let mut counters = TraversalCounters::default();
+            for ray in batch {
+                if any_hit {
+                    accel.occluded_counted(ray, &mut counters);
+                } else {
+                    accel.intersect_counted(ray, &mut counters);
+                }
+            }
+            counters
+        })
+        .reduce(TraversalCounters::default, |mut a, b| {
+            a += b;
+            a
+        })
 }
 
 /// Rows of a camera grid traced together: the side of the square tiles

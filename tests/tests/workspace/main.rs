@@ -5,6 +5,7 @@
 //! One test binary for the theme, a module a file.
 
 mod cli_reference;
+mod counters_doc;
 mod deploy;
 mod experiment;
 mod experiment_index;
