@@ -59,16 +59,19 @@ fn trace_writes_the_hits_of_every_variant_identically() {
     std::fs::write(&rays_path, encode(&rays)).unwrap();
     let reference = LinearScan::new(&scene.triangle_positions(), rtgi_accel::Intersector::default());
 
-    // `--grid 24`: the camera rays are a grid 24 wide, traced in tiles; the answers must not change.
-    for (accel, grid) in rtgi_accel::AccelKind::ALL.iter().flat_map(|a| [(a, None), (a, Some("24"))]) {
+    // `--grid 24`: the camera rays are a grid 24 wide, traced in tiles;
+    // `--single-ray`: ray by ray through the single-ray query. Neither may
+    // change the answers.
+    let modes: [(&str, &[&str]); 3] = [("", &[]), ("-grid", &["--grid", "24"]), ("-single", &["--single-ray"])];
+    for (accel, (mode, mode_args)) in rtgi_accel::AccelKind::ALL.iter().flat_map(|a| modes.map(|m| (a, m))) {
         for any_hit in [false, true] {
-            let out = dir.join(format!("{accel}-{any_hit}{}.bin", grid.map_or("", |_| "-grid")));
+            let out = dir.join(format!("{accel}-{any_hit}{mode}.bin"));
             let mut args =
                 vec!["trace", BOX, "--rays", path_str(&rays_path), "--out", path_str(&out), "--accel", accel.name()];
             if any_hit {
                 args.push("--any-hit");
             }
-            args.extend(grid.map(|width| ["--grid", width]).into_iter().flatten());
+            args.extend(mode_args);
             let run = rtgi(&args);
             assert!(run.success, "{run:?}");
             assert!(run.stderr.contains("Mrays/s") && run.stderr.contains("build"), "{}", run.stderr);
@@ -93,6 +96,15 @@ fn trace_writes_the_hits_of_every_variant_identically() {
     let central = (4..20).flat_map(|y| (4..20).map(move |x| y * 24 + x));
     assert!(central.into_iter().all(|i| hits[i].1 != u32::MAX));
     assert_eq!(hits[hits.len() - 1].1, u32::MAX);
+
+    // --stats counts the work per ray: a BVH tests its root at least.
+    let out = dir.join("stats.bin");
+    let run =
+        rtgi(&["trace", BOX, "--rays", path_str(&rays_path), "--out", path_str(&out), "--accel", "bvh8", "--stats"]);
+    assert!(run.success, "{run:?}");
+    let stats = run.stderr.lines().find(|l| l.starts_with("stats")).unwrap_or_else(|| panic!("{}", run.stderr));
+    let nodes: f64 = stats.split_whitespace().nth(1).and_then(|n| n.parse().ok()).unwrap_or_else(|| panic!("{stats}"));
+    assert!(nodes >= 1.0 && stats.contains("triangle tests per ray"), "{stats}");
 }
 
 #[test]
