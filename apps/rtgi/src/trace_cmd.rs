@@ -123,6 +123,9 @@ pub(crate) fn run(args: &TraceArgs) -> Result<()> {
     // complete: a failure leaves no partial file and keeps an earlier one.
     let grid = args.grid.map(|width| width as usize);
     let (mut ray_count, mut hit_count, mut trace_s) = (0usize, 0usize, 0.0);
+    // Counted for our structures only: a peer reports no work, so a pass
+    // over its rays would count nothing.
+    let count = args.stats && !args.accel.accel.is_peer();
     let mut work = TraversalCounters::default();
     let mut read_failure = None;
     let written = write_atomically_with(&out, |sink| {
@@ -149,7 +152,7 @@ pub(crate) fn run(args: &TraceArgs) -> Result<()> {
                 hit_count += hits.iter().flatten().count();
                 output.write_closest(&hits)?;
             }
-            if args.stats {
+            if count {
                 work += pool.install(|| count_work(accel, &rays, args.any_hit));
             }
             ray_count += rays.len();
@@ -190,15 +193,15 @@ pub(crate) fn run(args: &TraceArgs) -> Result<()> {
     );
     if args.stats {
         let per_ray = |total: u64| total as f64 / ray_count.max(1) as f64;
-        if args.accel.accel.is_peer() {
-            eprintln!("stats  {} reports no nodes or triangle tests", accel.build_stats().variant);
-        } else {
+        if count {
             eprintln!(
                 "stats  {:.2} nodes, {:.2} triangle tests per ray (counted in a second pass, not timed; {} kernels)",
                 per_ray(work.nodes_visited),
                 per_ray(work.triangles_tested),
                 rtgi_accel::simd::active_simd_level()
             );
+        } else {
+            eprintln!("stats  {} reports no nodes or triangle tests", accel.build_stats().variant);
         }
     }
     Ok(())

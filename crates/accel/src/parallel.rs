@@ -16,22 +16,18 @@ pub type HitFilter<'a> = &'a (dyn Fn(u32, f32, f32) -> bool + Sync);
 
 /// The closest hit of every ray, in their order, with `filter` if given.
 pub fn intersect_all(accel: &dyn Accel, rays: &[Ray], filter: Option<HitFilter<'_>>) -> Vec<Option<Hit>> {
-    let mut hits = vec![None; rays.len()];
-    rays.par_chunks(BATCH_RAYS).zip(hits.par_chunks_mut(BATCH_RAYS)).for_each(|(batch, out)| match filter {
+    by_runs(rays, |batch, out| match filter {
         Some(accept) => accel.intersect_batch_filtered(batch, out, accept),
         None => accel.intersect_batch(batch, out),
-    });
-    hits
+    })
 }
 
 /// Whether each ray is occluded, in their order, with `filter` if given.
 pub fn occluded_all(accel: &dyn Accel, rays: &[Ray], filter: Option<HitFilter<'_>>) -> Vec<bool> {
-    let mut occluded = vec![false; rays.len()];
-    rays.par_chunks(BATCH_RAYS).zip(occluded.par_chunks_mut(BATCH_RAYS)).for_each(|(batch, out)| match filter {
+    by_runs(rays, |batch, out| match filter {
         Some(accept) => accel.occluded_batch_filtered(batch, out, accept),
         None => accel.occluded_batch(batch, out),
-    });
-    occluded
+    })
 }
 
 /// [`intersect_all`] through the single-ray query ([`Accel::intersect`],
@@ -40,30 +36,34 @@ pub fn occluded_all(accel: &dyn Accel, rays: &[Ray], filter: Option<HitFilter<'_
 /// with (Embree's `rtcIntersect1`, where the batch queries are its packets).
 /// The answers are [`intersect_all`]'s.
 pub fn intersect_each(accel: &dyn Accel, rays: &[Ray], filter: Option<HitFilter<'_>>) -> Vec<Option<Hit>> {
-    let mut hits = vec![None; rays.len()];
-    rays.par_chunks(BATCH_RAYS).zip(hits.par_chunks_mut(BATCH_RAYS)).for_each(|(batch, out)| {
+    by_runs(rays, |batch, out| {
         for (ray, hit) in batch.iter().zip(out) {
             *hit = match filter {
                 Some(accept) => accel.intersect_filtered(ray, accept),
                 None => accel.intersect(ray),
             };
         }
-    });
-    hits
+    })
 }
 
 /// [`occluded_all`] through the single-ray query, as [`intersect_each`].
 pub fn occluded_each(accel: &dyn Accel, rays: &[Ray], filter: Option<HitFilter<'_>>) -> Vec<bool> {
-    let mut occluded = vec![false; rays.len()];
-    rays.par_chunks(BATCH_RAYS).zip(occluded.par_chunks_mut(BATCH_RAYS)).for_each(|(batch, out)| {
+    by_runs(rays, |batch, out| {
         for (ray, answer) in batch.iter().zip(out) {
             *answer = match filter {
                 Some(accept) => accel.occluded_filtered(ray, accept),
                 None => accel.occluded(ray),
             };
         }
-    });
-    occluded
+    })
+}
+
+/// Answers `rays` in runs of [`BATCH_RAYS`] consecutive rays, the runs in
+/// parallel, each by `query`; the answers in the rays' order.
+fn by_runs<T: Clone + Default + Send>(rays: &[Ray], query: impl Fn(&[Ray], &mut [T]) + Sync) -> Vec<T> {
+    let mut answers = vec![T::default(); rays.len()];
+    rays.par_chunks(BATCH_RAYS).zip(answers.par_chunks_mut(BATCH_RAYS)).for_each(|(batch, out)| query(batch, out));
+    answers
 }
 
 /// The work the single-ray queries of `rays` do: nodes whose boxes were
