@@ -25,8 +25,14 @@ pub struct Entry {
     pub label: String,
     /// Its render.
     pub image: HdrImage,
-    /// How long it took, in ms.
+    /// How long it took, in ms: in an equal-time panel, its fastest run
+    /// of the rounds it was timed in alternation with the budget's render.
     pub time_ms: f64,
+    /// In an equal-time panel, the budget's render's fastest run of the
+    /// same rounds: the time this entry was held to. Timed alongside, so
+    /// that the machine's speed, which drifts between the entries, cancels
+    /// in their ratio.
+    pub budget_ms: Option<f64>,
     /// Its RMSE against the reference.
     pub rmse: f64,
 }
@@ -233,9 +239,10 @@ impl Panel {
         Panel { file: file.into(), title: title.into(), reference, entries, crop, scale, budget_ms: None }
     }
 
-    /// An entry's time over the budget, for an equal-time panel.
+    /// An entry's time over the budget, for an equal-time panel: over the
+    /// budget timed alongside it where it was, else over the panel's.
     pub fn budget_share(&self, entry: &Entry) -> Option<f64> {
-        self.budget_ms.map(|budget| entry.time_ms / budget.max(1e-9))
+        self.budget_ms.map(|budget| entry.time_ms / entry.budget_ms.unwrap_or(budget).max(1e-9))
     }
 
     /// Per entry, the fraction of its crop's pixels whose error is above
@@ -299,9 +306,15 @@ impl Panel {
         } else {
             format!("clipping on it: {}", clipping.join(", "))
         };
+        let timing = if self.budget_ms.is_some() {
+            "; each time is the entry's fastest run of rounds alternated with the budget's render, and its share \
+             is over that render's fastest run of the same rounds"
+        } else {
+            ""
+        };
         format!(
             "{} ({}): top, the reference then {}; below, each one's absolute error, black 0 to pale yellow {} \
-             (inferno scale, one error scale per panel; {clipping}); crop {}×{} at ({}, {})",
+             (inferno scale, one error scale per panel; {clipping}); crop {}×{} at ({}, {}){timing}",
             self.title,
             self.file,
             entries.join(", "),
@@ -544,8 +557,8 @@ mod tests {
     fn the_png_carries_its_labels() {
         let reference = flat(0.5);
         let entries = vec![
-            Entry { label: "a".into(), image: flat(0.6), time_ms: 1.0, rmse: 0.1 },
-            Entry { label: "b".into(), image: flat(0.7), time_ms: 2.0, rmse: 0.2 },
+            Entry { label: "a".into(), image: flat(0.6), time_ms: 1.0, budget_ms: None, rmse: 0.1 },
+            Entry { label: "b".into(), image: flat(0.7), time_ms: 2.0, budget_ms: None, rmse: 0.2 },
         ];
         let panel = Panel::new("labels.png", "TITLE", reference, entries);
         let tiles = panel.tiles();
@@ -580,8 +593,8 @@ mod tests {
             }
         }
         let entries = vec![
-            Entry { label: "exact".into(), image: flat(0.5), time_ms: 1.0, rmse: 0.0 },
-            Entry { label: "noisy".into(), image: noisy, time_ms: 1.0, rmse: 0.1 },
+            Entry { label: "exact".into(), image: flat(0.5), time_ms: 1.0, budget_ms: None, rmse: 0.0 },
+            Entry { label: "noisy".into(), image: noisy, time_ms: 1.0, budget_ms: None, rmse: 0.1 },
         ];
         let panel = Panel::new("panel.png", "a test", reference, entries);
         let crop = panel.crop;
@@ -627,7 +640,9 @@ mod tests {
 
     #[test]
     fn labels_too_wide_for_their_column_at_twice_the_size_are_drawn_at_the_font_s_own() {
-        let entries = |label: &str| vec![Entry { label: label.into(), image: flat(0.6), time_ms: 1.0, rmse: 0.1 }];
+        let entries = |label: &str| {
+            vec![Entry { label: label.into(), image: flat(0.6), time_ms: 1.0, budget_ms: None, rmse: 0.1 }]
+        };
         let short = Panel::new("a.png", "t", flat(0.5), entries("none, 16 spp"));
         let long = Panel::new("b.png", "t", flat(0.5), entries("clamp 0.25× mean, 16 spp"));
         let tile = short.crop.side * short.zoom();

@@ -250,6 +250,9 @@ mod panel_files {
     struct EntryRecord {
         label: String,
         time_ms: f64,
+        /// The budget's render's time, timed in alternation with this entry.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        budget_ms: Option<f64>,
         /// Its time over the budget (1.0 = exactly the budget).
         #[serde(default, skip_serializing_if = "Option::is_none")]
         budget_share: Option<f64>,
@@ -268,6 +271,7 @@ mod panel_files {
                     .map(|e| EntryRecord {
                         label: e.label.clone(),
                         time_ms: e.time_ms,
+                        budget_ms: e.budget_ms,
                         budget_share: p.budget_share(e),
                         rmse: e.rmse,
                     })

@@ -9,7 +9,7 @@ use crate::report::Point;
 use crate::stats::{SeedErrors, Timing};
 use crate::{Options, Subject};
 
-pub(crate) use crate::measure::{render, render_denoised, render_timed};
+pub(crate) use crate::measure::{render, render_denoised};
 
 /// Renders `options.repeats` times with seeds 0, 1, 2... and measures the
 /// time and the error against `reference`: RMSE, relative MSE, the split
@@ -50,105 +50,163 @@ pub(crate) fn measure_with(
 
 /// The most samples per pixel an equal-time entry renders.
 const MAX_PANEL_SPP: f64 = 65_536.0;
-/// Renders an equal-time entry may take to meet the budget within the tolerance.
+/// Counts (or time bounds) an equal-time entry may try to meet the budget within the tolerance.
 const EQUAL_TIME_ATTEMPTS: usize = 8;
-/// Runs a fixed count is timed over in an equal-time panel, the median
-/// recorded: panels are renders of a tenth of a second and up, where one
-/// run can be 10% off on a shared machine.
-const EQUAL_TIME_RUNS: usize = 3;
+/// Rounds an equal-time entry is timed in, each one run of the budget's
+/// render and one of the entry's, in alternation. On the 2-core VM the
+/// report is made on, two runs of one render back to back differ by 7%
+/// (the standard deviation of their ratio), at 0.13 s as at 0.5 s, and
+/// slow spells of a second or more add 30%. Over 180 runs of one render
+/// (Cornell box, 128², 16 spp), the ratio of the fastest runs of 7 such
+/// rounds was within ±3.5% of 1 in 96% of the 83 windows, the median of
+/// 7 pairs' ratios in 81%; medians of 3 lone runs ranged over 47%.
+const EQUAL_TIME_ROUNDS: usize = 7;
+
+/// The samples per pixel of an equal-time panel's budget where a knob
+/// measures at `sweep_spp`, a power of two: half as many again. Counts
+/// just above a power of two cost up to a fifth more per sample than it
+/// (the stratified and low-discrepancy samplers' permutations walk cycles
+/// over the next power of two: 17 samples took 22% longer than 16 on the
+/// Cornell box, 15 longer than 16), so a budget at 16 leaves configurations
+/// a little cheaper per sample no count that fits; from 20 to 24 samples
+/// each one more took 3–4.5% longer (fastest of 5 runs each).
+pub(crate) fn budget_spp(sweep_spp: u32) -> u32 {
+    sweep_spp + sweep_spp / 2
+}
+
+/// The render whose time is an equal-time panel's budget: timed in
+/// alternation with each entry, so that the entry is held to the budget as
+/// the machine ran at the time.
+pub(crate) struct Budget {
+    /// What it renders (its samples per pixel included).
+    pub settings: RenderSettings,
+    /// How its image is made: a render, or a render and a filter.
+    pub make: MakeImage,
+    /// Its time as measured before (the median of a sweep's runs): the
+    /// start from which each entry's count is estimated.
+    pub estimate_ms: f64,
+}
+
+/// A configuration of an equal-time panel: rendered with as many samples
+/// per pixel (or, adaptive, for as long) as fit the budget.
+pub(crate) struct Candidate {
+    /// The configuration's name; the count it takes is appended.
+    pub label: String,
+    /// What it renders (its count is chosen).
+    pub settings: RenderSettings,
+    /// Its measured milliseconds per sample: the first count's estimate.
+    pub ms_per_sample: f64,
+    /// How its image is made.
+    pub make: MakeImage,
+}
+
+impl Candidate {
+    /// A configuration whose image is a plain render.
+    pub(crate) fn render(label: impl Into<String>, settings: RenderSettings, ms_per_sample: f64) -> Candidate {
+        Candidate { label: label.into(), settings, ms_per_sample, make: render }
+    }
+}
+
+/// An entry's image and its time against the budget's, from
+/// [`against_budget`]: (image, entry ms, budget ms).
+type Timed = (HdrImage, f64, f64);
+
+/// Times `entry` against the budget's render in [`EQUAL_TIME_ROUNDS`]
+/// rounds ([`crate::measure::fastest_in_alternation`]).
+fn against_budget(subject: &Subject, budget: &Budget, entry: impl FnMut() -> HdrImage) -> Timed {
+    crate::measure::fastest_in_alternation(EQUAL_TIME_ROUNDS, || (budget.make)(subject, &budget.settings), entry)
+}
 
 /// Renders each configuration (seed 0) with as many samples per pixel as
-/// fit `budget_ms`: the entries of an equal-time panel. A fixed count's
-/// time is the median of [`EQUAL_TIME_RUNS`] runs. The count starts
-/// from the configuration's measured milliseconds per sample and is
-/// corrected from each render's own time (fixed costs and caches make the
-/// time per sample of a long render differ from a short one's) until the
-/// render takes the budget within [`EQUAL_TIME_TOLERANCE`]; where one
-/// sample more or less steps over that window, or the time was noise, the
-/// count is rendered again, and the entry closest to the budget is kept.
-/// Each entry records its time, so a miss is visible, never hidden.
+/// fit the budget: the entries of an equal-time panel. Each count is timed
+/// in alternation with the budget's render ([`against_budget`]), and the
+/// entry's share of the budget is the ratio of their fastest runs. The
+/// count starts from the configuration's measured milliseconds per sample
+/// and is corrected from each measured share (fixed costs, caches and the
+/// sampler's patterns make time not quite proportional to samples) until
+/// the share is within [`EQUAL_TIME_TOLERANCE`] of 1 ([`calibrate`]);
+/// where one sample more or less steps over that window, the count closest
+/// to the budget is kept. Each entry records its time and the budget's
+/// timed alongside it, so a miss is visible, never hidden.
 pub(crate) fn equal_time(
     subject: &Subject,
     reference: &Reference,
-    configurations: &[(String, RenderSettings, f64)],
-    budget_ms: f64,
+    budget: &Budget,
+    candidates: &[Candidate],
 ) -> Vec<crate::panel::Entry> {
-    configurations
+    candidates
         .iter()
-        .map(|(label, settings, ms_per_sample)| {
-            let entry = |image: HdrImage, time_ms: f64, label: String| {
+        .map(|candidate| {
+            let entry = |(image, time_ms, budget_ms): Timed, label: String| {
                 let rmse = rtgi_image::compare(&image, &reference.image).expect("same size").rmse;
-                crate::panel::Entry { label, image, time_ms, rmse }
+                crate::panel::Entry { label, image, time_ms, budget_ms: Some(budget_ms), rmse }
             };
-            let off = |time_ms: f64| (time_ms / budget_ms - 1.0).abs();
-            if let Some(sampling) = settings.adaptive {
+            let share = |timed: &Timed| timed.1 / timed.2.max(1e-9);
+            // The first render after another configuration's pays for cold
+            // caches and sleeping threads: the budget's, untimed, first.
+            let _ = (budget.make)(subject, &budget.settings);
+            if let Some(sampling) = candidate.settings.adaptive {
                 // Adaptive sampling bounded by a time: the round that would
                 // overrun is cut to what fits, as predicted from the rounds
                 // so far, so the render can overrun by a little. The bound
-                // is corrected from each render's own time until the render
+                // is corrected from each measured share until the render
                 // meets the budget. One that meets its noise target early
                 // ends early, and says so by its time.
                 let bounded = |seconds: f64| RenderSettings {
                     samples_per_pixel: MAX_PANEL_SPP as u32,
                     seed: 0,
                     adaptive: Some(rtgi_render::AdaptiveSampling { seconds: Some(seconds), ..sampling }),
-                    ..settings.clone()
+                    ..candidate.settings.clone()
                 };
-                let mut seconds = budget_ms * 1e-3;
-                let mut best: Option<(HdrImage, f64, f64)> = None;
+                let off = |timed: &Timed| (share(timed) - 1.0).abs();
+                let mut seconds = budget.estimate_ms * 1e-3;
+                let mut best: Option<(Timed, f64)> = None;
                 for _ in 0..EQUAL_TIME_ATTEMPTS {
-                    let (image, time_ms) = render_timed(subject, &bounded(seconds));
-                    let next = seconds * budget_ms / time_ms.max(1e-9);
-                    if best.as_ref().is_none_or(|b| off(time_ms) < off(b.1)) {
-                        best = Some((image, time_ms, seconds));
+                    let timed = against_budget(subject, budget, || (candidate.make)(subject, &bounded(seconds)));
+                    let next = seconds / share(&timed).max(1e-9);
+                    let in_window = off(&timed) <= EQUAL_TIME_TOLERANCE;
+                    if best.as_ref().is_none_or(|b| off(&timed) < off(&b.0)) {
+                        best = Some((timed, seconds));
                     }
-                    if best.as_ref().is_some_and(|b| off(b.1) <= EQUAL_TIME_TOLERANCE) {
+                    if in_window {
                         break;
                     }
                     seconds = next;
                 }
-                let (image, time_ms, seconds) = best.expect("at least one attempt");
-                return entry(image, time_ms, format!("{label}, --time {seconds:.3} s"));
+                let (timed, seconds) = best.expect("at least one attempt");
+                return entry(timed, format!("{}, --time {seconds:.3} s", candidate.label));
             }
-            // A count's time is the median of its runs (the image is the
-            // same bits each time): one run slowed by the machine then
-            // neither misses the window nor becomes the entry's time.
             let render_at = |spp: u32| {
-                let settings = RenderSettings { samples_per_pixel: spp, seed: 0, ..settings.clone() };
-                let mut image = None;
-                let timing = crate::measure::time_each(
-                    EQUAL_TIME_RUNS,
-                    |_| render(subject, &settings),
-                    |made| {
-                        image.get_or_insert(made);
-                    },
-                );
-                (image.expect("at least one run"), timing.median_ms)
+                let settings = RenderSettings { samples_per_pixel: spp, seed: 0, ..candidate.settings.clone() };
+                let timed = against_budget(subject, budget, || (candidate.make)(subject, &settings));
+                let share = share(&timed);
+                (timed, share)
             };
-            let first = (budget_ms / ms_per_sample.max(1e-9)).round().clamp(1.0, MAX_PANEL_SPP) as u32;
-            // The first render after another configuration's pays for cold
-            // caches and sleeping threads: one untimed, shorter, first.
-            let _ = render_at((first / 4).max(1));
-            let (image, time_ms, spp) = calibrate(budget_ms, first, EQUAL_TIME_ATTEMPTS, render_at);
-            entry(image, time_ms, format!("{label}, {spp} spp"))
+            let first = (budget.estimate_ms / candidate.ms_per_sample.max(1e-9)).round().clamp(1.0, MAX_PANEL_SPP);
+            let (timed, _, spp) = calibrate(1.0, first as u32, EQUAL_TIME_ATTEMPTS, render_at);
+            entry(timed, format!("{}, {spp} spp", candidate.label))
         })
         .collect()
 }
 
-/// Finds the count of samples whose run takes `budget_ms`: runs `run` at
-/// `first`, then at counts from the median time per sample of the runs so
-/// far (a median, so that one slow run moves the estimate little), until a
-/// run is within [`EQUAL_TIME_TOLERANCE`] of the budget or `attempts` runs
-/// were made. A count already run twice outside the window is not run a
-/// third time: the next count towards the budget is. Returns the run
+/// Finds the count of samples whose run takes `budget` (a time, or a share
+/// of one): runs `run` at `first`, then at the untried count nearest the
+/// one the line through the runs so far predicts, until a run is within
+/// [`EQUAL_TIME_TOLERANCE`] of the budget, `attempts` runs were made, or
+/// no untried count is within [`SEARCH_REACH`] of the prediction. No
+/// count is run twice. Time is not monotone in the count: the stratified
+/// sampler's patterns cost more per sample where the count is not a power
+/// of two (17 samples took 22% longer than 16 on the Cornell box, 15
+/// longer than 16), so a count on either side of the window does not mean
+/// that no count fits, and the search goes on past it. Returns the run
 /// closest to the budget, its time and its count.
 pub(crate) fn calibrate<T>(
-    budget_ms: f64,
+    budget: f64,
     first: u32,
     attempts: usize,
     mut run: impl FnMut(u32) -> (T, f64),
 ) -> (T, f64, u32) {
-    let off = |ms: f64| (ms / budget_ms - 1.0).abs();
+    let off = |ms: f64| (ms / budget - 1.0).abs();
     let mut tried: Vec<(u32, f64)> = Vec::new();
     let mut best: Option<(T, f64, u32)> = None;
     let mut count = first.clamp(1, MAX_PANEL_SPP as u32);
@@ -161,24 +219,33 @@ pub(crate) fn calibrate<T>(
         if off(ms) <= EQUAL_TIME_TOLERANCE {
             break;
         }
-        let mut next = (next_count(&tried, budget_ms)).round().clamp(1.0, MAX_PANEL_SPP) as u32;
-        let runs_of = |n: u32| tried.iter().filter(|t| t.0 == n).map(|t| t.1).collect::<Vec<f64>>();
-        let at_next = runs_of(next);
-        if at_next.len() >= 2 {
-            // Twice outside the window: step towards the budget instead.
-            let mean = at_next.iter().sum::<f64>() / at_next.len() as f64;
-            next = if mean < budget_ms { next + 1 } else { next.saturating_sub(1).max(1) };
+        let predicted = next_count(&tried, budget).clamp(1.0, MAX_PANEL_SPP);
+        let reach = (SEARCH_REACH * predicted).max(2.0);
+        let untried = |n: &u32| tried.iter().all(|t| t.0 != *n);
+        let lowest = (predicted - reach).floor().max(1.0) as u32;
+        let highest = (predicted + reach).ceil().min(MAX_PANEL_SPP) as u32;
+        // The nearest untried count, the larger one of two as near.
+        let nearest = (lowest..=highest)
+            .filter(untried)
+            .filter(|&n| (n as f64 - predicted).abs() <= reach)
+            .min_by(|&a, &b| (a as f64 - predicted).abs().total_cmp(&(b as f64 - predicted).abs()).then(b.cmp(&a)));
+        match nearest {
+            Some(next) => count = next,
+            None => break,
         }
-        count = next;
     }
     best.expect("at least one run")
 }
 
-/// The count the runs `tried` (count, ms) say takes `budget_ms`: from the
+/// How far from the predicted count the search of [`calibrate`] looks for
+/// an untried one, as a fraction of it (and at least 2 counts).
+const SEARCH_REACH: f64 = 0.1;
+
+/// The count the runs `tried` (count, time) say takes `budget`: from the
 /// line through them (a render has a fixed cost beside its samples) where
 /// they span two counts or more and it rises, else from the median time per
 /// sample (a median, so that one slow run moves the estimate little).
-fn next_count(tried: &[(u32, f64)], budget_ms: f64) -> f64 {
+fn next_count(tried: &[(u32, f64)], budget: f64) -> f64 {
     let n = tried.len() as f64;
     let (mean_x, mean_y) =
         (tried.iter().map(|t| t.0 as f64).sum::<f64>() / n, tried.iter().map(|t| t.1).sum::<f64>() / n);
@@ -187,33 +254,50 @@ fn next_count(tried: &[(u32, f64)], budget_ms: f64) -> f64 {
     if sxx > 0.0 && sxy > 0.0 {
         let slope = sxy / sxx;
         let fixed = mean_y - slope * mean_x;
-        let count = (budget_ms - fixed) / slope;
+        let count = (budget - fixed) / slope;
         if count.is_finite() && count > 0.0 {
             return count;
         }
     }
     let mut rates: Vec<f64> = tried.iter().map(|&(n, ms)| ms / n as f64).collect();
     rates.sort_by(f64::total_cmp);
-    budget_ms / rates[rates.len() / 2].max(1e-12)
+    budget / rates[rates.len() / 2].max(1e-12)
 }
 
-/// Renders the configurations at equal time ([`equal_time`]) and adds their
-/// panel to `report`, its caption among the findings.
+/// Renders the candidates at equal time ([`equal_time`]) and adds their
+/// panel to `report`, its caption among the findings. The panel's budget
+/// is the median of the budget's times measured alongside the entries.
 pub(crate) fn add_equal_time_panel(
     report: &mut crate::Report,
     subject: &Subject,
     reference: &Reference,
     file: String,
     what: &str,
-    configurations: &[(String, RenderSettings, f64)],
-    budget_ms: f64,
+    budget: &Budget,
+    candidates: &[Candidate],
 ) {
-    let entries = equal_time(subject, reference, configurations, budget_ms);
+    let panel = equal_time_panel(subject, reference, file, what, budget, candidates);
+    report.findings.push(panel.caption());
+    report.panels.push(panel);
+}
+
+/// The equal-time panel of `candidates` ([`add_equal_time_panel`]).
+pub(crate) fn equal_time_panel(
+    subject: &Subject,
+    reference: &Reference,
+    file: String,
+    what: &str,
+    budget: &Budget,
+    candidates: &[Candidate],
+) -> crate::panel::Panel {
+    let entries = equal_time(subject, reference, budget, candidates);
+    let mut budgets: Vec<f64> = entries.iter().filter_map(|e| e.budget_ms).collect();
+    budgets.sort_by(f64::total_cmp);
+    let budget_ms = budgets.get(budgets.len() / 2).copied().unwrap_or(budget.estimate_ms);
     let title = format!("{what} at equal time ({} ms)", crate::report::format_ms(budget_ms));
     let mut panel = crate::panel::Panel::new(file, title, reference.image.clone(), entries);
     panel.budget_ms = Some(budget_ms);
-    report.findings.push(panel.caption());
-    report.panels.push(panel);
+    panel
 }
 
 /// A measured point's median milliseconds per sample per pixel.
@@ -256,9 +340,56 @@ mod tests {
     }
 
     #[test]
+    fn no_count_is_run_twice_and_a_cheaper_power_of_two_does_not_trap_the_search() {
+        // The stratified sampler's patterns cost more at counts that are
+        // not powers of two: 15 samples take longer than 16 here.
+        for budget in [100.0, 120.0, 135.0, 150.0] {
+            let mut runs = Vec::new();
+            let (_, ms, count) = calibrate(budget, 8, EQUAL_TIME_ATTEMPTS, |n| {
+                runs.push(n);
+                let per_sample = if n.is_power_of_two() { 7.9 } else { 8.9 };
+                ((), per_sample * n as f64)
+            });
+            let mut distinct = runs.clone();
+            distinct.sort_unstable();
+            distinct.dedup();
+            assert_eq!(distinct.len(), runs.len(), "budget {budget}: {runs:?}");
+            // 15 and 16 both fit 135 and 120 within 5%; 17 · 8.9 = 151.3 fits 150.
+            assert!((ms / budget - 1.0).abs() <= EQUAL_TIME_TOLERANCE, "budget {budget}: {count} took {ms}, {runs:?}");
+        }
+    }
+
+    #[test]
     fn where_no_count_fits_the_closest_is_kept() {
         // 30 ms a sample: 3 samples take 90 ms, 4 take 120; neither is within 5% of 100.
-        let (_, ms, count) = calibrate(100.0, 1, EQUAL_TIME_ATTEMPTS, |n| ((), 30.0 * n as f64));
+        let mut runs = Vec::new();
+        let (_, ms, count) = calibrate(100.0, 1, EQUAL_TIME_ATTEMPTS, |n| {
+            runs.push(n);
+            ((), 30.0 * n as f64)
+        });
         assert_eq!((count, ms), (3, 90.0));
+        assert!(runs.len() < EQUAL_TIME_ATTEMPTS, "the search gives up when no count near the line is left: {runs:?}");
+    }
+
+    #[test]
+    fn a_count_past_one_that_overran_is_tried_where_time_is_not_monotone() {
+        // The costs measured on the Cornell box (ms; 15 a little slower):
+        // 14 and 15 samples fall on either side of a 130.5 ms budget's
+        // window, and 16 fits.
+        let cost = |n: u32| match n {
+            12 => 104.2,
+            13 => 112.2,
+            14 => 119.4,
+            15 => 137.7,
+            16 => 130.5,
+            17 => 158.7,
+            n => 9.0 * n as f64,
+        };
+        let mut runs = Vec::new();
+        let (_, ms, count) = calibrate(130.5, 15, EQUAL_TIME_ATTEMPTS, |n| {
+            runs.push(n);
+            ((), cost(n))
+        });
+        assert_eq!((count, ms, runs), (16, 130.5, vec![15, 14, 16]));
     }
 }

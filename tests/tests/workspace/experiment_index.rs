@@ -178,6 +178,8 @@ fn every_equal_time_entry_records_its_share_of_the_budget_and_a_miss_is_said() {
             for entry in panel["entries"].as_array().expect("the panel's entries") {
                 let share = entry["budget_share"].as_f64().expect("each entry's share of the budget");
                 let time = entry["time_ms"].as_f64().unwrap();
+                // The budget's render timed alongside the entry, where it was.
+                let budget = entry["budget_ms"].as_f64().unwrap_or(budget);
                 assert!((time / budget - share).abs() < 1e-9, "{}: {entry}", path.display());
                 if !(0.95..=1.05).contains(&share) {
                     let label = entry["label"].as_str().unwrap();

@@ -11,7 +11,7 @@ use rtgi_render::{AdaptiveSampling, PixelSampler, RenderSettings};
 use crate::plot::{Curve, Plot};
 use crate::reference::reference;
 use crate::report::{Point, Report, Series, Table, measurement_cells, measurement_header};
-use crate::runner::{add_equal_time_panel, measure, ms_per_sample, time_and_error};
+use crate::runner::{Budget, Candidate, add_equal_time_panel, measure, ms_per_sample, time_and_error};
 use crate::verdict::{ErrorMeasure, compare_efficiency_by, most_efficient_by};
 use crate::{ExperimentError, Options, Steps, Subject};
 
@@ -133,20 +133,24 @@ pub(super) fn run(
     let stratified_name = format!("{}, every pixel alike", PixelSampler::Stratified);
     let sobol_name = format!("{}, every pixel alike", PixelSampler::Sobol);
     if let (Some(stratified), Some(sobol)) = (at(&stratified_name), at(&sobol_name)) {
-        let budget = stratified.time.as_ref().expect("measured").median_ms;
+        let budget = Budget {
+            settings: RenderSettings { sampler: PixelSampler::Stratified, samples_per_pixel: middle, ..base.clone() },
+            make: crate::runner::render,
+            estimate_ms: stratified.time.as_ref().expect("measured").median_ms,
+        };
         let tightest = *targets.last().expect("targets");
-        let configurations = vec![
-            (
-                "stratified".to_owned(),
+        let candidates = vec![
+            Candidate::render(
+                "stratified",
                 RenderSettings { sampler: PixelSampler::Stratified, ..base.clone() },
                 ms_per_sample(stratified, middle),
             ),
-            (
-                "sobol".to_owned(),
+            Candidate::render(
+                "sobol",
                 RenderSettings { sampler: PixelSampler::Sobol, ..base.clone() },
                 ms_per_sample(sobol, middle),
             ),
-            (format!("noise {tightest}"), adaptive(tightest), ms_per_sample(sobol, middle)),
+            Candidate::render(format!("noise {tightest}"), adaptive(tightest), ms_per_sample(sobol, middle)),
         ];
         steps.next("equal-time panel");
         let file = "adaptive-equal-time.png".to_owned();
@@ -156,8 +160,8 @@ pub(super) fn run(
             &reference,
             file,
             "Fixed and adaptive sampling",
-            &configurations,
-            budget,
+            &budget,
+            &candidates,
         );
     }
     report.tables.push(table);

@@ -10,7 +10,7 @@ use rtgi_render::RenderSettings;
 use crate::plot::{Corner, Curve, Plot};
 use crate::reference::reference;
 use crate::report::{Point, Report, Series, Table, format_number, measurement_cells, measurement_header};
-use crate::runner::{add_equal_time_panel, measure};
+use crate::runner::{Budget, Candidate, add_equal_time_panel, measure};
 use crate::verdict::compare_efficiency;
 use crate::{ExperimentError, Options, Steps, Subject};
 
@@ -155,24 +155,30 @@ pub(super) fn run(
         })
         .collect();
     report.plots.push(Plot::error_against_time("clamp-tradeoff.svg", title, curves));
-    // The equal-time panel: no clamp, the harshest, the best and a mild one, in the unclamped render's time.
-    let budget = points[0].2.time.as_ref().expect("measured").median_ms;
+    // The equal-time panel: no clamp, the harshest, the best and a mild one, in the time of the unclamped
+    // render at half as many samples again (`budget_spp`).
+    let panel_spp = crate::runner::budget_spp(spp);
+    let budget = Budget {
+        settings: RenderSettings { indirect_clamp: None, samples_per_pixel: panel_spp, ..base.clone() },
+        make: crate::runner::render,
+        estimate_ms: points[0].2.time.as_ref().expect("measured").median_ms * panel_spp as f64 / spp as f64,
+    };
     let best = series_best;
     let mut chosen: Vec<usize> = vec![0, 1, best, points.len() - 1];
     chosen.dedup();
     chosen.sort_unstable();
     chosen.dedup();
-    let configurations: Vec<(String, RenderSettings, f64)> = chosen
+    let candidates: Vec<Candidate> = chosen
         .iter()
         .map(|&i| {
             let (label, limit, point) = &points[i];
             let clamp = limit.is_finite().then_some(*limit as f32);
             let settings = RenderSettings { indirect_clamp: clamp, ..base.clone() };
-            (format!("clamp {label}"), settings, crate::runner::ms_per_sample(point, spp))
+            Candidate::render(format!("clamp {label}"), settings, crate::runner::ms_per_sample(point, spp))
         })
         .collect();
     let file = "clamp-equal-time.png".to_owned();
-    add_equal_time_panel(&mut report, subject, &reference, file, "Clamps", &configurations, budget);
+    add_equal_time_panel(&mut report, subject, &reference, file, "Clamps", &budget, &candidates);
     report.tables.push(table);
     report.reference = Some(reference.info);
     Ok(report)

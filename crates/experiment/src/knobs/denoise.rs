@@ -7,11 +7,13 @@
 
 use rtgi_render::RenderSettings;
 
-use crate::panel::{Entry, Panel};
 use crate::plot::{Curve, Plot};
 use crate::reference::reference;
-use crate::report::{Report, Series, Table, format_ms, measurement_cells, measurement_header};
-use crate::runner::{MakeImage, equal_time, measure_with, ms_per_sample, render, render_denoised, time_and_error};
+use crate::report::{Report, Series, Table, measurement_cells, measurement_header};
+use crate::runner::{
+    Budget, Candidate, MakeImage, equal_time_panel, measure_with, ms_per_sample, render, render_denoised,
+    time_and_error,
+};
 use crate::verdict::{compare_efficiency, most_efficient};
 use crate::{ExperimentError, Options, Steps, Subject};
 
@@ -78,40 +80,31 @@ pub(super) fn run(
         curves,
     ));
 
-    // Equal time: the denoised render at the budget's count sets the time;
+    // Equal time: the denoised render at half as many samples again as the
+    // budget's count (`budget_spp`) sets the time;
     // the mean of the samples gets as many samples as fit it.
     let at = |series: &Series| series.points.iter().find(|p| p.x == budget_spp as f64).cloned();
     if let (Some(raw), Some(clean)) = (at(&report.series[0]), at(&report.series[1])) {
         steps.next("equal-time panel");
-        let budget = clean.time.as_ref().expect("measured").median_ms;
-        let configuration = (
-            "mean of the samples".to_owned(),
-            RenderSettings { samples_per_pixel: budget_spp, ..base.clone() },
-            ms_per_sample(&raw, budget_spp),
-        );
-        let mut entries = equal_time(subject, &reference, &[configuration], budget);
-        let settings = RenderSettings { samples_per_pixel: budget_spp, seed: 0, ..base.clone() };
-        // The denoised render at the count whose median time is the budget:
-        // one run can stray from the median, so it is rendered again (up to
-        // a few times) until it is within the tolerance, keeping the closest.
-        let off = |ms: f64| (ms / budget - 1.0).abs();
-        let timed = || crate::measure::once(|| render_denoised(subject, &settings));
-        let mut best = timed();
-        for _ in 1..6 {
-            if off(best.1) <= crate::panel::EQUAL_TIME_TOLERANCE {
-                break;
-            }
-            let again = timed();
-            if off(again.1) < off(best.1) {
-                best = again;
-            }
-        }
-        let (image, time_ms) = best;
-        let rmse = rtgi_image::compare(&image, &reference.image).expect("same size").rmse;
-        entries.push(Entry { label: format!("denoised, {budget_spp} spp"), image, time_ms, rmse });
-        let title = format!("The samples' mean and the denoised image at equal time ({} ms)", format_ms(budget));
-        let mut panel = Panel::new("denoise-equal-time.png", title, reference.image.clone(), entries);
-        panel.budget_ms = Some(budget);
+        let panel_spp = crate::runner::budget_spp(budget_spp);
+        let settings = RenderSettings { samples_per_pixel: panel_spp, ..base.clone() };
+        let budget = Budget {
+            settings: settings.clone(),
+            make: render_denoised,
+            estimate_ms: clean.time.as_ref().expect("measured").median_ms * panel_spp as f64 / budget_spp as f64,
+        };
+        let candidates = [
+            Candidate::render("mean of the samples", settings.clone(), ms_per_sample(&raw, budget_spp)),
+            Candidate {
+                label: "denoised".to_owned(),
+                settings,
+                ms_per_sample: ms_per_sample(&clean, budget_spp),
+                make: render_denoised,
+            },
+        ];
+        let what = "The samples' mean and the denoised image";
+        let file = "denoise-equal-time.png".to_owned();
+        let panel = equal_time_panel(subject, &reference, file, what, &budget, &candidates);
         report.findings.push(panel.caption());
         report.panels.push(panel);
     }

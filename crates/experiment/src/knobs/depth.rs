@@ -7,7 +7,7 @@ use rtgi_render::{Integrator, RenderSettings};
 use crate::plot::{Corner, Curve, Plot};
 use crate::reference::reference;
 use crate::report::{Report, Series, Table, format_bias, measurement_cells, measurement_header};
-use crate::runner::{add_equal_time_panel, measure};
+use crate::runner::{Budget, Candidate, add_equal_time_panel, measure};
 use crate::verdict::{compare_efficiency, compare_times};
 use crate::{ExperimentError, Options, Steps, Subject};
 
@@ -163,18 +163,22 @@ pub(super) fn run(
         && let (Some(deep_on), Some(deep_off), Some(shallow_on)) =
             (on.points.last(), off.points.last(), on.points.iter().find(|p| p.x == shallow as f64))
     {
-        let budget = deep_on.time.as_ref().expect("measured").median_ms;
+        let budget = Budget {
+            settings: RenderSettings { max_depth: deepest, russian_roulette: true, ..base.clone() },
+            make: crate::runner::render,
+            estimate_ms: deep_on.time.as_ref().expect("measured").median_ms,
+        };
         let configuration = |label: String, depth: u32, roulette: bool, point: &crate::Point| {
             let settings = RenderSettings { max_depth: depth, russian_roulette: roulette, ..base.clone() };
-            (label, settings, crate::runner::ms_per_sample(point, spp))
+            Candidate::render(label, settings, crate::runner::ms_per_sample(point, spp))
         };
-        let configurations = vec![
+        let candidates = vec![
             configuration(format!("depth {deepest}, roulette on"), deepest, true, deep_on),
             configuration(format!("depth {deepest}, roulette off"), deepest, false, deep_off),
             configuration(format!("depth {shallow}, roulette on"), shallow, true, shallow_on),
         ];
         let (file, what) = ("depth-equal-time.png".to_owned(), "Depth and Russian roulette");
-        add_equal_time_panel(&mut report, subject, &reference, file, what, &configurations, budget);
+        add_equal_time_panel(&mut report, subject, &reference, file, what, &budget, &candidates);
     }
     report.tables.push(table);
     report.reference = Some(reference.info);

@@ -19,7 +19,7 @@ use rtgi_scene::description::Description;
 use crate::plot::{Curve, Plot};
 use crate::reference::reference;
 use crate::report::{Report, Series, Table, format_ms, format_number, measurement_cells, measurement_header};
-use crate::runner::{add_equal_time_panel, measure};
+use crate::runner::{Budget, Candidate, add_equal_time_panel, measure};
 use crate::verdict::compare;
 use crate::{ExperimentError, Options, Steps, Subject};
 
@@ -264,17 +264,36 @@ pub(super) fn run(
         ));
         // The equal-time panel: each strategy given the budget at its measured time per sample.
         let scene_series = &report.series[report.series.len() - strategies.len()..];
-        let configurations: Vec<(String, RenderSettings, f64)> = strategies
+        let candidates: Vec<Candidate> = strategies
             .iter()
             .zip(scene_series)
             .filter_map(|(&strategy, series)| {
                 let last = series.points.last()?;
                 let settings = RenderSettings { direct_strategy: strategy, ..scene_subject.settings.clone() };
-                Some((strategy.to_string(), settings, crate::runner::ms_per_sample(last, last.x as u32)))
+                Some(Candidate::render(
+                    strategy.to_string(),
+                    settings,
+                    crate::runner::ms_per_sample(last, last.x as u32),
+                ))
             })
             .collect();
-        let (file, what) = (format!("direct-{name}-equal-time.png"), format!("Direct light, {name},"));
-        add_equal_time_panel(&mut report, &scene_subject, &reference, file, &what, &configurations, budget);
+        // The budget is the longest render of the strategy that reached the least time.
+        let budget_render = strategies.iter().zip(scene_series).find_map(|(&strategy, series)| {
+            let last = series.points.last()?;
+            (last.time.as_ref()?.median_ms == budget).then(|| Budget {
+                settings: RenderSettings {
+                    direct_strategy: strategy,
+                    samples_per_pixel: last.x as u32,
+                    ..scene_subject.settings.clone()
+                },
+                make: crate::runner::render,
+                estimate_ms: budget,
+            })
+        });
+        if let Some(budget_render) = budget_render {
+            let (file, what) = (format!("direct-{name}-equal-time.png"), format!("Direct light, {name},"));
+            add_equal_time_panel(&mut report, &scene_subject, &reference, file, &what, &budget_render, &candidates);
+        }
         report.tables.push(table);
     }
     report.tables.insert(0, summary);

@@ -13,7 +13,9 @@ use rtgi_render::{FilterGlossy, RenderSettings};
 use crate::plot::{Curve, Plot};
 use crate::reference::reference;
 use crate::report::{Point, Report, Series, Table, format_bias, format_number, measurement_cells, measurement_header};
-use crate::runner::{MakeImage, add_equal_time_panel, measure_with, ms_per_sample, render, render_denoised};
+use crate::runner::{
+    Budget, Candidate, MakeImage, add_equal_time_panel, measure_with, ms_per_sample, render, render_denoised,
+};
 use crate::verdict::compare_efficiency;
 use crate::{ExperimentError, Options, Steps, Subject};
 
@@ -181,20 +183,27 @@ pub(super) fn run(
         curves,
     ));
 
-    // Equal time (raw renders): exact, the clamp, and the thresholds 0.3 and 1.
+    // Equal time (raw renders): exact, the clamp, and the thresholds 0.3 and 1, in the time of the exact
+    // render at half as many samples again (`budget_spp`).
     steps.next("equal-time panel");
-    let budget = points[0].time.as_ref().expect("measured").median_ms;
+    let exact = &configurations[0];
+    let panel_spp = crate::runner::budget_spp(spp);
+    let budget = Budget {
+        settings: RenderSettings { samples_per_pixel: panel_spp, ..exact.settings.clone() },
+        make: exact.make,
+        estimate_ms: points[0].time.as_ref().expect("measured").median_ms * panel_spp as f64 / spp as f64,
+    };
     let chosen: Vec<&Point> = points[..half]
         .iter()
         .filter(|p| {
             p.label == "exact" || p.label.starts_with("clamp") || p.label.ends_with(" 1") || p.label.ends_with(" 0.3")
         })
         .collect();
-    let panel: Vec<(String, RenderSettings, f64)> = chosen
+    let candidates: Vec<Candidate> = chosen
         .iter()
         .map(|p| {
             let settings = configurations.iter().find(|c| c.label == p.label).expect("configured").settings.clone();
-            (p.label.clone(), settings, ms_per_sample(p, spp))
+            Candidate::render(p.label.clone(), settings, ms_per_sample(p, spp))
         })
         .collect();
     add_equal_time_panel(
@@ -203,8 +212,8 @@ pub(super) fn run(
         &reference,
         "filter-glossy-equal-time.png".to_owned(),
         "Regularisation and the clamp",
-        &panel,
-        budget,
+        &budget,
+        &candidates,
     );
     report.tables.push(table);
     report.reference = Some(reference.info);

@@ -17,7 +17,7 @@ use rtgi_render::{Integrator, PixelSampler, RenderSettings};
 use crate::plot::{Corner, Curve, Plot};
 use crate::reference::reference;
 use crate::report::{Report, Series, Table, format_number, measurement_cells, measurement_header};
-use crate::runner::{add_equal_time_panel, measure};
+use crate::runner::{Budget, Candidate, add_equal_time_panel, measure};
 use crate::verdict::compare_efficiency;
 use crate::{ExperimentError, Options, Steps, Subject};
 
@@ -150,25 +150,37 @@ pub(super) fn run(
         ));
         report.tables.push(table);
         if integrator == subject.settings.integrator {
-            // Equal time: every sampler given the time stratified sampling takes at the compared count.
+            // Equal time: every sampler given the time stratified sampling takes at half as many samples
+            // again as the compared count (`budget_spp`: clear of the step in cost past a power of two).
             let at_count = |sampler: PixelSampler| {
                 report.series.iter().rev().find(|s| s.name == format!("{sampler}, {integrand}")).and_then(|s| {
                     s.points.iter().find(|p| p.x == COMPARED_AT.min(*counts.last().expect("counts") as f64))
                 })
             };
-            if let Some(budget) = at_count(PixelSampler::Stratified).and_then(|p| p.time.as_ref()).map(|t| t.median_ms)
-            {
-                let configurations: Vec<(String, RenderSettings, f64)> = SAMPLERS
+            if let Some(stratified) = at_count(PixelSampler::Stratified) {
+                let panel_spp = crate::runner::budget_spp(stratified.x as u32);
+                let budget = Budget {
+                    settings: RenderSettings {
+                        sampler: PixelSampler::Stratified,
+                        samples_per_pixel: panel_spp,
+                        ..base.clone()
+                    },
+                    make: crate::runner::render,
+                    estimate_ms: stratified.time.as_ref().expect("measured").median_ms * panel_spp as f64
+                        / stratified.x,
+                };
+                let candidates: Vec<Candidate> = SAMPLERS
                     .iter()
                     .filter_map(|&sampler| {
                         let point = at_count(sampler)?;
                         let settings = RenderSettings { sampler, ..base.clone() };
-                        Some((sampler.to_string(), settings, crate::runner::ms_per_sample(point, point.x as u32)))
+                        let ms_per_sample = crate::runner::ms_per_sample(point, point.x as u32);
+                        Some(Candidate::render(sampler.to_string(), settings, ms_per_sample))
                     })
                     .collect();
                 steps.next("equal-time panel");
                 let file = "spp-equal-time.png".to_owned();
-                add_equal_time_panel(&mut report, subject, &reference, file, "The samplers", &configurations, budget);
+                add_equal_time_panel(&mut report, subject, &reference, file, "The samplers", &budget, &candidates);
             }
             report.reference = Some(reference.info);
         }
