@@ -639,6 +639,26 @@ mod tests {
     }
 
     #[test]
+    fn an_entry_is_held_to_the_budget_timed_alongside_it_and_a_miss_is_said() {
+        let entry = |label: &str, time_ms: f64, budget_ms: Option<f64>| Entry {
+            label: label.into(),
+            image: flat(0.6),
+            time_ms,
+            budget_ms,
+            rmse: 0.1,
+        };
+        let entries = vec![entry("held", 102.0, Some(100.0)), entry("over", 110.0, Some(100.0)), entry("old", 97.0, None)];
+        let mut panel = Panel::new("p.png", "t", flat(0.5), entries);
+        panel.budget_ms = Some(120.0);
+        let shares: Vec<f64> = panel.entries.iter().map(|e| panel.budget_share(e).unwrap()).collect();
+        assert_eq!(shares, vec![1.02, 1.1, 97.0 / 120.0]);
+        let caption = panel.caption();
+        assert!(caption.contains("held (102 ms, +2.0% of the budget, RMSE"), "{caption}");
+        assert!(caption.contains("over (110 ms, +10.0% of the budget: outside ±5%, RMSE"), "{caption}");
+        assert!(caption.contains("fastest run of rounds alternated with the budget's render"), "{caption}");
+    }
+
+    #[test]
     fn labels_too_wide_for_their_column_at_twice_the_size_are_drawn_at_the_font_s_own() {
         let entries = |label: &str| {
             vec![Entry { label: label.into(), image: flat(0.6), time_ms: 1.0, budget_ms: None, rmse: 0.1 }]
