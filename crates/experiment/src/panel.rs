@@ -647,7 +647,8 @@ mod tests {
             budget_ms,
             rmse: 0.1,
         };
-        let entries = vec![entry("held", 102.0, Some(100.0)), entry("over", 110.0, Some(100.0)), entry("old", 97.0, None)];
+        let entries =
+            vec![entry("held", 102.0, Some(100.0)), entry("over", 110.0, Some(100.0)), entry("old", 97.0, None)];
         let mut panel = Panel::new("p.png", "t", flat(0.5), entries);
         panel.budget_ms = Some(120.0);
         let shares: Vec<f64> = panel.entries.iter().map(|e| panel.budget_share(e).unwrap()).collect();
