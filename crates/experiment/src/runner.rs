@@ -276,20 +276,6 @@ pub(crate) fn add_equal_time_panel(
     budget: &Budget,
     candidates: &[Candidate],
 ) {
-    let panel = equal_time_panel(subject, reference, file, what, budget, candidates);
-    report.findings.push(panel.caption());
-    report.panels.push(panel);
-}
-
-/// The equal-time panel of `candidates` ([`add_equal_time_panel`]).
-pub(crate) fn equal_time_panel(
-    subject: &Subject,
-    reference: &Reference,
-    file: String,
-    what: &str,
-    budget: &Budget,
-    candidates: &[Candidate],
-) -> crate::panel::Panel {
     let entries = equal_time(subject, reference, budget, candidates);
     let mut budgets: Vec<f64> = entries.iter().filter_map(|e| e.budget_ms).collect();
     budgets.sort_by(f64::total_cmp);
@@ -297,7 +283,8 @@ pub(crate) fn equal_time_panel(
     let title = format!("{what} at equal time ({} ms)", crate::report::format_ms(budget_ms));
     let mut panel = crate::panel::Panel::new(file, title, reference.image.clone(), entries);
     panel.budget_ms = Some(budget_ms);
-    panel
+    report.findings.push(panel.caption());
+    report.panels.push(panel);
 }
 
 /// A measured point's median milliseconds per sample per pixel.

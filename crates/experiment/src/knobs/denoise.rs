@@ -11,7 +11,7 @@ use crate::plot::{Curve, Plot};
 use crate::reference::reference;
 use crate::report::{Report, Series, Table, measurement_cells, measurement_header};
 use crate::runner::{
-    Budget, Candidate, MakeImage, equal_time_panel, measure_with, ms_per_sample, render, render_denoised,
+    Budget, Candidate, MakeImage, add_equal_time_panel, measure_with, ms_per_sample, render, render_denoised,
     time_and_error,
 };
 use crate::verdict::{compare_efficiency, most_efficient};
@@ -104,9 +104,7 @@ pub(super) fn run(
         ];
         let what = "The samples' mean and the denoised image";
         let file = "denoise-equal-time.png".to_owned();
-        let panel = equal_time_panel(subject, &reference, file, what, &budget, &candidates);
-        report.findings.push(panel.caption());
-        report.panels.push(panel);
+        add_equal_time_panel(&mut report, subject, &reference, file, what, &budget, &candidates);
     }
     report.tables.push(table);
     report.reference = Some(reference.info);
