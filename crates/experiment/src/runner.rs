@@ -69,7 +69,7 @@ const EQUAL_TIME_ROUNDS: usize = 7;
 /// over the next power of two: 17 samples took 22% longer than 16 on the
 /// Cornell box, 15 longer than 16), so a budget at 16 leaves configurations
 /// a little cheaper per sample no count that fits; from 20 to 24 samples
-/// each one more took 3–4.5% longer (fastest of 5 runs each).
+/// each one more took 2.8–4.2% longer (fastest of 5 runs each).
 pub(crate) fn budget_spp(sweep_spp: u32) -> u32 {
     sweep_spp + sweep_spp / 2
 }
