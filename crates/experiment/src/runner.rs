@@ -87,6 +87,18 @@ pub(crate) struct Budget {
     pub estimate_ms: f64,
 }
 
+impl Budget {
+    /// The budget of a knob whose sweep rendered `settings` (at a
+    /// power-of-two count) and measured it as `point`: the same render at
+    /// [`budget_spp`] of that count, its time estimated in proportion.
+    pub(crate) fn from_sweep(settings: RenderSettings, make: MakeImage, point: &Point) -> Budget {
+        let sweep_spp = settings.samples_per_pixel;
+        let panel_spp = budget_spp(sweep_spp);
+        let estimate_ms = point.time.as_ref().expect("measured").median_ms * panel_spp as f64 / sweep_spp.max(1) as f64;
+        Budget { settings: RenderSettings { samples_per_pixel: panel_spp, ..settings }, make, estimate_ms }
+    }
+}
+
 /// A configuration of an equal-time panel: rendered with as many samples
 /// per pixel (or, adaptive, for as long) as fit the budget.
 pub(crate) struct Candidate {

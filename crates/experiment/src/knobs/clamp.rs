@@ -157,12 +157,7 @@ pub(super) fn run(
     report.plots.push(Plot::error_against_time("clamp-tradeoff.svg", title, curves));
     // The equal-time panel: no clamp, the harshest, the best and a mild one, in the time of the unclamped
     // render at half as many samples again (`budget_spp`).
-    let panel_spp = crate::runner::budget_spp(spp);
-    let budget = Budget {
-        settings: RenderSettings { indirect_clamp: None, samples_per_pixel: panel_spp, ..base.clone() },
-        make: crate::runner::render,
-        estimate_ms: points[0].2.time.as_ref().expect("measured").median_ms * panel_spp as f64 / spp as f64,
-    };
+    let budget = Budget::from_sweep(base.clone(), crate::runner::render, &points[0].2);
     let best = series_best;
     let mut chosen: Vec<usize> = vec![0, 1, best, points.len() - 1];
     chosen.dedup();

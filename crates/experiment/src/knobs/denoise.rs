@@ -86,13 +86,8 @@ pub(super) fn run(
     let at = |series: &Series| series.points.iter().find(|p| p.x == budget_spp as f64).cloned();
     if let (Some(raw), Some(clean)) = (at(&report.series[0]), at(&report.series[1])) {
         steps.next("equal-time panel");
-        let panel_spp = crate::runner::budget_spp(budget_spp);
-        let settings = RenderSettings { samples_per_pixel: panel_spp, ..base.clone() };
-        let budget = Budget {
-            settings: settings.clone(),
-            make: render_denoised,
-            estimate_ms: clean.time.as_ref().expect("measured").median_ms * panel_spp as f64 / budget_spp as f64,
-        };
+        let settings = RenderSettings { samples_per_pixel: budget_spp, ..base.clone() };
+        let budget = Budget::from_sweep(settings.clone(), render_denoised, &clean);
         let candidates = [
             Candidate::render("mean of the samples", settings.clone(), ms_per_sample(&raw, budget_spp)),
             Candidate {

@@ -187,12 +187,7 @@ pub(super) fn run(
     // render at half as many samples again (`budget_spp`).
     steps.next("equal-time panel");
     let exact = &configurations[0];
-    let panel_spp = crate::runner::budget_spp(spp);
-    let budget = Budget {
-        settings: RenderSettings { samples_per_pixel: panel_spp, ..exact.settings.clone() },
-        make: exact.make,
-        estimate_ms: points[0].time.as_ref().expect("measured").median_ms * panel_spp as f64 / spp as f64,
-    };
+    let budget = Budget::from_sweep(exact.settings.clone(), exact.make, &points[0]);
     let chosen: Vec<&Point> = points[..half]
         .iter()
         .filter(|p| {

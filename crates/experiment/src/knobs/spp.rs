@@ -158,17 +158,12 @@ pub(super) fn run(
                 })
             };
             if let Some(stratified) = at_count(PixelSampler::Stratified) {
-                let panel_spp = crate::runner::budget_spp(stratified.x as u32);
-                let budget = Budget {
-                    settings: RenderSettings {
-                        sampler: PixelSampler::Stratified,
-                        samples_per_pixel: panel_spp,
-                        ..base.clone()
-                    },
-                    make: crate::runner::render,
-                    estimate_ms: stratified.time.as_ref().expect("measured").median_ms * panel_spp as f64
-                        / stratified.x,
+                let sweep = RenderSettings {
+                    sampler: PixelSampler::Stratified,
+                    samples_per_pixel: stratified.x as u32,
+                    ..base.clone()
                 };
+                let budget = Budget::from_sweep(sweep, crate::runner::render, stratified);
                 let candidates: Vec<Candidate> = SAMPLERS
                     .iter()
                     .filter_map(|&sampler| {
