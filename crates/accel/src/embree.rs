@@ -43,6 +43,21 @@ fn traceable(ray: &Ray) -> bool {
         && ray.direction.abs().max_element() <= EMBREE_LARGEST
 }
 
+/// The ray as Embree takes it, and how much Embree's distances fall short
+/// of ours. Embree requires `tnear ≥ 0` (its builds with assertions abort
+/// otherwise), so a range that starts behind the origin is given from a
+/// moved origin `origin + t_min·direction` over `[0, t_max − t_min]`, and
+/// Embree's distances are `t_min` short. The moved origin is rounded, so
+/// those answers are near ours rather than exact, as a peer's may be.
+fn embree_view(ray: &Ray) -> (Ray, f32) {
+    if ray.t_min < 0.0 {
+        let moved = ray.origin + ray.t_min * ray.direction;
+        (Ray::with_range(moved, ray.direction, 0.0, ray.t_max - ray.t_min), ray.t_min)
+    } else {
+        (*ray, 0.0)
+    }
+}
+
 /// The build quality of every scene: Embree's default, the one its own
 /// benchmarks of static scenes use.
 const BUILD_QUALITY: sys::RTCBuildQuality = sys::RTCBuildQuality::MEDIUM;
@@ -358,11 +373,12 @@ impl EmbreeBackend {
 
     /// The closest hit, with `filter` (or none) in the intersection context.
     fn closest(&self, ray: &Ray, filter: Option<&dyn Fn(u32, f32, f32) -> bool>) -> Option<Hit> {
-        if !traceable(ray) {
+        let (ray, shift) = embree_view(ray);
+        if !traceable(&ray) {
             return None;
         }
         let mut context = FilterContext::new(sys::RTCIntersectContextFlags::INCOHERENT, filter, &self.ids);
-        let mut ray_hit = sys::RTCRayHit { ray: embree_ray(ray), hit: no_hit() };
+        let mut ray_hit = sys::RTCRayHit { ray: embree_ray(&ray), hit: no_hit() };
         let context_pointer: *mut FilterContext = &mut context;
         // SAFETY: the scene is committed and only read; `context_pointer`
         // points to a live `FilterContext` whose first field is the
@@ -372,16 +388,17 @@ impl EmbreeBackend {
         unsafe { sys::rtcIntersect1(self.scene, context_pointer.cast(), &mut ray_hit) };
         context.rethrow();
         (ray_hit.hit.geomID != INVALID_ID)
-            .then(|| self.hit(ray_hit.ray.tfar, ray_hit.hit.primID, ray_hit.hit.u, ray_hit.hit.v))
+            .then(|| self.hit(ray_hit.ray.tfar + shift, ray_hit.hit.primID, ray_hit.hit.u, ray_hit.hit.v))
     }
 
     /// Whether anything is hit, with `filter` (or none) in the context.
     fn any(&self, ray: &Ray, filter: Option<&dyn Fn(u32, f32, f32) -> bool>) -> bool {
-        if !traceable(ray) {
+        let (ray, _) = embree_view(ray);
+        if !traceable(&ray) {
             return false;
         }
         let mut context = FilterContext::new(sys::RTCIntersectContextFlags::INCOHERENT, filter, &self.ids);
-        let mut embree_ray = embree_ray(ray);
+        let mut embree_ray = embree_ray(&ray);
         let context_pointer: *mut FilterContext = &mut context;
         // SAFETY: as in `closest`; Embree sets `tfar` to -∞ on a hit.
         unsafe { sys::rtcOccluded1(self.scene, context_pointer.cast(), &mut embree_ray) };
@@ -422,7 +439,7 @@ impl EmbreeBackend {
             for (lane, hit) in hits.iter_mut().enumerate() {
                 if valid.0[lane] != 0 && packet.hit.geomID[lane] != INVALID_ID {
                     *hit = Some(self.hit(
-                        packet.ray.tfar[lane],
+                        packet.ray.tfar[lane] + embree_view(&rays[lane]).1,
                         packet.hit.primID[lane],
                         packet.hit.u[lane],
                         packet.hit.v[lane],
@@ -572,7 +589,7 @@ impl ValidMask {
     fn of(rays: &[Ray]) -> Self {
         let mut mask = [0; PACKET];
         for (lane, ray) in mask.iter_mut().zip(rays) {
-            *lane = if traceable(ray) { -1 } else { 0 };
+            *lane = if traceable(&embree_view(ray).0) { -1 } else { 0 };
         }
         Self(mask)
     }
@@ -599,7 +616,7 @@ fn packet_rays(rays: &[Ray]) -> sys::RTCRay16 {
         id: [0; PACKET],
         flags: [0; PACKET],
     };
-    for (lane, ray) in rays.iter().enumerate().filter(|(_, r)| traceable(r)) {
+    for (lane, (ray, _)) in rays.iter().map(embree_view).enumerate().filter(|(_, (r, _))| traceable(r)) {
         packet.org_x[lane] = ray.origin.x;
         packet.org_y[lane] = ray.origin.y;
         packet.org_z[lane] = ray.origin.z;

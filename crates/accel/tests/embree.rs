@@ -356,3 +356,42 @@ fn builds_from_an_indexed_mesh_as_from_its_soup() {
         assert_eq!(from_mesh.occluded(&ray), from_soup.occluded(&ray), "{ray:?}");
     }
 }
+
+/// Embree requires `tnear ≥ 0`, and its builds with assertions abort on a
+/// ray whose range starts behind its origin. The backend gives it such a
+/// ray from the start of its range; the answers, distances included, are
+/// ours up to the rounding of the moved origin, singly and in batches.
+#[test]
+fn ranges_that_start_behind_the_origin_are_traced_from_their_start() {
+    let triangles = soup(2000, 1.5, 13);
+    let linear = LinearScan::new(&triangles, Default::default());
+    let embree = EmbreeBackend::new(&triangles).expect("Embree builds");
+    let mut rng = Rng::new(14, 3);
+    let rays: Vec<Ray> = random_rays(4000, 15)
+        .into_iter()
+        .map(|ray| Ray::with_range(ray.origin, ray.direction, -20.0 * rng.next_f32(), f32::INFINITY))
+        .collect();
+    let mut batch = vec![None; rays.len()];
+    embree.intersect_batch(&rays, &mut batch);
+    let (mut both, mut same_triangle, mut behind) = (0, 0, 0);
+    for (ray, batch) in rays.iter().zip(&batch) {
+        let (ours, theirs) = (linear.intersect(ray), embree.intersect(ray));
+        assert_eq!(theirs.map(|h| h.triangle), batch.map(|h| h.triangle), "single and batch for {ray:?}");
+        assert_eq!(embree.occluded(ray), theirs.is_some(), "any hit and closest hit disagree for {ray:?}");
+        match (ours, theirs) {
+            (Some(a), Some(b)) => {
+                both += 1;
+                behind += usize::from(a.t < 0.0);
+                same_triangle += usize::from(a.triangle == b.triangle);
+                let tolerance = 1e-4 * (a.t.abs() - ray.t_min + 1.0);
+                assert!((a.t - b.t).abs() <= tolerance, "{a:?} against {b:?} for {ray:?}");
+            }
+            (None, None) => {}
+            (Some(hit), None) | (None, Some(hit)) => {
+                assert!(grazing(&hit), "hit {hit:?} by one only, not at an edge, for {ray:?}")
+            }
+        }
+    }
+    assert!(behind > rays.len() / 10, "{behind} hits behind the origin of {both}");
+    assert!(same_triangle as f64 >= 0.999 * both as f64, "same triangle on {same_triangle} of {both} hits");
+}
