@@ -252,9 +252,18 @@ fn verify_checks_the_built_in_adversarial_scenes_and_writes_json() {
     let json = dir.join("verify.json");
     let run = rtgi(&["verify", "--rays", "20000", "--json", path_str(&json)]);
     assert!(run.success, "{}", run.stderr);
-    for kind in
-        ["random", "vertex", "edge", "axis-parallel", "secondary", "silhouette", "camera", "inside", "through-edge"]
-    {
+    for kind in [
+        "random",
+        "vertex",
+        "edge",
+        "axis-parallel",
+        "secondary",
+        "silhouette",
+        "camera",
+        "behind-origin",
+        "inside",
+        "through-edge",
+    ] {
         assert!(run.stdout.lines().any(|l| l.starts_with(kind)), "no row for {kind}:\n{}", run.stdout);
     }
     for structure in ["linear", "object-median", "spatial-median", "sah", "sah-sweep", "bvh4", "bvh8", "sbvh", "sbvh8"]

@@ -36,6 +36,14 @@ pub enum RayKind {
     /// the triangle's first corner. Sixteen consecutive rays form a tile,
     /// so that batch queries trace them as packets.
     Camera,
+    /// Random, vertex, edge and axis-parallel rays whose range starts
+    /// behind the origin, by up to twice the scene's size: boxes and
+    /// axis-aligned triangles on both sides of it. Their exits behind the
+    /// origin take the second exit inverse of the slab test
+    /// (`rtgi_math::exit_inverses`), and single-ray queries run them at
+    /// the portable level. (Last, so that the other kinds keep their
+    /// random streams.)
+    BehindOrigin,
 }
 
 impl RayKind {
@@ -48,6 +56,7 @@ impl RayKind {
         RayKind::Secondary,
         RayKind::Silhouette,
         RayKind::Camera,
+        RayKind::BehindOrigin,
     ];
 
     /// The kind's name in reports.
@@ -60,6 +69,7 @@ impl RayKind {
             RayKind::Secondary => "secondary",
             RayKind::Silhouette => "silhouette",
             RayKind::Camera => "camera",
+            RayKind::BehindOrigin => "behind-origin",
         }
     }
 
@@ -200,6 +210,13 @@ impl<'a> SceneFeatures<'a> {
                     Expect::Nothing
                 };
                 Some(ProbeRay { ray, expect })
+            }
+            RayKind::BehindOrigin => {
+                let kinds = [RayKind::Random, RayKind::Vertex, RayKind::Edge, RayKind::AxisParallel];
+                let mut probe = self.ray(kinds[rng.next_below(4) as usize], rng)?;
+                let reach = self.bounds.extent().max_element() / probe.ray.direction.length();
+                probe.ray.t_min = -2.0 * rng.next_f32() * reach;
+                Some(probe)
             }
             RayKind::Silhouette | RayKind::Camera => unreachable!("made by silhouette_rays and camera_rays"),
         }
