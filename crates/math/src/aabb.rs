@@ -124,8 +124,9 @@ impl Aabb {
     ///
     /// The near and far planes are chosen from the sign bit of `1 / d_c`, so
     /// -0 behaves as a negative direction, consistent with its reciprocal -∞.
-    /// The exit distance is moved later by the factor `1 + 2γ(3)` (divided by
-    /// it where it is negative, [`later_exit`]), which makes the test
+    /// The exit distance is computed with the inverse enlarged by
+    /// `1 + 2⁻²¹` (reduced by it where the exit lies behind the origin of a
+    /// range that starts there, [`later_exit`]), which makes the test
     /// conservative: rounding can never drop a box the ray touches (Ize,
     /// "Robust BVH Ray Traversal", JCGT 2013; pbrt-v4 `Bounds3::IntersectP`),
     /// behind the origin too.
@@ -139,7 +140,8 @@ impl Aabb {
             let near_plane = bounds[octant[axis]][axis];
             let far_plane = bounds[1 - octant[axis]][axis];
             let t_near = (near_plane - ray.origin[axis]) * ray.inv_direction[axis];
-            let t_far = later_exit((far_plane - ray.origin[axis]) * ray.inv_direction[axis], f32::max);
+            let (ahead, behind) = (ray.inv_exit.0[axis], ray.inv_exit.1[axis]);
+            let t_far = later_exit(far_plane - ray.origin[axis], ahead, behind, f32::max);
             // Written as comparisons so that a NaN distance leaves the interval alone.
             if t_near > t_enter {
                 t_enter = t_near;
@@ -205,7 +207,7 @@ mod tests {
     #[test]
     fn a_flat_box_behind_the_origin_is_hit_by_a_range_that_starts_behind_it() {
         // The box of an axis-aligned triangle at x = -1: entered and left at
-        // t = -1. Multiplying that exit by 1 + 2γ moved it before the entry.
+        // t = -1. Enlarging that exit's magnitude would move it before the entry.
         let wall = Aabb::new(Vec3::new(-1.0, -1.0, -1.0), Vec3::new(-1.0, 1.0, 1.0));
         let ray = Ray::with_range(Vec3::ZERO, Vec3::X, -10.0, 10.0).with_inverse();
         let (enter, exit) = wall.intersect(&ray).expect("the wall behind the origin is in the ray's range");

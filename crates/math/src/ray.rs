@@ -1,5 +1,7 @@
 use glam::Vec3;
 
+use crate::float::exit_inverses;
+
 /// A ray `origin + t * direction` for `t` in `[t_min, t_max]`.
 ///
 /// The direction need not be normalised; `t` is measured in multiples of it.
@@ -66,6 +68,9 @@ pub struct RayWithInverse {
     pub direction: Vec3,
     /// `1 / direction` per component, `±∞` for `±0`.
     pub inv_direction: Vec3,
+    /// The inverse for exit distances ahead of the origin, and for those
+    /// behind it, per component ([`crate::exit_inverses`]).
+    pub inv_exit: (Vec3, Vec3),
     /// Nearest distance counted as a hit.
     pub t_min: f32,
     /// Farthest distance counted as a hit.
@@ -76,10 +81,13 @@ impl RayWithInverse {
     #[inline]
     /// Precomputes the inverse direction of `ray`.
     pub fn new(ray: &Ray) -> Self {
+        let inv_direction = Vec3::ONE / ray.direction;
+        let [x, y, z] = inv_direction.to_array().map(|inv| exit_inverses(inv, ray.t_min));
         Self {
             origin: ray.origin,
             direction: ray.direction,
-            inv_direction: Vec3::ONE / ray.direction,
+            inv_direction,
+            inv_exit: (Vec3::new(x.0, y.0, z.0), Vec3::new(x.1, y.1, z.1)),
             t_min: ray.t_min,
             t_max: ray.t_max,
         }

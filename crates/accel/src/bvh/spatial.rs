@@ -28,9 +28,9 @@
 //!
 //! One step of this needs the piece on the entry side not to be left
 //! before it is entered: its exit at the plane must not fall below the
-//! entry, which lies before the plane. The robust test moves every exit
-//! later, negative ones too (`slab::later_exit`), so this holds for rays
-//! whose range starts behind their origin as well.
+//! entry, which lies before the plane. The robust test computes every
+//! exit late enough, negative ones too where the ray's range starts behind
+//! its origin (`slab::later_exit`), so this holds for those rays as well.
 //!
 //! The builder, like the others, sees only boxes.
 

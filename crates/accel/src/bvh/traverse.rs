@@ -26,7 +26,8 @@ pub(crate) const STACK_SIZE: usize = 128;
 pub enum Traversal {
     /// Conservative: never drops a box the ray touches.
     ///
-    /// Exit distances moved later by the factor `1 + 2γ(3)` (Ize 2013; negative ones divided by it),
+    /// Exit distances computed with the inverse direction enlarged by `1 + 2⁻²¹` (Ize 2013; reduced for
+    /// exits behind the origin of a range that starts there),
     /// near and far planes chosen by the direction's sign bit, and the NaN
     /// of `0 · ∞` (an origin on a slab plane along a zero direction
     /// component) ignored. Never drops a box the ray touches.

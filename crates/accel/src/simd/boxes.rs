@@ -117,7 +117,8 @@ pub(crate) fn enter_planes<const W: usize>(
 #[inline(always)]
 pub(crate) fn single_ray_distances(ray: &PlaneRay, axis: usize, near: Vec4, far: Vec4) -> (Vec4, Vec4) {
     let (origin, inv) = (Vec4::splat(ray.origin[axis]), Vec4::splat(ray.inv_direction[axis]));
-    ((near - origin) * inv, later_exit((far - origin) * inv, Vec4::max))
+    let (ahead, behind) = (Vec4::splat(ray.inv_exit[axis]), Vec4::splat(ray.inv_exit_behind[axis]));
+    ((near - origin) * inv, later_exit(far - origin, ahead, behind, Vec4::max))
 }
 
 /// `near ^ FAR_OF_NEAR[axis]` turns the index of an axis's min plane into
@@ -131,6 +132,13 @@ pub(crate) const FAR_OF_NEAR: [usize; 3] = [3, 1 ^ 4, 2 ^ 5];
 pub(crate) struct PlaneRay {
     pub(crate) origin: [f32; 3],
     pub(crate) inv_direction: [f32; 3],
+    /// The inverses for exit distances ahead of and behind the origin
+    /// ([`crate::slab::exit_inverses`]).
+    pub(crate) inv_exit: [f32; 3],
+    pub(crate) inv_exit_behind: [f32; 3],
+    /// Whether the range starts behind the origin: only then do the two
+    /// exit inverses differ, and an exit needs both products.
+    pub(crate) starts_behind: bool,
     pub(crate) near: [usize; 3],
     pub(crate) t_min: f32,
 }
@@ -142,6 +150,9 @@ impl PlaneRay {
         Self {
             origin: ray.origin.to_array(),
             inv_direction: ray.inv_direction.to_array(),
+            inv_exit: ray.inv_exit.to_array(),
+            inv_exit_behind: ray.inv_exit_behind.to_array(),
+            starts_behind: ray.starts_behind,
             near: [0, 1, 2].map(|axis| if negative[axis] { axis + 3 } else { axis }),
             t_min: ray.t_min,
         }

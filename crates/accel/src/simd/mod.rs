@@ -22,5 +22,5 @@ pub(crate) mod packet;
 pub(crate) mod packet_triangles;
 pub(crate) mod triangles;
 
-pub(crate) use dispatch::{Isa, Kernel, dispatch, prefetch};
+pub(crate) use dispatch::{Isa, Kernel, Portable, dispatch, prefetch};
 pub use dispatch::{SimdLevel, active_simd_level, limit_simd_level};

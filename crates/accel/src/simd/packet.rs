@@ -9,7 +9,7 @@ use rtgi_math::glam::BVec4A;
 use rtgi_math::{Mat4, Ray, Vec4};
 
 use super::boxes::{WideBoxes, enter_planes};
-use crate::slab::later_exit;
+use crate::slab::{EXIT_FOLD, later_exit};
 
 /// Rays in a packet.
 pub(crate) const PACKET: usize = 16;
@@ -21,6 +21,10 @@ pub(crate) const PACKET: usize = 16;
 pub(crate) struct PacketRays {
     pub(crate) origin: [Lanes; 3],
     pub(crate) inv_direction: [Lanes; 3],
+    /// The inverses for exit distances ahead of and behind each ray's
+    /// origin ([`crate::slab::exit_inverses`]).
+    pub(crate) inv_exit: [Lanes; 3],
+    pub(crate) inv_exit_behind: [Lanes; 3],
     pub(crate) t_min: Lanes,
     /// Index of each axis's near plane in a node's planes (see `WideBoxes`).
     pub(crate) near: [usize; 3],
@@ -95,6 +99,8 @@ impl PacketRays {
         let mut packet = PacketRays {
             origin: [Lanes([0.0; PACKET]); 3],
             inv_direction: [Lanes([0.0; PACKET]); 3],
+            inv_exit: [Lanes([0.0; PACKET]); 3],
+            inv_exit_behind: [Lanes([0.0; PACKET]); 3],
             t_min: Lanes([0.0; PACKET]),
             near: [0, 1, 2].map(|axis| if signs >> axis & 1 == 1 { axis + 3 } else { axis }),
         };
@@ -133,8 +139,13 @@ impl PacketRays {
             let lanes = chunk * 4..chunk * 4 + 4;
             for (axis, (o, d)) in [(ox, dx), (oy, dy), (oz, dz)].into_iter().enumerate() {
                 o.write_to_slice(&mut packet.origin[axis].0[lanes.clone()]);
-                // As `BoxRay` computes it, so that the box tests agree with the scalar one.
-                (Vec4::ONE / d).write_to_slice(&mut packet.inv_direction[axis].0[lanes.clone()]);
+                // As `BoxRay` computes them, so that the box tests agree with the scalar one.
+                let inv = Vec4::ONE / d;
+                let ahead = inv * EXIT_FOLD;
+                let behind = Vec4::select(t_min.cmpge(Vec4::ZERO), ahead, inv / EXIT_FOLD);
+                inv.write_to_slice(&mut packet.inv_direction[axis].0[lanes.clone()]);
+                ahead.write_to_slice(&mut packet.inv_exit[axis].0[lanes.clone()]);
+                behind.write_to_slice(&mut packet.inv_exit_behind[axis].0[lanes.clone()]);
             }
             t_min.write_to_slice(&mut packet.t_min.0[lanes]);
         }
@@ -158,8 +169,10 @@ impl PacketRays {
             for axis in 0..3 {
                 let origin = Vec4::from_slice(&self.origin[axis].0[lanes.clone()]);
                 let inv = Vec4::from_slice(&self.inv_direction[axis].0[lanes.clone()]);
+                let ahead = Vec4::from_slice(&self.inv_exit[axis].0[lanes.clone()]);
+                let behind = Vec4::from_slice(&self.inv_exit_behind[axis].0[lanes.clone()]);
                 let t_near = (Vec4::splat(near[axis]) - origin) * inv;
-                let t_far = later_exit((Vec4::splat(far[axis]) - origin) * inv, Vec4::max);
+                let t_far = later_exit(Vec4::splat(far[axis]) - origin, ahead, behind, Vec4::max);
                 // A NaN compares false and leaves the bound as it was.
                 enter = Vec4::select(t_near.cmpgt(enter), t_near, enter);
                 exit = Vec4::select(t_far.cmplt(exit), t_far, exit);
@@ -200,6 +213,12 @@ pub(crate) struct IntervalRay {
     inv_small: [f32; 3],
     /// Per axis, the inverse direction of greatest magnitude.
     inv_big: [f32; 3],
+    /// Per axis, the least and greatest magnitude of the rays' inverses
+    /// for exits ahead of their origins, and of those for exits behind.
+    exit_small: [f32; 3],
+    exit_big: [f32; 3],
+    exit_behind_small: [f32; 3],
+    exit_behind_big: [f32; 3],
     /// Per axis, 1 for a positive direction and -1 for a negative one.
     sign: [f32; 3],
     near: [usize; 3],
@@ -215,6 +234,10 @@ impl IntervalRay {
             origin_behind: [0.0; 3],
             inv_small: [0.0; 3],
             inv_big: [0.0; 3],
+            exit_small: [0.0; 3],
+            exit_big: [0.0; 3],
+            exit_behind_small: [0.0; 3],
+            exit_behind_big: [0.0; 3],
             sign: [1.0; 3],
             near: packet.near,
             t_min: packet.t_min.range().0,
@@ -222,14 +245,20 @@ impl IntervalRay {
         for axis in 0..3 {
             let (origin_min, origin_max) = packet.origin[axis].range();
             let (inv_min, inv_max) = packet.inv_direction[axis].range();
+            let (exit_min, exit_max) = packet.inv_exit[axis].range();
+            let (behind_min, behind_max) = packet.inv_exit_behind[axis].range();
             if packet.near[axis] == axis {
                 ray.origin_ahead[axis] = origin_max;
                 ray.origin_behind[axis] = origin_min;
                 (ray.inv_small[axis], ray.inv_big[axis]) = (inv_min, inv_max);
+                (ray.exit_small[axis], ray.exit_big[axis]) = (exit_min, exit_max);
+                (ray.exit_behind_small[axis], ray.exit_behind_big[axis]) = (behind_min, behind_max);
             } else {
                 ray.origin_ahead[axis] = origin_min;
                 ray.origin_behind[axis] = origin_max;
                 (ray.inv_small[axis], ray.inv_big[axis]) = (inv_max, inv_min);
+                (ray.exit_small[axis], ray.exit_big[axis]) = (exit_max, exit_min);
+                (ray.exit_behind_small[axis], ray.exit_behind_big[axis]) = (behind_max, behind_min);
                 ray.sign[axis] = -1.0;
             }
         }
@@ -274,8 +303,14 @@ impl IntervalRay {
         let to_near = near - Vec4::splat(self.origin_ahead[axis]);
         let to_far = far - Vec4::splat(self.origin_behind[axis]);
         let t_near = to_near * Vec4::select((to_near * sign).cmpgt(Vec4::ZERO), small, big);
-        let t_far = to_far * Vec4::select((to_far * sign).cmplt(Vec4::ZERO), small, big);
-        (t_near, later_exit(t_far, Vec4::max))
+        // Each ray's exit is the larger of two products, one with each of
+        // its exit inverses (`crate::slab::later_exit`); each product is
+        // bounded at its own corner, and so is their maximum.
+        let backwards = (to_far * sign).cmplt(Vec4::ZERO);
+        let pick = |small: f32, big: f32| Vec4::select(backwards, Vec4::splat(small), Vec4::splat(big));
+        let ahead = pick(self.exit_small[axis], self.exit_big[axis]);
+        let behind = pick(self.exit_behind_small[axis], self.exit_behind_big[axis]);
+        (t_near, later_exit(to_far, ahead, behind, Vec4::max))
     }
 }
 

@@ -38,6 +38,7 @@ use crate::simd::packet::{IntervalRay, Lanes, PACKET, PacketRays};
 use crate::simd::packet_triangles::WatertightPacket;
 use crate::simd::triangles::TriangleBlock;
 use crate::simd::{Isa, Kernel, dispatch};
+use crate::slab::BoxRay;
 use crate::triangle::{TriangleTest, with_triangle_test};
 use crate::{Hit, NoCounter};
 
@@ -328,8 +329,11 @@ impl<const W: usize, N: NodeLayout<W>, Q: QueryKind, T: TriangleTest, F: HitFilt
                 ),
                 None => {
                     for (lane, ray) in chunk.iter().enumerate() {
-                        let hit =
-                            bvh.traverse::<Q, NoCounter, T, F, I, 32>(isa, ray, &mut stack, &mut NoCounter, filter);
+                        let hit = if I::NODES_TAKE_RAYS_STARTING_BEHIND || !BoxRay::starts_behind(ray) {
+                            bvh.traverse::<Q, NoCounter, T, F, I, 32>(isa, ray, &mut stack, &mut NoCounter, filter)
+                        } else {
+                            bvh.traverse_portable::<Q, NoCounter, T, F>(ray, &mut NoCounter, filter)
+                        };
                         answer(offset + lane, hit);
                     }
                 }

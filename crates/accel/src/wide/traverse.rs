@@ -12,7 +12,7 @@ use super::{WideBvh, insert_far_to_near};
 use crate::contract::{Best, HitFilter, PreparedRay, QueryKind, lane_hit};
 use crate::simd::boxes::PlaneRay;
 use crate::simd::triangles::TriangleBlock;
-use crate::simd::{Isa, Kernel, dispatch, prefetch};
+use crate::simd::{Isa, Kernel, Portable, dispatch, prefetch};
 use crate::slab::BoxRay;
 use crate::triangle::{TriangleTest, with_triangle_test};
 use crate::{Counter, Hit};
@@ -95,6 +95,13 @@ impl<const W: usize, N: NodeLayout<W>> WideBvh<W, N> {
         counter: &mut C,
         filter: &F,
     ) -> Option<Hit> {
+        if BoxRay::starts_behind(ray) {
+            // Before dispatching, not in the traversal: a call there, even
+            // one never made, cost about 65 instructions a ray on the bunny
+            // (cachegrind), more than the folded exit saves.
+            return with_triangle_test!(self.intersector, |T| self
+                .traverse_portable::<Q, C, T, F>(ray, counter, filter));
+        }
         with_triangle_test!(self.intersector, |T| dispatch(SingleRay::<W, N, Q, C, T, F> {
             bvh: self,
             ray,
@@ -118,6 +125,10 @@ impl<const W: usize, N: NodeLayout<W>> WideBvh<W, N> {
             return None;
         }
         let box_ray = BoxRay::new(ray);
+        debug_assert!(
+            I::NODES_TAKE_RAYS_STARTING_BEHIND || !box_ray.starts_behind,
+            "the caller sends rays whose range starts behind the origin to `traverse_portable`"
+        );
         let plane_ray = PlaneRay::new(&box_ray);
         // The triangle test's preparation waits for the first leaf: most
         // camera rays of a framed object never reach one.
@@ -224,6 +235,24 @@ impl<const W: usize, N: NodeLayout<W>> WideBvh<W, N> {
                 }
             }
         }
+    }
+
+    /// [`WideBvh::traverse`] at the portable level, for a ray whose range
+    /// starts behind its origin when the active level's node kernels do
+    /// not take those ([`Isa::NODES_TAKE_RAYS_STARTING_BEHIND`]). Not
+    /// inlined: such rays are rare, and a second copy of the loop in every
+    /// level's traversal would only cost build time. It has a stack of its
+    /// own: lending it the caller's lets that stack's address escape, which
+    /// kept its length in memory and cost about 30 instructions a ray.
+    #[inline(never)]
+    pub(super) fn traverse_portable<Q: QueryKind, C: Counter, T: TriangleTest, F: HitFilter>(
+        &self,
+        ray: &Ray,
+        counter: &mut C,
+        filter: &F,
+    ) -> Option<Hit> {
+        let mut stack = TraversalStack::<INLINE_STACK>::new();
+        self.traverse::<Q, C, T, F, Portable, INLINE_STACK>(Portable, ray, &mut stack, counter, filter)
     }
 
     /// Pushes a stack entry, first asking for its child's memory.
