@@ -56,18 +56,35 @@ def test_python_runs_while_a_thread_is_inside_intersect():
 
 
 def test_two_threads_trace_at_once():
+    # A second thread calls `intersect` while the first is inside its call.
+    # Holding the GIL there, the first would keep the main thread from
+    # starting the second until it returned. The calls share rayon's
+    # workers, which finish the earlier call's work before the later one's
+    # (injected jobs come last), so their end times tell nothing: an earlier
+    # version of this test asserted that they end together, and failed four
+    # times in six here, before and after the change that exposed it.
     accel, rays = slow_query(scene(), 0.4)
     alone = []
+    expected = accel.intersect(*rays)
     traced(accel, rays, alone)
     single = alone[0][1] - alone[0][0]
-    intervals = []
-    threads = [threading.Thread(target=traced, args=(accel, rays, intervals)) for _ in range(2)]
-    for t in threads:
-        t.start()
-    for t in threads:
-        t.join()
+    intervals, answers = [], []
+
+    def traced_with_answer():
+        started = time.perf_counter()
+        answers.append(accel.intersect(*rays))
+        intervals.append((started, time.perf_counter()))
+
+    first = threading.Thread(target=traced_with_answer)
+    first.start()
+    time.sleep(0.1 * single)
+    second = threading.Thread(target=traced_with_answer)
+    second.start()
+    first.join()
+    second.join()
     (a0, a1), (b0, b1) = sorted(intervals)
-    # Together, the two calls share the worker threads and end together;
-    # one holding the GIL would keep the other out until it ended, a
-    # whole call's time earlier.
-    assert abs(a1 - b1) < 0.5 * single, f"the calls ended {abs(a1 - b1):.3f} s apart; one alone takes {single:.3f} s"
+    assert single > 0.1, "the call was too short to tell"
+    assert b0 < a1 - 0.5 * single, f"the second call began {b0 - a0:.3f} s after the first, which took {a1 - a0:.3f} s"
+    for hits in answers:
+        for got, want in zip(hits, expected):
+            assert np.array_equal(got, want)
