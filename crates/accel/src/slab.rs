@@ -12,7 +12,7 @@ use rtgi_math::{BVec3A, Ray, Vec3A};
 // The robust slab test's exit inverses and their use on either sign,
 // shared with `rtgi_math::Aabb::intersect`: one definition of the
 // rounding rule.
-pub(crate) use rtgi_math::{EXIT_FOLD, later_exit};
+pub(crate) use rtgi_math::{EXIT_FOLD, exit_inverses, later_exit};
 
 /// A ray prepared for box tests.
 #[derive(Clone, Copy, Debug)]
@@ -39,15 +39,13 @@ impl BoxRay {
     pub(crate) fn new(ray: &Ray) -> Self {
         let direction = Vec3A::from(ray.direction);
         let inv_direction = Vec3A::ONE / direction;
-        // `exit_inverses`, three lanes at once (the same operations).
-        let starts_behind = Self::starts_behind(ray);
-        let inv_exit = inv_direction * EXIT_FOLD;
+        let (inv_exit, inv_exit_behind) = exit_inverses(inv_direction, ray.t_min);
         Self {
             origin: ray.origin.into(),
             inv_direction,
             inv_exit,
-            inv_exit_behind: if starts_behind { inv_direction / EXIT_FOLD } else { inv_exit },
-            starts_behind,
+            inv_exit_behind,
+            starts_behind: Self::starts_behind(ray),
             negative: BVec3A::new(
                 direction.x.is_sign_negative(),
                 direction.y.is_sign_negative(),
@@ -63,7 +61,7 @@ impl BoxRay {
     /// NaN): only such a ray has two different exit inverses.
     #[inline(always)]
     pub(crate) fn starts_behind(ray: &Ray) -> bool {
-        ray.t_min < 0.0 || ray.t_min.is_nan()
+        rtgi_math::starts_behind(ray.t_min)
     }
 }
 
@@ -136,7 +134,7 @@ fn clip_nan_ignoring(near: Vec3A, far: Vec3A, lower: Vec3A, upper: Vec3A) -> (f3
 #[cfg(test)]
 mod tests {
     use super::*;
-    use rtgi_math::{Vec3, exit_inverses};
+    use rtgi_math::Vec3;
 
     fn enter(origin: Vec3, direction: Vec3, min: Vec3, max: Vec3) -> f32 {
         RobustSlabs::enter(&BoxRay::new(&Ray::new(origin, direction)), min.into(), max.into(), f32::INFINITY)

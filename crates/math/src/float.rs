@@ -40,11 +40,24 @@ pub const EXIT_FOLD: f32 = 1.0 + 1.0 / (1u32 << 21) as f32;
 /// behind the range `[t_min, …]` and is missed whatever its exit's
 /// magnitude. Only a range that starts behind the origin needs the second
 /// inverse, whose product keeps negative exits late.
-#[inline]
-pub fn exit_inverses(inv: f32, t_min: f32) -> (f32, f32) {
+///
+/// For one component (`f32`) or several at once (`Vec3`, `Vec3A`), with
+/// the same operations lane by lane.
+#[inline(always)]
+pub fn exit_inverses<T>(inv: T, t_min: f32) -> (T, T)
+where
+    T: Copy + std::ops::Mul<f32, Output = T> + std::ops::Div<f32, Output = T>,
+{
     let ahead = inv * EXIT_FOLD;
-    let behind = if t_min >= 0.0 { ahead } else { inv / EXIT_FOLD };
+    let behind = if starts_behind(t_min) { inv / EXIT_FOLD } else { ahead };
     (ahead, behind)
+}
+
+/// Whether a range starting at `t_min` starts behind the ray's origin
+/// (`t_min < 0`, or NaN): only then do the two [`exit_inverses`] differ.
+#[inline(always)]
+pub fn starts_behind(t_min: f32) -> bool {
+    t_min < 0.0 || t_min.is_nan()
 }
 
 /// A slab test's exit distance from the far plane's offset `to_far = p − o`

@@ -33,7 +33,7 @@ mod spawn;
 pub use aabb::Aabb;
 pub use choices::{NamedChoice, parse_choice, parse_vec3};
 pub use colour::luminance;
-pub use float::{EXIT_FOLD, exit_inverses, gamma, later_exit, next_float_down, next_float_up};
+pub use float::{EXIT_FOLD, exit_inverses, gamma, later_exit, next_float_down, next_float_up, starts_behind};
 pub use frame::{Frame, uniform_sphere};
 pub use glam;
 pub use glam::{BVec3A, Mat3, Mat4, Vec2, Vec3, Vec3A, Vec4, vec2, vec3};

@@ -82,12 +82,12 @@ impl RayWithInverse {
     /// Precomputes the inverse direction of `ray`.
     pub fn new(ray: &Ray) -> Self {
         let inv_direction = Vec3::ONE / ray.direction;
-        let [x, y, z] = inv_direction.to_array().map(|inv| exit_inverses(inv, ray.t_min));
+
         Self {
             origin: ray.origin,
             direction: ray.direction,
             inv_direction,
-            inv_exit: (Vec3::new(x.0, y.0, z.0), Vec3::new(x.1, y.1, z.1)),
+            inv_exit: exit_inverses(inv_direction, ray.t_min),
             t_min: ray.t_min,
             t_max: ray.t_max,
         }
