@@ -1,13 +1,18 @@
 //! Ctrl-C and SIGTERM during a render: the first asks the render to stop
-//! and write what it has; a second ends the process at once, touching no
-//! output (files are only ever renamed into place whole, so none is left half written).
+//! and write what it has. What a repeat means depends on who sends it:
 //!
-//! Signals that arrive within [`SAME_REQUEST`] of the first are that first
-//! request delivered again, not a second one: a scheduler signals every
-//! process of a job at once (Slurm's time limit, `scancel`), and the job's
-//! script forwards the signal to rtgi as well, so rtgi gets two within
-//! milliseconds. Taken as two, they would end the render without its
-//! checkpoint. A person's second Ctrl-C comes later than that.
+//! - A second SIGINT, later than [`SAME_REQUEST`] after the first, is a
+//!   person pressing Ctrl-C again: it ends the process at once, touching no
+//!   output (files are only ever renamed into place whole, so none is left
+//!   half written).
+//! - A repeated SIGTERM never cuts the stop short. Schedulers send SIGTERM
+//!   (Slurm's `--signal` and time limit, `scancel`, Kubernetes, systemd),
+//!   and each signals every process of a job at once while the job's script
+//!   forwards the signal too, so rtgi gets it twice. On a loaded node the
+//!   forwarded copy can come well after the first; taken as a second request
+//!   it ended the render without its checkpoint. A scheduler that means to
+//!   end a job now sends SIGKILL after its grace period.
+//! - Any signal within [`SAME_REQUEST`] of the first is that request again.
 
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::time::{Duration, Instant};
@@ -46,22 +51,51 @@ pub(crate) fn install() -> Result<CancelToken> {
     std::thread::Builder::new()
         .name("signals".into())
         .spawn(move || {
-            let mut first: Option<Instant> = None;
+            let mut first: Option<(i32, Instant)> = None;
             for signal in signals.forever() {
-                match first {
-                    None => {
-                        SIGNAL.store(signal as usize, Ordering::SeqCst);
-                        REQUESTED.store(true, Ordering::SeqCst);
-                        cancel.cancel(name(signal));
-                        first = Some(Instant::now());
+                let Some((first_signal, at)) = first else {
+                    SIGNAL.store(signal as usize, Ordering::SeqCst);
+                    REQUESTED.store(true, Ordering::SeqCst);
+                    cancel.cancel(name(signal));
+                    first = Some((signal, Instant::now()));
+                    continue;
+                };
+                match repeat(first_signal, signal, at.elapsed()) {
+                    Repeat::SameRequest => {}
+                    Repeat::StillStopping => eprintln!(
+                        "rtgi: {} while stopping: the stop goes on, saving what is done (SIGKILL ends at once)",
+                        name(signal)
+                    ),
+                    Repeat::EndNow => {
+                        eprintln!("rtgi: a second {}: ending at once, writing nothing more", name(signal));
+                        std::process::exit(exit_status(signal) as i32)
                     }
-                    Some(at) if at.elapsed() < SAME_REQUEST => {}
-                    Some(_) => std::process::exit(exit_status(signal) as i32),
                 }
             }
         })
         .context("cannot start the signal thread")?;
     Ok(token)
+}
+
+/// What a signal arriving `after` the first one means.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Repeat {
+    /// The first request delivered again (a job's processes all signalled at once).
+    SameRequest,
+    /// A later SIGTERM: the stop goes on; only SIGKILL cuts it short.
+    StillStopping,
+    /// A person's second Ctrl-C: end the process now.
+    EndNow,
+}
+
+fn repeat(first: i32, again: i32, after: Duration) -> Repeat {
+    if after < SAME_REQUEST && again == first {
+        Repeat::SameRequest
+    } else if again == SIGINT && after >= SAME_REQUEST {
+        Repeat::EndNow
+    } else {
+        Repeat::StillStopping
+    }
 }
 
 /// Whether a SIGINT or SIGTERM has arrived.
@@ -95,3 +129,34 @@ impl std::fmt::Display for StoppedBySignal {
 }
 
 impl std::error::Error for StoppedBySignal {}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const SOON: Duration = Duration::from_millis(5);
+    const LATE: Duration = Duration::from_millis(600);
+    const MUCH_LATER: Duration = Duration::from_secs(30);
+
+    #[test]
+    fn a_signal_repeated_at_once_is_the_same_request() {
+        assert_eq!(repeat(SIGTERM, SIGTERM, SOON), Repeat::SameRequest);
+        assert_eq!(repeat(SIGINT, SIGINT, SOON), Repeat::SameRequest);
+    }
+
+    #[test]
+    fn a_later_ctrl_c_ends_the_process() {
+        assert_eq!(repeat(SIGINT, SIGINT, LATE), Repeat::EndNow);
+        assert_eq!(repeat(SIGTERM, SIGINT, LATE), Repeat::EndNow);
+    }
+
+    #[test]
+    fn a_late_sigterm_never_cuts_the_stop_short() {
+        // A job script's forwarded copy, delayed on a loaded node.
+        assert_eq!(repeat(SIGTERM, SIGTERM, LATE), Repeat::StillStopping);
+        assert_eq!(repeat(SIGTERM, SIGTERM, MUCH_LATER), Repeat::StillStopping);
+        assert_eq!(repeat(SIGINT, SIGTERM, LATE), Repeat::StillStopping);
+        // A SIGTERM right after a Ctrl-C is not a Ctrl-C repeated.
+        assert_eq!(repeat(SIGINT, SIGTERM, SOON), Repeat::StillStopping);
+    }
+}

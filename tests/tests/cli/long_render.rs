@@ -134,6 +134,40 @@ fn the_same_signal_delivered_twice_at_once_still_saves_the_checkpoint() {
 }
 
 #[test]
+fn a_later_sigterm_does_not_cut_the_stop_short() {
+    // On a loaded node a job script's forwarded copy of the scheduler's SIGTERM can come
+    // long after the first; only SIGKILL may end the render without its checkpoint. Here
+    // the stop is often over before the second signal: the rule itself is unit-tested in
+    // apps/rtgi/src/interrupt.rs, and this checks the real process either way.
+    let dir = scratch_dir("sigterm-later");
+    let (image, checkpoint) = (dir.join("image.exr"), dir.join("render.accum"));
+    let args: Vec<&str> = [
+        "render",
+        "--width",
+        "256",
+        "--height",
+        "256",
+        "--spp",
+        "4096",
+        "-o",
+        path_str(&image),
+        "--checkpoint",
+        path_str(&checkpoint),
+    ]
+    .into();
+    let child = spawn(&args);
+    std::thread::sleep(Duration::from_millis(1500));
+    send("TERM", child.id());
+    std::thread::sleep(Duration::from_millis(300));
+    // Sent whether or not rtgi is still stopping; kill(1) fails only once it has exited.
+    let _ = Command::new("kill").args(["-TERM", &child.id().to_string()]).status();
+    let run: Run = child.wait_with_output().unwrap().into();
+    assert_eq!(run.code, Some(143), "{run:?}");
+    assert!(run.stdout.contains("stopped     by SIGTERM"), "{run:?}");
+    assert!(checkpoint.exists(), "no checkpoint after a second, later SIGTERM: {run:?}");
+}
+
+#[test]
 fn a_time_limit_stops_with_the_samples_done_and_says_how_many() {
     let dir = scratch_dir("time-limit");
     let (limited, range) = (dir.join("limited.accum"), dir.join("range.accum"));

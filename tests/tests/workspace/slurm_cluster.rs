@@ -120,7 +120,13 @@ fn a_split_render_on_a_real_slurm_survives_a_signal_a_cancel_and_a_time_limit() 
     let task = format!("{array}_0");
     cluster.wait("the time-limited task to stop", Duration::from_secs(120), |c| c.ended(&task));
     let log = std::fs::read_to_string(limited.join("logs/part-0.log")).unwrap();
-    assert!(log.contains("stopped     by SIGTERM"), "the signal did not reach rtgi:\n{log}");
+    let slurm_log = std::fs::read_to_string(limited.join(format!("logs/render-{task}.log"))).unwrap_or_default();
+    let (state, code) = (cluster.field(&task, "JobState"), cluster.field(&task, "ExitCode"));
+    assert!(
+        log.contains("stopped     by SIGTERM"),
+        "the signal did not reach rtgi, or did not let it save (JobState={state} ExitCode={code}):\n{log}\n\
+         Slurm's log of the task:\n{slurm_log}"
+    );
     assert!(limited.join("part-0.checkpoint.accum").exists(), "{log}");
     assert_ne!(cluster.field(&task, "JobState"), "TIMEOUT", "killed at the limit, not stopped before it");
     eprintln!("time limit: stopped ahead of it after {:?}", started.elapsed());
