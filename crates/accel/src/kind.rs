@@ -116,6 +116,12 @@ impl BuildParams {
     }
 }
 
+/// The SAH's traversal cost for a BVH of `width`-wide nodes, built as a
+/// binary tree and collapsed: `1 / log2(width)` ([`AccelKind::default_params`]).
+fn wide_traversal_cost(width: usize) -> f32 {
+    1.0 / (width as f32).log2()
+}
+
 impl Default for BuildParams {
     fn default() -> Self {
         Self {
@@ -189,16 +195,22 @@ impl AccelKind {
 
     /// The build parameters this variant is tuned for. The binary BVHs
     /// take [`BuildParams::default`]. The wide ones take leaves of up to 8
-    /// triangles (two blocks of four); their SAH prices a leaf by its
-    /// blocks, and a node's eight boxes cost about one block's test, so
-    /// their traversal cost stays 1. Priced by triangles with a traversal
-    /// cost of 4 (until 2026-11), the trees traced as fast but took a
-    /// tenth (bunny) to a sixth (conference room) more memory: leaves of
-    /// five were split four and one, and 23% of the conference room's
-    /// blocks held a single triangle.
+    /// triangles (two blocks of four), and their SAH prices a leaf by its
+    /// blocks. Their traversal cost is `1 / log2(width)`: a third for the
+    /// eight-wide BVHs, a half for the four-wide. The SAH prices the nodes
+    /// of the binary tree they are collapsed from, and one wide node takes
+    /// the place of about `log2(width)` levels of it, each of whose boxes
+    /// costs about one block's test.
+    ///
+    /// Priced by triangles with a traversal cost of 4 (until 2026-11), the
+    /// trees traced as fast but took a tenth (bunny) to a sixth
+    /// (conference room) more memory: leaves of five were split four and
+    /// one, and 23% of the conference room's blocks held a single triangle.
     pub fn default_params(self) -> BuildParams {
         match self.node_width() {
-            Some(width) if width > 2 => BuildParams { max_leaf_size: 8, ..BuildParams::default() },
+            Some(width) if width > 2 => {
+                BuildParams { max_leaf_size: 8, traversal_cost: wide_traversal_cost(width), ..BuildParams::default() }
+            }
             _ => BuildParams::default(),
         }
     }

@@ -216,7 +216,8 @@ pub struct Structure {
     pub sah_bins: u32,
     /// Axes the binned SAH build tries planes on.
     pub sah_axes: SahAxes,
-    /// Cost of a traversal step relative to a leaf test, for the SAH.
+    /// Cost of a traversal step relative to a leaf test, for the SAH;
+    /// `None` takes the structure's own ([`rtgi_accel::AccelKind::default_params`]).
     pub traversal_cost: Option<f32>,
     /// The ray/triangle test.
     pub intersector: Intersector,
