@@ -62,6 +62,12 @@ fi
 rows=()      # table rows, "|"-separated, in order
 run_lines=() # "ID ours: V V V against: V V V"
 
+# Two decimals, rounded in double precision as tests/tests/workspace/targets_doc.rs
+# rounds (bash's printf rounds in long double: 3.205 became 3.20, not 3.21).
+two_places() {
+    awk -v v="$1" 'BEGIN { printf "%.2f", v }'
+}
+
 median() { # of the numbers given as arguments
     printf '%s\n' "$@" | sort -g | awk '{ v[NR] = $1 } END { print v[int((NR + 1) / 2)] }'
 }
@@ -76,16 +82,16 @@ row() {
     if [[ ${#against[@]} -gt 0 ]]; then
         m_against="$(median "${against[@]}")"
         ratio="$(awk -v a="$m_ours" -v b="$m_against" 'BEGIN { printf "%.2f×", a / b }')"
-        against_cell="$(printf '%.2f' "$m_against") ($label)"
+        against_cell="$(two_places "$m_against") ($label)"
     fi
     case "$target" in
         ratio\>=*) value="${ratio%×}"; op=">="; bound="${target#ratio>=}"; goal="≥ ${bound}×" ;;
         ratio\<=*) value="${ratio%×}"; op="<="; bound="${target#ratio<=}"; goal="≤ ${bound}×" ;;
-        ours\>=*) value="$(printf '%.2f' "$m_ours")"; op=">="; bound="${target#ours>=}"; goal="≥ $bound" ;;
+        ours\>=*) value="$(two_places "$m_ours")"; op=">="; bound="${target#ours>=}"; goal="≥ $bound" ;;
         *) echo "targets: unknown target '$target'" >&2; exit 1 ;;
     esac
     met="$(awk -v v="$value" -v b="$bound" -v op="$op" 'BEGIN { ok = op == ">=" ? v >= b : v <= b; print ok ? "**met**" : "no" }')"
-    rows+=("| $id | $scene | $measure | $(printf '%.2f' "$m_ours") | $against_cell | $ratio | $goal | $met |")
+    rows+=("| $id | $scene | $measure | $(two_places "$m_ours") | $against_cell | $ratio | $goal | $met |")
     run_lines+=("$id ours: ${ours[*]} against: ${against[*]}")
 }
 
