@@ -7,7 +7,7 @@ use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
 use super::{RTGI, path_str, rtgi};
-use rtgi_tests::{Run, scratch_dir};
+use rtgi_tests::{Run, ScratchDir, scratch_dir};
 
 /// The built-in Cornell box, small, at many samples: a few seconds of work.
 const RENDER: &[&str] = &["render", "--width", "64", "--height", "48", "--spp", "192", "--seed", "11"];
@@ -103,31 +103,28 @@ fn a_second_interrupt_ends_the_render_at_once() {
     assert!(!run.stderr.contains("panicked"), "{run:?}");
 }
 
+/// A checkpointed render sent SIGTERM once it is under way and again `gap`
+/// later: what it printed, and its scratch folder (kept while the caller
+/// looks) with where its checkpoint should be.
+fn sigterm_twice(name: &str, gap: Duration) -> (Run, ScratchDir, PathBuf) {
+    let dir = scratch_dir(name);
+    let (image, checkpoint) = (dir.join("image.exr"), dir.join("render.accum"));
+    let mut args = vec!["render", "--width", "256", "--height", "256", "--spp", "4096"];
+    args.extend(["-o", path_str(&image), "--checkpoint", path_str(&checkpoint)]);
+    let child = spawn(&args);
+    std::thread::sleep(Duration::from_millis(1500));
+    send("TERM", child.id());
+    std::thread::sleep(gap);
+    // Until it is waited for, an exited child is still there to signal.
+    send("TERM", child.id());
+    (child.wait_with_output().unwrap().into(), dir, checkpoint)
+}
+
 #[test]
 fn the_same_signal_delivered_twice_at_once_still_saves_the_checkpoint() {
     // A scheduler signals every process of a job, and the job's script forwards the signal too:
     // rtgi gets it twice within milliseconds, and must take it as one request to stop and save.
-    let dir = scratch_dir("signal-twice");
-    let (image, checkpoint) = (dir.join("image.exr"), dir.join("render.accum"));
-    let args: Vec<&str> = [
-        "render",
-        "--width",
-        "256",
-        "--height",
-        "256",
-        "--spp",
-        "4096",
-        "-o",
-        path_str(&image),
-        "--checkpoint",
-        path_str(&checkpoint),
-    ]
-    .into();
-    let child = spawn(&args);
-    std::thread::sleep(Duration::from_millis(1500));
-    send("TERM", child.id());
-    send("TERM", child.id());
-    let run: Run = child.wait_with_output().unwrap().into();
+    let (run, _dir, checkpoint) = sigterm_twice("signal-twice", Duration::ZERO);
     assert_eq!(run.code, Some(143), "{run:?}");
     assert!(run.stdout.contains("stopped     by SIGTERM"), "{run:?}");
     assert!(checkpoint.exists(), "no checkpoint after a doubled SIGTERM: {run:?}");
@@ -139,29 +136,7 @@ fn a_later_sigterm_does_not_cut_the_stop_short() {
     // long after the first; only SIGKILL may end the render without its checkpoint. Here
     // the stop is often over before the second signal: the rule itself is unit-tested in
     // apps/rtgi/src/interrupt.rs, and this checks the real process either way.
-    let dir = scratch_dir("sigterm-later");
-    let (image, checkpoint) = (dir.join("image.exr"), dir.join("render.accum"));
-    let args: Vec<&str> = [
-        "render",
-        "--width",
-        "256",
-        "--height",
-        "256",
-        "--spp",
-        "4096",
-        "-o",
-        path_str(&image),
-        "--checkpoint",
-        path_str(&checkpoint),
-    ]
-    .into();
-    let child = spawn(&args);
-    std::thread::sleep(Duration::from_millis(1500));
-    send("TERM", child.id());
-    std::thread::sleep(Duration::from_millis(300));
-    // Sent whether or not rtgi is still stopping; kill(1) fails only once it has exited.
-    let _ = Command::new("kill").args(["-TERM", &child.id().to_string()]).status();
-    let run: Run = child.wait_with_output().unwrap().into();
+    let (run, _dir, checkpoint) = sigterm_twice("sigterm-later", Duration::from_millis(300));
     assert_eq!(run.code, Some(143), "{run:?}");
     assert!(run.stdout.contains("stopped     by SIGTERM"), "{run:?}");
     assert!(checkpoint.exists(), "no checkpoint after a second, later SIGTERM: {run:?}");
