@@ -344,6 +344,8 @@ pub struct EmissiveTriangle {
 
 impl EmissiveTriangle {
     /// The radiance leaving the point `(beta, gamma)` towards `towards` (unit).
+    // Always inlined: see `bent_towards_view`.
+    #[inline(always)]
     pub fn radiance(&self, scene: &Scene, beta: f32, gamma: f32, towards: Vec3) -> Vec3 {
         if !self.two_sided && self.normal.dot(towards) <= 0.0 {
             return Vec3::ZERO;

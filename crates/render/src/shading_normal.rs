@@ -23,6 +23,12 @@ use rtgi_math::Vec3;
 /// Unchanged where the mirror direction is above that bound: flat
 /// triangles, whose shading normal is the geometric one, keep their bits.
 /// The result faces the viewer (`wo · n > 0`).
+///
+/// Always inlined: called once per bounce, and called out of line its
+/// vectors went through memory (as `offset_ray_origin`'s did); inlined with
+/// `EmissiveTriangle::radiance`, a Cornell box render took 2.5% less time,
+/// with the same bits.
+#[inline(always)]
 pub(crate) fn bent_towards_view(shading: Vec3, geometric: Vec3, wo: Vec3) -> Vec3 {
     let cos_view = wo.dot(geometric);
     // The lowest the mirror direction may go: 0.01 above the surface, or
