@@ -332,7 +332,7 @@ pub(crate) struct BuildArgs {
     #[arg(long, value_enum, default_value_t = SahAxes::All)]
     pub(crate) sah_axes: SahAxes,
 
-    /// Cost of a BVH traversal step relative to a leaf test (a ray/triangle test; for the wide BVHs, a block of four triangles tested at once), for the SAH [default: 1; for the wide BVHs 1/log2(width): 1/2 for bvh4, 1/3 for the eight-wide]
+    /// Cost of a BVH traversal step relative to a leaf test (a ray/triangle test; for the wide BVHs, a block of four triangles tested at once), for the SAH [default: 1; for the wide BVHs 2/width: 1/2 for bvh4, 1/4 for the eight-wide]
     #[arg(long, value_parser = parse_positive, allow_negative_numbers = true)]
     pub(crate) traversal_cost: Option<f32>,
 

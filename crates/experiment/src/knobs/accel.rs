@@ -66,7 +66,7 @@ fn configurations(triangles: usize, quick: bool) -> Vec<(String, AccelKind, Buil
     }
     // The SAH's traversal cost against a leaf test: low costs make deep
     // trees of small leaves, high costs shallow trees of large ones.
-    // Each structure's own default is its base row (a third for bvh8), so
+    // Each structure's own default is its base row (a quarter for bvh8), so
     // 1 appears only for the structures whose default it is not.
     let costs: &[f32] = if quick { &[4.0] } else { &[0.25, 0.5, 1.0, 2.0, 4.0] };
     for kind in [AccelKind::Sah, AccelKind::Bvh8] {
