@@ -205,11 +205,11 @@ impl AccelKind {
     /// Counting levels gives `1 / log2(width)`, a third for eight-wide
     /// nodes, which was the default until 2026-11-29; a quarter was
     /// measured better (`rtgi trace`, 1 thread, the two alternating, 9
-    /// pairs): the Cornell box's surface rays took 0.887 (0.874-0.908) of the
+    /// pairs): the Cornell box's surface rays took 0.889 (0.845-0.902) of the
     /// time, a ray testing 4.1 triangles rather than 6.3 (`--stats`);
     /// the bunny's, the conference room's and Sponza's camera, random and
     /// surface rays, single and in packets, stayed within their spread
-    /// (medians 0.98 to 1.02), for 1% (bunny) to 7% (conference room) more
+    /// (medians 0.994 to 1.017), for 1% (bunny) to 7% (conference room) more
     /// memory. For four-wide nodes 3/8 changed no time, so a half stays.
     ///
     /// Priced by triangles with a traversal cost of 4 (until 2026-11), the
