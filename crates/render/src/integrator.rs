@@ -323,7 +323,7 @@ impl<'a, A: Accel + ?Sized> Transport<'a, A> {
             let mut u: [f32; dim::COUNT] = std::array::from_fn(|_| rng.next_f32());
             if depth < SAMPLED_VERTICES {
                 // The first vertices take the sampler's numbers, spread over the pixel's samples.
-                let first = start.sampler.vertex(&start.pixel, depth, rng);
+                let first = start.pattern.vertex(start.index, depth, rng);
                 [u[dim::LIGHT_CHOICE], u[dim::LOBE]] = first.choices.to_array();
                 [u[dim::LIGHT], u[dim::LIGHT + 1]] = first.light.to_array();
                 [u[dim::BSDF], u[dim::BSDF + 1]] = first.bsdf.to_array();

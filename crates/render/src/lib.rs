@@ -80,7 +80,7 @@ pub use identity::{Difference, RenderIdentity, scene_fingerprint};
 pub use integrator::{DirectStrategy, Integrator, ROULETTE_START};
 pub use lights::{Environment, EnvironmentMap, EnvironmentSpec, EnvironmentSpecError, LightSet};
 pub use regularisation::FilterGlossy;
-pub use sampler::{PixelSample, PixelSampler, VertexNumbers};
+pub use sampler::{PixelPattern, PixelSample, PixelSampler, VertexNumbers};
 pub use shade::{albedo, emission, shade_primary, shading_normal};
 
 use std::ops::Range;
@@ -497,11 +497,11 @@ fn render_transport<A: Accel + ?Sized>(
 /// Where a sample's path starts: its camera ray, the ray's closest hit if
 /// it was traced with others of its block (`None` if not), and which sample
 /// of its pixel it is, for the sampler's numbers of the first vertex.
-pub(crate) struct PathStart {
+pub(crate) struct PathStart<'a> {
     pub(crate) ray: Ray,
     pub(crate) first_hit: Option<Option<Hit>>,
-    pub(crate) pixel: PixelSample,
-    pub(crate) sampler: PixelSampler,
+    pub(crate) pattern: &'a PixelPattern,
+    pub(crate) index: u32,
 }
 
 /// Closest hits of a batch of camera rays ([`Accel::intersect_batch`]).
@@ -546,11 +546,11 @@ fn render_samples(
             return Some(0);
         }
         // One more generator per pixel, past every sample's: its shift of the pixel's pattern.
-        let shifts: Vec<Vec2> = pixels
+        let patterns: Vec<PixelPattern> = pixels
             .iter()
             .map(|&pixel| {
                 let mut shift = Rng::for_sample(settings.seed, pixel_index(pixel), u64::MAX);
-                Vec2::new(shift.next_f32(), shift.next_f32())
+                settings.sampler.pattern(spp, Vec2::new(shift.next_f32(), shift.next_f32()))
             })
             .collect();
         let mut traced = 0;
@@ -563,19 +563,17 @@ fn render_samples(
             }
             generators.clear();
             rays.clear();
-            for (&(x, y), &pixel_shift) in pixels.iter().zip(&shifts) {
+            for (&(x, y), pattern) in pixels.iter().zip(&patterns) {
                 let mut rng = Rng::for_sample(settings.seed, pixel_index((x, y)), index as u64);
-                let position = PixelSample { index, count: spp, pixel_shift };
-                rays.push(camera_rays.ray(x, y, settings.sampler.offset(&position, &mut rng)));
+                rays.push(camera_rays.ray(x, y, pattern.offset(index, &mut rng)));
                 generators.push(rng);
             }
             if let Some(first_hits) = first_hits {
                 first_hits(&rays, &mut hits);
             }
             for (i, (ray, rng)) in rays.iter().zip(&mut generators).enumerate() {
-                let pixel = PixelSample { index, count: spp, pixel_shift: shifts[i] };
                 let start =
-                    PathStart { ray: *ray, first_hit: first_hits.map(|_| hits[i]), pixel, sampler: settings.sampler };
+                    PathStart { ray: *ray, first_hit: first_hits.map(|_| hits[i]), pattern: &patterns[i], index };
                 let value = sample(&start, rng, &mut traced);
                 let slot = chosen.as_ref().map_or(i, |chosen| chosen[i]);
                 accumulation::add(&mut values[slot], &to_fixed(value));

@@ -97,27 +97,21 @@ impl PixelSampler {
     /// sample's generator where the sampler is random.
     #[inline]
     pub fn offset(self, sample: &PixelSample, rng: &mut Rng) -> Vec2 {
-        match self {
-            PixelSampler::Center => Vec2::splat(0.5),
-            PixelSampler::Uniform => Vec2::new(rng.next_f32(), rng.next_f32()),
-            PixelSampler::Stratified => {
-                let count = sample.count.max(1);
-                let index = remainder(sample.index, count);
-                let (columns, rows) = grid(count);
-                let (column, row) = (remainder(index, columns), quotient(index, columns));
-                // The pixel's two permutations: of the rows within a column
-                // (which x strip of its column a sample takes) and of the
-                // columns within a row (which y strip of its row).
-                let seed = pixel_seed(sample.pixel_shift);
-                let x_strip = column * rows + permute(row, rows, seed as u32);
-                let y_strip = row * columns + permute(column, columns, (seed >> 32) as u32);
-                Vec2::new(in_strip(x_strip, rng.next_f32(), count), in_strip(y_strip, rng.next_f32(), count))
-            }
-            PixelSampler::LowDiscrepancy => {
-                let shift = sample.pixel_shift.to_array().map(to_fixed);
-                r2_point(sample.index as u64, shift)
-            }
-            PixelSampler::Sobol => sobol_point(sample.index, pixel_seed(sample.pixel_shift)),
+        self.pattern(sample.count, sample.pixel_shift).offset(sample.index, rng)
+    }
+
+    /// What every sample of a pixel shares: the sampler's seeds for the
+    /// pixel, hashed from its shift once rather than for every sample.
+    pub fn pattern(self, count: u32, pixel_shift: Vec2) -> PixelPattern {
+        let count = count.max(1);
+        let pixel = pixel_seed(pixel_shift);
+        PixelPattern {
+            sampler: self,
+            count,
+            grid: grid(count),
+            pixel_shift,
+            pixel,
+            first_vertex: std::array::from_fn(|pair| PairSeeds::of(pixel, 1 + pair as u64)),
         }
     }
 }
@@ -148,42 +142,118 @@ impl PixelSampler {
     /// the sample's generator. Each number is uniform in `[0, 1)` for any
     /// sample count, so estimates stay unbiased.
     pub fn vertex(self, sample: &PixelSample, depth: u32, rng: &mut Rng) -> VertexNumbers {
-        let count = sample.count.max(1);
-        let index = remainder(sample.index, count);
-        let (columns, rows) = grid(count);
-        let pixel = pixel_seed(sample.pixel_shift);
-        let mut pair = |dimension: u64| {
-            // Two independent 64-bit seeds per pair: one for the permutation
-            // of the sample indices, one for the pattern's own choices.
-            let seed = hash_u64(pixel ^ dimension.wrapping_mul(0x9e37_79b9_7f4a_7c15));
-            let pattern = hash_u64(seed);
-            match self {
-                PixelSampler::Center | PixelSampler::Uniform => Vec2::new(rng.next_f32(), rng.next_f32()),
-                PixelSampler::Stratified => {
-                    // The index permutation decorrelates the pairs: it must
-                    // be a good one (an affine map would relate the pairs'
-                    // indices to each other, and their numbers with them).
-                    let j = permute(index, count, seed as u32);
-                    let (column, row) = (remainder(j, columns), quotient(j, columns));
-                    let x_strip = column * rows + shuffle(row, rows, pattern);
-                    // Its own hash: the two strip permutations must be
-                    // independent, or a sample can reach only some of the
-                    // sub-squares of its cell (half of them, when the y
-                    // permutation reused the x one's bits), which biased
-                    // small lights found by BSDF sampling by a third.
-                    let y_strip = row * columns + shuffle(column, columns, hash_u64(pattern));
-                    Vec2::new(in_strip(x_strip, rng.next_f32(), count), in_strip(y_strip, rng.next_f32(), count))
-                }
-                PixelSampler::LowDiscrepancy => {
-                    r2_point(permute(index, count, seed as u32) as u64, [pattern, pattern << 24])
-                }
-                // The index shuffle and scramble of its own seed decorrelate the pair.
-                PixelSampler::Sobol => sobol_point(index, seed),
+        self.pattern(sample.count, sample.pixel_shift).vertex(sample.index, depth, rng)
+    }
+}
+
+/// A pixel's seeds for its sampler ([`PixelSampler::pattern`]): sample `i`
+/// of the pixel is [`PixelPattern::offset`] and [`PixelPattern::vertex`]
+/// of `i`, the same numbers as [`PixelSampler::offset`] and
+/// [`PixelSampler::vertex`] give, without hashing the seeds again.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PixelPattern {
+    sampler: PixelSampler,
+    /// The pixel's samples in the whole render (at least 1).
+    count: u32,
+    /// The stratified sampler's columns and rows.
+    grid: (u32, u32),
+    pixel_shift: Vec2,
+    /// The hash of the shift, which seeds everything else.
+    pixel: u64,
+    /// The seeds of the first vertex's three pairs (the rest are hashed when asked for).
+    first_vertex: [PairSeeds; 3],
+}
+
+/// The seeds of one pair of numbers: two independent 64-bit seeds, one for
+/// the permutation of the sample indices, one for the pattern's own
+/// choices, and a third for the stratified sampler's y strips.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct PairSeeds {
+    seed: u64,
+    pattern: u64,
+    // Its own hash: the two strip permutations must be independent, or a
+    // sample can reach only some of the sub-squares of its cell (half of
+    // them, when the y permutation reused the x one's bits), which biased
+    // small lights found by BSDF sampling by a third.
+    y_pattern: u64,
+}
+
+impl PairSeeds {
+    /// Pair `dimension` of the pixel whose seed is `pixel` (0 is the position in the pixel).
+    fn of(pixel: u64, dimension: u64) -> Self {
+        let seed = hash_u64(pixel ^ dimension.wrapping_mul(0x9e37_79b9_7f4a_7c15));
+        let pattern = hash_u64(seed);
+        PairSeeds { seed, pattern, y_pattern: hash_u64(pattern) }
+    }
+}
+
+impl PixelPattern {
+    /// The position in `[0, 1)²` of sample `index` of the pixel, drawing
+    /// from that sample's generator where the sampler is random.
+    #[inline]
+    pub fn offset(&self, index: u32, rng: &mut Rng) -> Vec2 {
+        match self.sampler {
+            PixelSampler::Center => Vec2::splat(0.5),
+            PixelSampler::Uniform => Vec2::new(rng.next_f32(), rng.next_f32()),
+            PixelSampler::Stratified => {
+                let count = self.count;
+                let index = remainder(index, count);
+                let (columns, rows) = self.grid;
+                let (column, row) = (remainder(index, columns), quotient(index, columns));
+                // The pixel's two permutations: of the rows within a column
+                // (which x strip of its column a sample takes) and of the
+                // columns within a row (which y strip of its row).
+                let seed = self.pixel;
+                let x_strip = column * rows + permute(row, rows, seed as u32);
+                let y_strip = row * columns + permute(column, columns, (seed >> 32) as u32);
+                Vec2::new(in_strip(x_strip, rng.next_f32(), count), in_strip(y_strip, rng.next_f32(), count))
             }
+            PixelSampler::LowDiscrepancy => {
+                let shift = self.pixel_shift.to_array().map(to_fixed);
+                r2_point(index as u64, shift)
+            }
+            PixelSampler::Sobol => sobol_point(index, self.pixel),
+        }
+    }
+
+    /// The numbers of vertex `depth` of sample `index`'s path, as [`PixelSampler::vertex`] says.
+    #[inline]
+    pub fn vertex(&self, index: u32, depth: u32, rng: &mut Rng) -> VertexNumbers {
+        let index = remainder(index, self.count);
+        let seeds = |pair: u32| match self.first_vertex.get((3 * depth + pair) as usize) {
+            Some(seeds) => *seeds,
+            None => PairSeeds::of(self.pixel, 1 + 3 * depth as u64 + pair as u64),
         };
-        // Pair 0 is the position in the pixel.
-        let first = 1 + 3 * depth as u64;
-        VertexNumbers { choices: pair(first), light: pair(first + 1), bsdf: pair(first + 2) }
+        VertexNumbers {
+            choices: self.pair(index, seeds(0), rng),
+            light: self.pair(index, seeds(1), rng),
+            bsdf: self.pair(index, seeds(2), rng),
+        }
+    }
+
+    /// One pair of numbers of sample `index` (below the count).
+    #[inline]
+    fn pair(&self, index: u32, PairSeeds { seed, pattern, y_pattern }: PairSeeds, rng: &mut Rng) -> Vec2 {
+        let count = self.count;
+        match self.sampler {
+            PixelSampler::Center | PixelSampler::Uniform => Vec2::new(rng.next_f32(), rng.next_f32()),
+            PixelSampler::Stratified => {
+                let (columns, rows) = self.grid;
+                // The index permutation decorrelates the pairs: it must
+                // be a good one (an affine map would relate the pairs'
+                // indices to each other, and their numbers with them).
+                let j = permute(index, count, seed as u32);
+                let (column, row) = (remainder(j, columns), quotient(j, columns));
+                let x_strip = column * rows + shuffle(row, rows, pattern);
+                let y_strip = row * columns + shuffle(column, columns, y_pattern);
+                Vec2::new(in_strip(x_strip, rng.next_f32(), count), in_strip(y_strip, rng.next_f32(), count))
+            }
+            PixelSampler::LowDiscrepancy => {
+                r2_point(permute(index, count, seed as u32) as u64, [pattern, pattern << 24])
+            }
+            // The index shuffle and scramble of its own seed decorrelate the pair.
+            PixelSampler::Sobol => sobol_point(index, seed),
+        }
     }
 }
 
