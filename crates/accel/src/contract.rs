@@ -113,8 +113,14 @@ pub(crate) fn hit_triangle<T: TriangleTest>(
 #[inline(always)]
 pub(crate) fn box_rule(ray: &BoxRay, triangle: &[Vec3A; 3], hit: TriangleHit, t_max: f32) -> Option<TriangleHit> {
     let [a, b, c] = *triangle;
-    let enter = RobustSlabs::enter(ray, a.min(b).min(c), a.max(b).max(c), t_max);
-    // `enter` is +∞ when the box is missed; otherwise it lies in [t_min, t_max].
+    box_rule_at(hit, RobustSlabs::enter(ray, a.min(b).min(c), a.max(b).max(c), t_max))
+}
+
+/// [`box_rule`] for a ray that enters the triangle's box at `enter` (its
+/// [`RobustSlabs`] test: +∞ when the box is missed, otherwise a distance
+/// in `[t_min, t_max]`).
+#[inline(always)]
+pub(crate) fn box_rule_at(hit: TriangleHit, enter: f32) -> Option<TriangleHit> {
     (enter != f32::INFINITY).then_some(TriangleHit { t: hit.t.max(enter), ..hit })
 }
 

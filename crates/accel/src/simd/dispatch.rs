@@ -19,7 +19,7 @@
 use std::sync::atomic::{AtomicU8, Ordering};
 
 use super::boxes::{FAR_OF_NEAR, PlaneRay, WideBoxes};
-use super::packet::{Lanes, PACKET, PacketRays};
+use super::packet::{IntervalRay, Lanes, PACKET, PacketRays};
 use super::packet_triangles::{PacketHits, WatertightPacket};
 use crate::wide::QuantisedNode;
 
@@ -180,6 +180,10 @@ pub(crate) trait Isa: Copy {
     /// `W` quantised boxes of a node.
     fn enter_quantised<const W: usize>(self, node: &QuantisedNode<W>, ray: &PlaneRay, t_max: f32) -> (u32, [f32; W]);
 
+    /// [`IntervalRay::enter_boxes`]: which of `W` boxes some ray of a
+    /// packet may enter, tested once for the packet.
+    fn enter_interval<const W: usize>(self, boxes: &WideBoxes<W>, ray: &IntervalRay, t_max: f32) -> (u32, [f32; W]);
+
     /// [`PacketRays::enter_box`]: which rays of a packet enter one box.
     fn enter_box_packet(
         self,
@@ -189,6 +193,12 @@ pub(crate) trait Isa: Copy {
         t_max: &Lanes,
         active: u32,
     ) -> (u32, f32);
+
+    /// [`PacketRays::enter_box_lanes`]: where each ray of a packet enters
+    /// one box.
+    fn enter_box_lanes(self, near: [f32; 3], far: [f32; 3], rays: &PacketRays, t_max: &Lanes) -> Lanes {
+        rays.enter_box_lanes(near, far, t_max)
+    }
 
     /// Whether packets test each triangle against all their rays at once
     /// ([`Isa::watertight_packet`]) rather than ray by ray: only where one
@@ -235,6 +245,11 @@ impl Isa for Portable {
     #[inline(always)]
     fn enter_quantised<const W: usize>(self, node: &QuantisedNode<W>, ray: &PlaneRay, t_max: f32) -> (u32, [f32; W]) {
         node.enter_portable(ray, t_max)
+    }
+
+    #[inline(always)]
+    fn enter_interval<const W: usize>(self, boxes: &WideBoxes<W>, ray: &IntervalRay, t_max: f32) -> (u32, [f32; W]) {
+        ray.enter_boxes(boxes, t_max)
     }
 
     #[inline(always)]
@@ -296,6 +311,15 @@ impl Isa for Avx2 {
     }
 
     #[inline(always)]
+    fn enter_interval<const W: usize>(self, boxes: &WideBoxes<W>, ray: &IntervalRay, t_max: f32) -> (u32, [f32; W]) {
+        if !W.is_multiple_of(8) {
+            return ray.enter_boxes(boxes, t_max);
+        }
+        // SAFETY: as above, the CPU runs AVX2.
+        unsafe { enter_interval_avx2(boxes, ray, t_max) }
+    }
+
+    #[inline(always)]
     fn enter_box_packet(
         self,
         near: [f32; 3],
@@ -333,6 +357,13 @@ impl Isa for Avx512 {
         Avx2(()).enter_quantised(node, ray, t_max)
     }
 
+    /// As [`Avx512::enter_boxes`], the AVX2 kernel, with EVEX encodings
+    /// and sixteen more registers where this level compiles it.
+    #[inline(always)]
+    fn enter_interval<const W: usize>(self, boxes: &WideBoxes<W>, ray: &IntervalRay, t_max: f32) -> (u32, [f32; W]) {
+        Avx2(()).enter_interval(boxes, ray, t_max)
+    }
+
     #[inline(always)]
     fn enter_box_packet(
         self,
@@ -344,6 +375,12 @@ impl Isa for Avx512 {
     ) -> (u32, f32) {
         // SAFETY: an `Avx512` exists only where the CPU was seen to run AVX-512 F.
         unsafe { enter_box_packet_avx512(near, far, rays, t_max, active) }
+    }
+
+    #[inline(always)]
+    fn enter_box_lanes(self, near: [f32; 3], far: [f32; 3], rays: &PacketRays, t_max: &Lanes) -> Lanes {
+        // SAFETY: an `Avx512` exists only where the CPU was seen to run AVX-512 F.
+        unsafe { enter_box_lanes_avx512(near, far, rays, t_max) }
     }
 
     const PACKET_TRIANGLES: bool = true;
@@ -544,6 +581,59 @@ fn enter_planes_avx2<const W: usize>(
     (mask, distances)
 }
 
+/// [`IntervalRay::enter_boxes`] eight boxes at a time, in 256-bit
+/// registers: the same operations in the same order, lane by lane, except
+/// that the side of the origin a plane lies on is read from the sign bit
+/// of the difference flipped by the direction's sign, where the portable
+/// kernel multiplies by ±1 (an exact product: the comparisons agree, NaN
+/// and ±0 included).
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+#[inline]
+fn enter_interval_avx2<const W: usize>(boxes: &WideBoxes<W>, ray: &IntervalRay, t_max: f32) -> (u32, [f32; W]) {
+    use std::arch::x86_64::*;
+    let load = |plane: usize, chunk: usize| {
+        let lanes: &[f32; 8] = boxes.planes[plane][chunk * 8..chunk * 8 + 8].try_into().expect("eight lanes");
+        // SAFETY: as in `enter_boxes_avx2`: eight aligned `f32`s.
+        unsafe { _mm256_load_ps(lanes.as_ptr()) }
+    };
+    let zero = _mm256_setzero_ps();
+    let mut distances = [f32::INFINITY; W];
+    let mut mask = 0;
+    for chunk in 0..W / 8 {
+        let mut enter = _mm256_set1_ps(ray.t_min);
+        let mut exit = _mm256_set1_ps(t_max);
+        for (axis, flip) in FAR_OF_NEAR.into_iter().enumerate() {
+            let near = load(ray.near[axis], chunk);
+            let far = load(ray.near[axis] ^ flip, chunk);
+            // -0.0 for a negative direction, +0.0 for a positive one.
+            let sign = _mm256_set1_ps(if ray.sign[axis] < 0.0 { -0.0 } else { 0.0 });
+            let to_near = _mm256_sub_ps(near, _mm256_set1_ps(ray.origin_ahead[axis]));
+            let along = _mm256_cmp_ps::<_CMP_GT_OQ>(_mm256_xor_ps(to_near, sign), zero);
+            let inv = _mm256_blendv_ps(_mm256_set1_ps(ray.inv_big[axis]), _mm256_set1_ps(ray.inv_small[axis]), along);
+            let t_near = _mm256_mul_ps(to_near, inv);
+            let to_far = _mm256_sub_ps(far, _mm256_set1_ps(ray.origin_behind[axis]));
+            let backwards = _mm256_cmp_ps::<_CMP_LT_OQ>(_mm256_xor_ps(to_far, sign), zero);
+            let pick = |small: f32, big: f32| _mm256_blendv_ps(_mm256_set1_ps(big), _mm256_set1_ps(small), backwards);
+            let ahead = pick(ray.exit_small[axis], ray.exit_big[axis]);
+            let behind = pick(ray.exit_behind_small[axis], ray.exit_behind_big[axis]);
+            let t_far = later_exit_avx2(to_far, ahead, behind);
+            // `max(a, b)` is `a > b ? a : b`: a NaN in `a` leaves the bound.
+            enter = _mm256_max_ps(t_near, enter);
+            exit = _mm256_min_ps(t_far, exit);
+        }
+        let infinity = _mm256_set1_ps(f32::INFINITY);
+        let entered =
+            _mm256_and_ps(_mm256_cmp_ps::<_CMP_LE_OQ>(enter, exit), _mm256_cmp_ps::<_CMP_LT_OQ>(enter, infinity));
+        let out: &mut [f32; 8] = (&mut distances[chunk * 8..chunk * 8 + 8]).try_into().expect("eight lanes");
+        // SAFETY: `out` is a mutable reference to eight `f32`s, valid for an
+        // unaligned 32-byte store.
+        unsafe { _mm256_storeu_ps(out.as_mut_ptr(), _mm256_blendv_ps(infinity, enter, entered)) };
+        mask |= (_mm256_movemask_ps(entered) as u32) << (chunk * 8);
+    }
+    (mask, distances)
+}
+
 /// [`PacketRays::enter_box`] eight rays at a time, in 256-bit registers.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
@@ -584,11 +674,18 @@ fn enter_box_packet_avx2(near: [f32; 3], far: [f32; 3], rays: &PacketRays, t_max
     (mask & active, lanes.iter().fold(f32::INFINITY, |a, &b| a.min(b)))
 }
 
-/// [`PacketRays::enter_box`] on all sixteen rays in one 512-bit register.
+/// The robust slab test of one box for all sixteen rays of a packet in
+/// 512-bit registers, as [`PacketRays::enter_box`] computes it: the rays
+/// that enter the box, and where each enters (valid in those lanes).
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx512f")]
 #[inline]
-fn enter_box_packet_avx512(near: [f32; 3], far: [f32; 3], rays: &PacketRays, t_max: &Lanes, active: u32) -> (u32, f32) {
+fn box_packet_avx512(
+    near: [f32; 3],
+    far: [f32; 3],
+    rays: &PacketRays,
+    t_max: &Lanes,
+) -> (std::arch::x86_64::__mmask16, std::arch::x86_64::__m512) {
     use std::arch::x86_64::*;
     // SAFETY: each argument is a reference to sixteen `f32`s, valid for a
     // 64-byte load, and `Lanes` is 64-byte aligned.
@@ -608,9 +705,34 @@ fn enter_box_packet_avx512(near: [f32; 3], far: [f32; 3], rays: &PacketRays, t_m
     }
     let entered = _mm512_cmp_ps_mask::<_CMP_LE_OQ>(enter, exit)
         & _mm512_cmp_ps_mask::<_CMP_LT_OQ>(enter, _mm512_set1_ps(f32::INFINITY));
+    (entered, enter)
+}
+
+/// [`PacketRays::enter_box`] on all sixteen rays in one 512-bit register.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx512f")]
+#[inline]
+fn enter_box_packet_avx512(near: [f32; 3], far: [f32; 3], rays: &PacketRays, t_max: &Lanes, active: u32) -> (u32, f32) {
+    use std::arch::x86_64::*;
+    let (entered, enter) = box_packet_avx512(near, far, rays, t_max);
     // The masked reduction of no lanes gives f32::MAX; the portable kernel's +∞ is kept.
     let earliest = if entered == 0 { f32::INFINITY } else { _mm512_mask_reduce_min_ps(entered, enter) };
     (entered as u32 & active, earliest)
+}
+
+/// [`PacketRays::enter_box_lanes`] on all sixteen rays in one 512-bit register.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx512f")]
+#[inline]
+fn enter_box_lanes_avx512(near: [f32; 3], far: [f32; 3], rays: &PacketRays, t_max: &Lanes) -> Lanes {
+    use std::arch::x86_64::*;
+    let (entered, enter) = box_packet_avx512(near, far, rays, t_max);
+    let mut entries = Lanes([0.0; PACKET]);
+    // SAFETY: `entries` is sixteen `f32`s, 64-byte aligned, valid for a 64-byte store.
+    unsafe {
+        _mm512_store_ps(entries.0.as_mut_ptr(), _mm512_mask_blend_ps(entered, _mm512_set1_ps(f32::INFINITY), enter))
+    };
+    entries
 }
 
 #[cfg(test)]
@@ -628,12 +750,14 @@ mod tests {
         t_max: f32,
         packet_t_max: &'a Lanes,
         quantised: &'a QuantisedNode<8>,
+        interval: &'a IntervalRay,
     }
 
     type Entered = (u32, [f32; 8]);
 
     impl Kernel for Compare<'_> {
-        type Output = ((Entered, Entered), (Entered, Entered), Vec<((u32, f32), (u32, f32))>);
+        type Output =
+            ((Entered, Entered), (Entered, Entered), (Entered, Entered), Vec<((u32, f32), (u32, f32), Lanes, Lanes)>);
 
         #[inline(always)]
         fn run<I: Isa>(self, isa: I) -> Self::Output {
@@ -645,6 +769,10 @@ mod tests {
                 isa.enter_quantised(self.quantised, self.ray, self.t_max),
                 Portable.enter_quantised(self.quantised, self.ray, self.t_max),
             );
+            let interval = (
+                isa.enter_interval(self.boxes, self.interval, self.t_max),
+                Portable.enter_interval(self.boxes, self.interval, self.t_max),
+            );
             let packets = (0..8)
                 .map(|lane| {
                     let planes = &self.boxes.planes;
@@ -653,15 +781,17 @@ mod tests {
                     (
                         isa.enter_box_packet(near, far, self.packet, self.packet_t_max, 0xffff),
                         Portable.enter_box_packet(near, far, self.packet, self.packet_t_max, 0xffff),
+                        isa.enter_box_lanes(near, far, self.packet, self.packet_t_max),
+                        Portable.enter_box_lanes(near, far, self.packet, self.packet_t_max),
                     )
                 })
                 .collect();
-            (node, quantised, packets)
+            (node, quantised, interval, packets)
         }
     }
 
     /// The intrinsic kernels of every level the CPU has compute the bits
-    /// of the portable ones, on boxes and rays with zeros, ±0 direction
+    /// of the portable ones (the interval ray's included), on boxes and rays with zeros, ±0 direction
     /// components, origins on box planes and NaN-producing `0 · ∞`.
     #[test]
     fn every_level_computes_the_portable_kernels_bits() {
@@ -689,6 +819,16 @@ mod tests {
             let rays: Vec<Ray> =
                 (0..PACKET).map(|_| Ray::new(Vec3::from([0; 3].map(|_| coordinate(&mut rng))), direction)).collect();
             let packet = PacketRays::new(&rays).expect("equal directions are coherent");
+            // The interval ray of rays whose directions differ a little
+            // (same signs, zeros kept), so that its inverses span a range.
+            let spread: Vec<Ray> = rays
+                .iter()
+                .map(|ray| {
+                    let scale = Vec3::from([0; 3].map(|_| 1.0 + rng.next_f32() * 0.02));
+                    Ray::new(ray.origin, ray.direction * scale)
+                })
+                .collect();
+            let interval = IntervalRay::new(&PacketRays::new(&spread).expect("directions 1° apart are coherent"));
             let ray = PlaneRay::new(&BoxRay::new(&rays[0]));
             let t_max = if rng.next_u32().is_multiple_of(2) { f32::INFINITY } else { rng.next_f32() * 4.0 };
             let packet_t_max = Lanes(std::array::from_fn(|_| rng.next_f32() * 8.0));
@@ -701,15 +841,17 @@ mod tests {
                     t_max,
                     packet_t_max: &packet_t_max,
                     quantised: &quantised,
+                    interval: &interval,
                 };
-                let (node, node_quantised, packets) = dispatch(compare);
-                for (ours, portable) in [node, node_quantised] {
+                let (node, node_quantised, node_interval, packets) = dispatch(compare);
+                for (ours, portable) in [node, node_quantised, node_interval] {
                     assert_eq!(ours.0, portable.0, "{level}");
                     assert_eq!(ours.1.map(f32::to_bits), portable.1.map(f32::to_bits), "{level}");
                 }
-                for (ours, portable) in packets {
+                for (ours, portable, ours_lanes, portable_lanes) in packets {
                     assert_eq!(ours.0, portable.0, "{level}");
                     assert_eq!(ours.1.to_bits(), portable.1.to_bits(), "{level}");
+                    assert_eq!(ours_lanes.0.map(f32::to_bits), portable_lanes.0.map(f32::to_bits), "{level}");
                 }
             }
         }

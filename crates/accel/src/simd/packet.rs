@@ -185,6 +185,36 @@ impl PacketRays {
     }
 }
 
+impl PacketRays {
+    /// Where each ray enters the box whose near planes (for the packet's
+    /// direction signs) are `near` and far planes `far`, within its
+    /// `[t_min, t_max]`, or +∞ for a ray that misses it: lane by lane the
+    /// bits of [`crate::slab::RobustSlabs`]'s test of that ray (the
+    /// arithmetic of [`PacketRays::enter_box`], each lane kept).
+    #[inline(always)]
+    pub(crate) fn enter_box_lanes(&self, near: [f32; 3], far: [f32; 3], t_max: &Lanes) -> Lanes {
+        let mut entries = Lanes([f32::INFINITY; PACKET]);
+        for chunk in 0..PACKET / 4 {
+            let lanes = chunk * 4..chunk * 4 + 4;
+            let mut enter = Vec4::from_slice(&self.t_min.0[lanes.clone()]);
+            let mut exit = Vec4::from_slice(&t_max.0[lanes.clone()]);
+            for axis in 0..3 {
+                let origin = Vec4::from_slice(&self.origin[axis].0[lanes.clone()]);
+                let inv = Vec4::from_slice(&self.inv_direction[axis].0[lanes.clone()]);
+                let ahead = Vec4::from_slice(&self.inv_exit[axis].0[lanes.clone()]);
+                let behind = Vec4::from_slice(&self.inv_exit_behind[axis].0[lanes.clone()]);
+                let t_near = (Vec4::splat(near[axis]) - origin) * inv;
+                let t_far = later_exit(Vec4::splat(far[axis]) - origin, ahead, behind, Vec4::max);
+                enter = Vec4::select(t_near.cmpgt(enter), t_near, enter);
+                exit = Vec4::select(t_far.cmplt(exit), t_far, exit);
+            }
+            let entered = enter.cmple(exit) & enter.cmplt(Vec4::INFINITY);
+            Vec4::select(entered, enter, Vec4::INFINITY).write_to_slice(&mut entries.0[lanes]);
+        }
+        entries
+    }
+}
+
 /// The rays of a packet as one ray with interval coordinates: for each
 /// axis, the range of the origins and of the inverse directions. Its box
 /// test bounds every ray's: the distance at which it enters a box is no
@@ -206,24 +236,24 @@ impl PacketRays {
 pub(crate) struct IntervalRay {
     /// Per axis, the origin coordinate furthest along the direction: the
     /// one whose near plane distance is least.
-    origin_ahead: [f32; 3],
+    pub(super) origin_ahead: [f32; 3],
     /// Per axis, the origin coordinate least far along the direction.
-    origin_behind: [f32; 3],
+    pub(super) origin_behind: [f32; 3],
     /// Per axis, the inverse direction of least magnitude.
-    inv_small: [f32; 3],
+    pub(super) inv_small: [f32; 3],
     /// Per axis, the inverse direction of greatest magnitude.
-    inv_big: [f32; 3],
+    pub(super) inv_big: [f32; 3],
     /// Per axis, the least and greatest magnitude of the rays' inverses
     /// for exits ahead of their origins, and of those for exits behind.
-    exit_small: [f32; 3],
-    exit_big: [f32; 3],
-    exit_behind_small: [f32; 3],
-    exit_behind_big: [f32; 3],
+    pub(super) exit_small: [f32; 3],
+    pub(super) exit_big: [f32; 3],
+    pub(super) exit_behind_small: [f32; 3],
+    pub(super) exit_behind_big: [f32; 3],
     /// Per axis, 1 for a positive direction and -1 for a negative one.
-    sign: [f32; 3],
-    near: [usize; 3],
+    pub(super) sign: [f32; 3],
+    pub(super) near: [usize; 3],
     /// The least `t_min` of the rays.
-    t_min: f32,
+    pub(super) t_min: f32,
 }
 
 impl IntervalRay {

@@ -42,8 +42,8 @@ pub(crate) trait NodeLayout<const W: usize>: Copy + std::fmt::Debug + Send + Syn
     /// child, and the mask of the children it enters.
     fn enter<I: Isa>(&self, isa: I, ray: &PlaneRay, t_max: f32) -> (u32, [f32; W]);
 
-    /// [`IntervalRay::enter_boxes`] on the node's boxes.
-    fn enter_interval(&self, ray: &IntervalRay, t_max: f32) -> (u32, [f32; W]);
+    /// [`Isa::enter_interval`] on the node's boxes.
+    fn enter_interval<I: Isa>(&self, isa: I, ray: &IntervalRay, t_max: f32) -> (u32, [f32; W]);
 
     /// The box of the child in `lane`, as its minimum and maximum.
     fn child_box(&self, lane: usize) -> ([f32; 3], [f32; 3]);
@@ -67,8 +67,8 @@ impl<const W: usize> NodeLayout<W> for WideNode<W> {
     }
 
     #[inline(always)]
-    fn enter_interval(&self, ray: &IntervalRay, t_max: f32) -> (u32, [f32; W]) {
-        ray.enter_boxes(&self.boxes, t_max)
+    fn enter_interval<I: Isa>(&self, isa: I, ray: &IntervalRay, t_max: f32) -> (u32, [f32; W]) {
+        isa.enter_interval(&self.boxes, ray, t_max)
     }
 
     #[inline(always)]

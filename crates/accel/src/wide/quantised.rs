@@ -225,7 +225,7 @@ impl<const W: usize> NodeLayout<W> for QuantisedNode<W> {
     }
 
     #[inline(always)]
-    fn enter_interval(&self, ray: &IntervalRay, t_max: f32) -> (u32, [f32; W]) {
+    fn enter_interval<I: Isa>(&self, _isa: I, ray: &IntervalRay, t_max: f32) -> (u32, [f32; W]) {
         let (entered, enter) = ray.enter_planes(|k, first| self.four_planes(k, first), t_max);
         (entered & self.occupied, enter)
     }
