@@ -1,9 +1,10 @@
 //! Ray/triangle intersection tests.
 
-use rtgi_math::{Ray, Vec3A};
+use rtgi_math::Vec3A;
 
 use crate::exact;
 use crate::simd::arith;
+use crate::simd::packet::PacketRays;
 use crate::simd::packet_triangles::WatertightPacket;
 use crate::simd::triangles::{self, BlockHits, TriangleBlock};
 use crate::triangle_hit::TriangleHit;
@@ -88,12 +89,12 @@ pub(crate) trait TriangleTest {
     /// `intersect` itself (the watertight test's double-precision cases).
     fn intersect_block(ray: &Self::Ray, t_min: f32, t_max: f32, block: &TriangleBlock) -> BlockHits;
 
-    /// The rays of a packet (1 to 16 valid rays) prepared to be tested
-    /// against one triangle at a time ([`crate::simd::packet_triangles`]),
-    /// or `None` where the test has no such kernel or these rays cannot
-    /// share one: they are then tested ray by ray.
+    /// The rays of a packet prepared to be tested against one triangle at
+    /// a time ([`crate::simd::packet_triangles`]), or `None` where the test
+    /// has no such kernel or these rays cannot share one: they are then
+    /// tested ray by ray.
     #[inline(always)]
-    fn packet(_rays: &[Ray]) -> Option<WatertightPacket> {
+    fn packet(_rays: &PacketRays) -> Option<WatertightPacket> {
         None
     }
 }
@@ -229,8 +230,8 @@ impl TriangleTest for Watertight {
 
     /// Packets whose rays share the permutation of axes.
     #[inline(always)]
-    fn packet(rays: &[Ray]) -> Option<WatertightPacket> {
-        WatertightPacket::new(rays)
+    fn packet(rays: &PacketRays) -> Option<WatertightPacket> {
+        WatertightPacket::of_packet(rays)
     }
 }
 

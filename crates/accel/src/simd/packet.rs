@@ -20,6 +20,9 @@ pub(crate) const PACKET: usize = 16;
 #[repr(C, align(64))]
 pub(crate) struct PacketRays {
     pub(crate) origin: [Lanes; 3],
+    /// The directions, for the packet triangle test's shears
+    /// ([`crate::simd::packet_triangles::WatertightPacket::of_packet`]).
+    pub(crate) direction: [Lanes; 3],
     pub(crate) inv_direction: [Lanes; 3],
     /// The inverses for exit distances ahead of and behind each ray's
     /// origin ([`crate::slab::exit_inverses`]).
@@ -38,7 +41,7 @@ pub(crate) struct Lanes(pub(crate) [f32; PACKET]);
 impl Lanes {
     /// Lanes `4 chunk .. 4 chunk + 4`.
     #[inline(always)]
-    fn chunk(&self, chunk: usize) -> Vec4 {
+    pub(crate) fn chunk(&self, chunk: usize) -> Vec4 {
         Vec4::from_slice(&self.0[chunk * 4..chunk * 4 + 4])
     }
 
@@ -98,6 +101,7 @@ impl PacketRays {
         let signs = first.direction.is_negative_bitmask();
         let mut packet = PacketRays {
             origin: [Lanes([0.0; PACKET]); 3],
+            direction: [Lanes([0.0; PACKET]); 3],
             inv_direction: [Lanes([0.0; PACKET]); 3],
             inv_exit: [Lanes([0.0; PACKET]); 3],
             inv_exit_behind: [Lanes([0.0; PACKET]); 3],
@@ -139,6 +143,7 @@ impl PacketRays {
             let lanes = chunk * 4..chunk * 4 + 4;
             for (axis, (o, d)) in [(ox, dx), (oy, dy), (oz, dz)].into_iter().enumerate() {
                 o.write_to_slice(&mut packet.origin[axis].0[lanes.clone()]);
+                d.write_to_slice(&mut packet.direction[axis].0[lanes.clone()]);
                 // As `BoxRay` computes them, so that the box tests agree with the scalar one.
                 let inv = Vec4::ONE / d;
                 let ahead = inv * EXIT_FOLD;
