@@ -569,16 +569,26 @@ fn enter_planes_avx2<const W: usize>(
             enter = _mm256_max_ps(t_near, enter);
             exit = _mm256_min_ps(t_far, exit);
         }
-        let infinity = _mm256_set1_ps(f32::INFINITY);
-        let entered =
-            _mm256_and_ps(_mm256_cmp_ps::<_CMP_LE_OQ>(enter, exit), _mm256_cmp_ps::<_CMP_LT_OQ>(enter, infinity));
         let out: &mut [f32; 8] = (&mut distances[chunk * 8..chunk * 8 + 8]).try_into().expect("eight lanes");
-        // SAFETY: `out` is a mutable reference to eight `f32`s, valid for an
-        // unaligned 32-byte store.
-        unsafe { _mm256_storeu_ps(out.as_mut_ptr(), _mm256_blendv_ps(infinity, enter, entered)) };
-        mask |= (_mm256_movemask_ps(entered) as u32) << (chunk * 8);
+        mask |= store_entries_avx2(enter, exit, out) << (chunk * 8);
     }
     (mask, distances)
+}
+
+/// The end of the slab test on eight boxes: writes each box's entry
+/// distance `enter`, or +∞ where the box is missed (`enter > exit`, or
+/// `enter` is +∞), to `out`, and returns the mask of the boxes entered.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+#[inline]
+fn store_entries_avx2(enter: std::arch::x86_64::__m256, exit: std::arch::x86_64::__m256, out: &mut [f32; 8]) -> u32 {
+    use std::arch::x86_64::*;
+    let infinity = _mm256_set1_ps(f32::INFINITY);
+    let entered = _mm256_and_ps(_mm256_cmp_ps::<_CMP_LE_OQ>(enter, exit), _mm256_cmp_ps::<_CMP_LT_OQ>(enter, infinity));
+    // SAFETY: `out` is a mutable reference to eight `f32`s, valid for an
+    // unaligned 32-byte store.
+    unsafe { _mm256_storeu_ps(out.as_mut_ptr(), _mm256_blendv_ps(infinity, enter, entered)) };
+    _mm256_movemask_ps(entered) as u32
 }
 
 /// [`IntervalRay::enter_boxes`] eight boxes at a time, in 256-bit
@@ -622,14 +632,8 @@ fn enter_interval_avx2<const W: usize>(boxes: &WideBoxes<W>, ray: &IntervalRay, 
             enter = _mm256_max_ps(t_near, enter);
             exit = _mm256_min_ps(t_far, exit);
         }
-        let infinity = _mm256_set1_ps(f32::INFINITY);
-        let entered =
-            _mm256_and_ps(_mm256_cmp_ps::<_CMP_LE_OQ>(enter, exit), _mm256_cmp_ps::<_CMP_LT_OQ>(enter, infinity));
         let out: &mut [f32; 8] = (&mut distances[chunk * 8..chunk * 8 + 8]).try_into().expect("eight lanes");
-        // SAFETY: `out` is a mutable reference to eight `f32`s, valid for an
-        // unaligned 32-byte store.
-        unsafe { _mm256_storeu_ps(out.as_mut_ptr(), _mm256_blendv_ps(infinity, enter, entered)) };
-        mask |= (_mm256_movemask_ps(entered) as u32) << (chunk * 8);
+        mask |= store_entries_avx2(enter, exit, out) << (chunk * 8);
     }
     (mask, distances)
 }

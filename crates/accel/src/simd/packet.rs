@@ -165,26 +165,14 @@ impl PacketRays {
     /// entry among them. The robust slab test's arithmetic, ray by ray.
     #[inline(always)]
     pub(crate) fn enter_box(&self, near: [f32; 3], far: [f32; 3], t_max: &Lanes, active: u32) -> (u32, f32) {
+        let entries = self.enter_box_lanes(near, far, t_max);
         let mut mask = 0;
         let mut earliest = Vec4::INFINITY;
         for chunk in 0..PACKET / 4 {
-            let lanes = chunk * 4..chunk * 4 + 4;
-            let mut enter = Vec4::from_slice(&self.t_min.0[lanes.clone()]);
-            let mut exit = Vec4::from_slice(&t_max.0[lanes.clone()]);
-            for axis in 0..3 {
-                let origin = Vec4::from_slice(&self.origin[axis].0[lanes.clone()]);
-                let inv = Vec4::from_slice(&self.inv_direction[axis].0[lanes.clone()]);
-                let ahead = Vec4::from_slice(&self.inv_exit[axis].0[lanes.clone()]);
-                let behind = Vec4::from_slice(&self.inv_exit_behind[axis].0[lanes.clone()]);
-                let t_near = (Vec4::splat(near[axis]) - origin) * inv;
-                let t_far = later_exit(Vec4::splat(far[axis]) - origin, ahead, behind, Vec4::max);
-                // A NaN compares false and leaves the bound as it was.
-                enter = Vec4::select(t_near.cmpgt(enter), t_near, enter);
-                exit = Vec4::select(t_far.cmplt(exit), t_far, exit);
-            }
-            let entered = enter.cmple(exit) & enter.cmplt(Vec4::INFINITY);
-            earliest = earliest.min(Vec4::select(entered, enter, Vec4::INFINITY));
-            mask |= entered.bitmask() << (chunk * 4);
+            // A lane holds +∞ exactly where its ray misses the box.
+            let entry = entries.chunk(chunk);
+            earliest = earliest.min(entry);
+            mask |= entry.cmplt(Vec4::INFINITY).bitmask() << (chunk * 4);
         }
         (mask & active, earliest.min_element())
     }
