@@ -500,17 +500,21 @@ fn later_exit_avx2(
 #[target_feature(enable = "avx2")]
 #[inline]
 fn enter_boxes_avx2<const W: usize>(boxes: &WideBoxes<W>, ray: &PlaneRay, t_max: f32) -> (u32, [f32; W]) {
-    use std::arch::x86_64::*;
-    let load = |plane: usize, chunk: usize| {
-        let lanes: &[f32; 8] = boxes.planes[plane][chunk * 8..chunk * 8 + 8].try_into().expect("eight lanes");
-        // SAFETY: `lanes` is a reference to eight `f32`s, valid for a
-        // 32-byte load, and 32-byte aligned: `WideBoxes` is, and each of
-        // its rows is a multiple of eight lanes (32 bytes) long. (An
-        // unaligned load would do, but LLVM's generic tuning splits those
-        // in two unless it sees the alignment.)
-        unsafe { _mm256_load_ps(lanes.as_ptr()) }
-    };
-    enter_planes_avx2::<W>(load, ray, t_max)
+    enter_planes_avx2::<W>(|plane, chunk| load_planes_avx2(boxes, plane, chunk), ray, t_max)
+}
+
+/// Row `plane` of `boxes`' planes, lanes `8 · chunk` to `8 · chunk + 7`.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+#[inline]
+fn load_planes_avx2<const W: usize>(boxes: &WideBoxes<W>, plane: usize, chunk: usize) -> std::arch::x86_64::__m256 {
+    let lanes: &[f32; 8] = boxes.planes[plane][chunk * 8..chunk * 8 + 8].try_into().expect("eight lanes");
+    // SAFETY: `lanes` is a reference to eight `f32`s, valid for a
+    // 32-byte load, and 32-byte aligned: `WideBoxes` is, and each of
+    // its rows is a multiple of eight lanes (32 bytes) long. (An
+    // unaligned load would do, but LLVM's generic tuning splits those
+    // in two unless it sees the alignment.)
+    unsafe { std::arch::x86_64::_mm256_load_ps(lanes.as_ptr()) }
 }
 
 /// [`QuantisedNode::enter_portable`] eight lanes at a time: each plane's
@@ -551,44 +555,61 @@ fn enter_planes_avx2<const W: usize>(
     t_max: f32,
 ) -> (u32, [f32; W]) {
     use std::arch::x86_64::*;
-    let mut distances = [f32::INFINITY; W];
+    slab_test_avx2(load, ray.near, ray.t_min, t_max, |axis, near, far| {
+        let origin = _mm256_set1_ps(ray.origin[axis]);
+        let inv = _mm256_set1_ps(ray.inv_direction[axis]);
+        // One product for the exit: the two exit inverses are equal for the
+        // rays this kernel takes, and so are the bits (`crate::slab::later_exit`).
+        let exit_inv = _mm256_set1_ps(ray.inv_exit[axis]);
+        (_mm256_mul_ps(_mm256_sub_ps(near, origin), inv), _mm256_mul_ps(_mm256_sub_ps(far, origin), exit_inv))
+    })
+}
+
+/// The slab test's combination of distances, eight boxes at a time, as
+/// [`crate::simd::boxes::enter_planes`] combines four: `distances(axis,
+/// near, far)` gives the distances along `axis` to eight boxes' near
+/// planes and (enlarged) far planes, which `load(plane, chunk)` gives,
+/// `near_planes[axis]` indexing the near ones. Returns each box's entry
+/// distance within `[t_min, t_max]`, or +∞, and the mask of the boxes
+/// entered.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+#[inline]
+fn slab_test_avx2<const W: usize>(
+    load: impl Fn(usize, usize) -> std::arch::x86_64::__m256,
+    near_planes: [usize; 3],
+    t_min: f32,
+    t_max: f32,
+    distances: impl Fn(
+        usize,
+        std::arch::x86_64::__m256,
+        std::arch::x86_64::__m256,
+    ) -> (std::arch::x86_64::__m256, std::arch::x86_64::__m256),
+) -> (u32, [f32; W]) {
+    use std::arch::x86_64::*;
+    let mut entries = [f32::INFINITY; W];
     let mut mask = 0;
     for chunk in 0..W / 8 {
-        let mut enter = _mm256_set1_ps(ray.t_min);
+        let mut enter = _mm256_set1_ps(t_min);
         let mut exit = _mm256_set1_ps(t_max);
         for (axis, flip) in FAR_OF_NEAR.into_iter().enumerate() {
-            let near = load(ray.near[axis], chunk);
-            let far = load(ray.near[axis] ^ flip, chunk);
-            let origin = _mm256_set1_ps(ray.origin[axis]);
-            let inv = _mm256_set1_ps(ray.inv_direction[axis]);
-            let t_near = _mm256_mul_ps(_mm256_sub_ps(near, origin), inv);
-            // One product: the two exit inverses are equal for the rays
-            // this kernel takes, and so are the bits (`crate::slab::later_exit`).
-            let t_far = _mm256_mul_ps(_mm256_sub_ps(far, origin), _mm256_set1_ps(ray.inv_exit[axis]));
+            let near = load(near_planes[axis], chunk);
+            let far = load(near_planes[axis] ^ flip, chunk);
+            let (t_near, t_far) = distances(axis, near, far);
             // `max(a, b)` is `a > b ? a : b`: a NaN in `a` leaves the bound.
             enter = _mm256_max_ps(t_near, enter);
             exit = _mm256_min_ps(t_far, exit);
         }
-        let out: &mut [f32; 8] = (&mut distances[chunk * 8..chunk * 8 + 8]).try_into().expect("eight lanes");
-        mask |= store_entries_avx2(enter, exit, out) << (chunk * 8);
+        let infinity = _mm256_set1_ps(f32::INFINITY);
+        let entered =
+            _mm256_and_ps(_mm256_cmp_ps::<_CMP_LE_OQ>(enter, exit), _mm256_cmp_ps::<_CMP_LT_OQ>(enter, infinity));
+        let out: &mut [f32; 8] = (&mut entries[chunk * 8..chunk * 8 + 8]).try_into().expect("eight lanes");
+        // SAFETY: `out` is a mutable reference to eight `f32`s, valid for an
+        // unaligned 32-byte store.
+        unsafe { _mm256_storeu_ps(out.as_mut_ptr(), _mm256_blendv_ps(infinity, enter, entered)) };
+        mask |= (_mm256_movemask_ps(entered) as u32) << (chunk * 8);
     }
-    (mask, distances)
-}
-
-/// The end of the slab test on eight boxes: writes each box's entry
-/// distance `enter`, or +∞ where the box is missed (`enter > exit`, or
-/// `enter` is +∞), to `out`, and returns the mask of the boxes entered.
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2")]
-#[inline]
-fn store_entries_avx2(enter: std::arch::x86_64::__m256, exit: std::arch::x86_64::__m256, out: &mut [f32; 8]) -> u32 {
-    use std::arch::x86_64::*;
-    let infinity = _mm256_set1_ps(f32::INFINITY);
-    let entered = _mm256_and_ps(_mm256_cmp_ps::<_CMP_LE_OQ>(enter, exit), _mm256_cmp_ps::<_CMP_LT_OQ>(enter, infinity));
-    // SAFETY: `out` is a mutable reference to eight `f32`s, valid for an
-    // unaligned 32-byte store.
-    unsafe { _mm256_storeu_ps(out.as_mut_ptr(), _mm256_blendv_ps(infinity, enter, entered)) };
-    _mm256_movemask_ps(entered) as u32
+    (mask, entries)
 }
 
 /// [`IntervalRay::enter_boxes`] eight boxes at a time, in 256-bit
@@ -602,40 +623,21 @@ fn store_entries_avx2(enter: std::arch::x86_64::__m256, exit: std::arch::x86_64:
 #[inline]
 fn enter_interval_avx2<const W: usize>(boxes: &WideBoxes<W>, ray: &IntervalRay, t_max: f32) -> (u32, [f32; W]) {
     use std::arch::x86_64::*;
-    let load = |plane: usize, chunk: usize| {
-        let lanes: &[f32; 8] = boxes.planes[plane][chunk * 8..chunk * 8 + 8].try_into().expect("eight lanes");
-        // SAFETY: as in `enter_boxes_avx2`: eight aligned `f32`s.
-        unsafe { _mm256_load_ps(lanes.as_ptr()) }
-    };
+    let load = |plane: usize, chunk: usize| load_planes_avx2(boxes, plane, chunk);
     let zero = _mm256_setzero_ps();
-    let mut distances = [f32::INFINITY; W];
-    let mut mask = 0;
-    for chunk in 0..W / 8 {
-        let mut enter = _mm256_set1_ps(ray.t_min);
-        let mut exit = _mm256_set1_ps(t_max);
-        for (axis, flip) in FAR_OF_NEAR.into_iter().enumerate() {
-            let near = load(ray.near[axis], chunk);
-            let far = load(ray.near[axis] ^ flip, chunk);
-            // -0.0 for a negative direction, +0.0 for a positive one.
-            let sign = _mm256_set1_ps(if ray.sign[axis] < 0.0 { -0.0 } else { 0.0 });
-            let to_near = _mm256_sub_ps(near, _mm256_set1_ps(ray.origin_ahead[axis]));
-            let along = _mm256_cmp_ps::<_CMP_GT_OQ>(_mm256_xor_ps(to_near, sign), zero);
-            let inv = _mm256_blendv_ps(_mm256_set1_ps(ray.inv_big[axis]), _mm256_set1_ps(ray.inv_small[axis]), along);
-            let t_near = _mm256_mul_ps(to_near, inv);
-            let to_far = _mm256_sub_ps(far, _mm256_set1_ps(ray.origin_behind[axis]));
-            let backwards = _mm256_cmp_ps::<_CMP_LT_OQ>(_mm256_xor_ps(to_far, sign), zero);
-            let pick = |small: f32, big: f32| _mm256_blendv_ps(_mm256_set1_ps(big), _mm256_set1_ps(small), backwards);
-            let ahead = pick(ray.exit_small[axis], ray.exit_big[axis]);
-            let behind = pick(ray.exit_behind_small[axis], ray.exit_behind_big[axis]);
-            let t_far = later_exit_avx2(to_far, ahead, behind);
-            // `max(a, b)` is `a > b ? a : b`: a NaN in `a` leaves the bound.
-            enter = _mm256_max_ps(t_near, enter);
-            exit = _mm256_min_ps(t_far, exit);
-        }
-        let out: &mut [f32; 8] = (&mut distances[chunk * 8..chunk * 8 + 8]).try_into().expect("eight lanes");
-        mask |= store_entries_avx2(enter, exit, out) << (chunk * 8);
-    }
-    (mask, distances)
+    slab_test_avx2(load, ray.near, ray.t_min, t_max, |axis, near, far| {
+        // -0.0 for a negative direction, +0.0 for a positive one.
+        let sign = _mm256_set1_ps(if ray.sign[axis] < 0.0 { -0.0 } else { 0.0 });
+        let to_near = _mm256_sub_ps(near, _mm256_set1_ps(ray.origin_ahead[axis]));
+        let along = _mm256_cmp_ps::<_CMP_GT_OQ>(_mm256_xor_ps(to_near, sign), zero);
+        let inv = _mm256_blendv_ps(_mm256_set1_ps(ray.inv_big[axis]), _mm256_set1_ps(ray.inv_small[axis]), along);
+        let to_far = _mm256_sub_ps(far, _mm256_set1_ps(ray.origin_behind[axis]));
+        let backwards = _mm256_cmp_ps::<_CMP_LT_OQ>(_mm256_xor_ps(to_far, sign), zero);
+        let pick = |small: f32, big: f32| _mm256_blendv_ps(_mm256_set1_ps(big), _mm256_set1_ps(small), backwards);
+        let ahead = pick(ray.exit_small[axis], ray.exit_big[axis]);
+        let behind = pick(ray.exit_behind_small[axis], ray.exit_behind_big[axis]);
+        (_mm256_mul_ps(to_near, inv), later_exit_avx2(to_far, ahead, behind))
+    })
 }
 
 /// [`PacketRays::enter_box`] eight rays at a time, in 256-bit registers.
@@ -795,8 +797,9 @@ mod tests {
     }
 
     /// The intrinsic kernels of every level the CPU has compute the bits
-    /// of the portable ones (the interval ray's included), on boxes and rays with zeros, ±0 direction
-    /// components, origins on box planes and NaN-producing `0 · ∞`.
+    /// of the portable ones (the interval ray's included), on boxes and
+    /// rays with zeros, ±0 direction components, origins on box planes
+    /// and NaN-producing `0 · ∞`.
     #[test]
     fn every_level_computes_the_portable_kernels_bits() {
         let detected = SimdLevel::detected();

@@ -179,6 +179,17 @@ impl PacketRays {
 }
 
 impl PacketRays {
+    /// The near and far planes, for the packet's direction signs, of the
+    /// box `[min, max]`: the arguments of [`PacketRays::enter_box`] and
+    /// [`PacketRays::enter_box_lanes`].
+    #[inline(always)]
+    pub(crate) fn near_far(&self, min: [f32; 3], max: [f32; 3]) -> ([f32; 3], [f32; 3]) {
+        let planes = [min, max];
+        // `near[axis]` is `axis` (the minimum) or `axis + 3` (the maximum).
+        let plane = |axis: usize, far: bool| planes[(self.near[axis] >= 3) as usize ^ far as usize][axis];
+        ([plane(0, false), plane(1, false), plane(2, false)], [plane(0, true), plane(1, true), plane(2, true)])
+    }
+
     /// Where each ray enters the box whose near planes (for the packet's
     /// direction signs) are `near` and far planes `far`, within its
     /// `[t_min, t_max]`, or +∞ for a ray that misses it: lane by lane the

@@ -178,12 +178,7 @@ impl<const W: usize, N: NodeLayout<W>> WideBvh<W, N> {
                     let child = children[lane];
                     let entry = if child.is_leaf() {
                         let (min, max) = node.child_box(lane);
-                        let planes = [min, max];
-                        // `packet.near[axis]` is `axis` (the minimum) or `axis + 3` (the maximum).
-                        let plane =
-                            |axis: usize, far: bool| planes[(packet.near[axis] >= 3) as usize ^ far as usize][axis];
-                        let near = [plane(0, false), plane(1, false), plane(2, false)];
-                        let far = [plane(0, true), plane(1, true), plane(2, true)];
+                        let (near, far) = packet.near_far(min, max);
                         let (rays_in, enter) = isa.enter_box_packet(near, far, packet, &t_max, active);
                         if rays_in == 0 {
                             continue;
@@ -291,12 +286,7 @@ impl<const W: usize, N: NodeLayout<W>> WideBvh<W, N> {
                 let triangle = block.triangle(triangle_lane);
                 let entries = if lanes & !hits.rescan != 0 {
                     let [a, b, c] = triangle;
-                    let planes = [a.min(b).min(c).to_array(), a.max(b).max(c).to_array()];
-                    // `near[axis]` is `axis` (the minimum) or `axis + 3` (the maximum).
-                    let plane =
-                        |axis: usize, far: bool| planes[(packet_rays.near[axis] >= 3) as usize ^ far as usize][axis];
-                    let near = [plane(0, false), plane(1, false), plane(2, false)];
-                    let far = [plane(0, true), plane(1, true), plane(2, true)];
+                    let (near, far) = packet_rays.near_far(a.min(b).min(c).to_array(), a.max(b).max(c).to_array());
                     isa.enter_box_lanes(near, far, packet_rays, t_max)
                 } else {
                     Lanes([f32::INFINITY; PACKET])
