@@ -201,6 +201,13 @@ pub(crate) struct Transport<'a, A: Accel + ?Sized> {
     layered_materials: Vec<bool>,
     /// Normal and elongation of every triangle, for the points spawning rays.
     shapes: Vec<TriangleShape>,
+    /// Per triangle, its shading normal where its three vertices share one
+    /// (flat faces, as in most architectural scenes): normalised once here
+    /// instead of interpolated and normalised at every hit.
+    flat_normals: Vec<Option<Vec3>>,
+    /// Whether any vertex has a colour other than white; without, the
+    /// interpolation of `COLOR_0` is skipped (multiplying by white is exact).
+    vertex_colors: bool,
     /// The alpha test of cut-outs, where the plan has them.
     cut_outs: Option<AlphaTest<'a>>,
 }
@@ -278,6 +285,15 @@ impl<'a, A: Accel + ?Sized> Transport<'a, A> {
                 .iter()
                 .map(|t| TriangleShape::of(&t.vertices.map(|v| scene.vertices[v as usize].position)))
                 .collect(),
+            flat_normals: scene
+                .triangles
+                .iter()
+                .map(|t| {
+                    let [a, b, c] = t.vertices.map(|v| scene.vertices[v as usize].normal);
+                    (a == b && b == c).then(|| a.try_normalize()).flatten()
+                })
+                .collect(),
+            vertex_colors: scene.vertices.iter().any(|v| v.color != Vec4::ONE),
         }
     }
 
@@ -504,12 +520,16 @@ impl<'a, A: Accel + ?Sized> Transport<'a, A> {
         let corners = triangle.vertices.map(|v| scene.vertices[v as usize].position);
         let point =
             SurfacePoint::on_triangle_with_shape(&corners, hit.beta, hit.gamma, self.shapes[hit.triangle as usize]);
-        let mut normal = scene.interpolate(triangle, hit.beta, hit.gamma, |v| v.normal);
+        let flat_normal = self.flat_normals[hit.triangle as usize];
+        let mut unit = flat_normal.is_some();
+        let mut normal = flat_normal.unwrap_or_else(|| scene.interpolate(triangle, hit.beta, hit.gamma, |v| v.normal));
         // Before any normal map: a clear coat without a map of its own follows it.
         let geometry_normal = normal;
         // COLOR_0 multiplies the base colour (white where a file has none).
-        let vertex_color = scene.interpolate(triangle, hit.beta, hit.gamma, |v| v.color).truncate();
-        let mut base_color = material.base_color * vertex_color;
+        let mut base_color = material.base_color;
+        if self.vertex_colors {
+            base_color *= scene.interpolate(triangle, hit.beta, hit.gamma, |v| v.color).truncate();
+        }
         let mut roughness = material.roughness;
         let mut metallic = material.metallic;
         let mut transmission = material.transmission;
@@ -532,9 +552,11 @@ impl<'a, A: Accel + ?Sized> Transport<'a, A> {
             {
                 let tangent: Vec4 = scene.interpolate(triangle, hit.beta, hit.gamma, |v| v.tangent);
                 normal = perturb(normal, tangent, texture(id).truncate(), scale);
+                unit = false;
             }
         }
-        let mut normal = normal.try_normalize().unwrap_or(point.normal);
+        // A flat face's normal is a unit vector already, unless a normal map bent it.
+        let mut normal = if unit { normal } else { normal.try_normalize().unwrap_or(point.normal) };
         // Keep the geometric normal on the shading normal's side: the shading
         // normal says where "outside" is (for refraction).
         let mut point = point;

@@ -109,3 +109,32 @@ fn a_smooth_low_poly_sphere_has_no_dark_fringe_along_its_silhouette() {
         "smooth silhouette band {smooth_band} against flat {flat_band}: a dark fringe"
     );
 }
+
+/// What a file gives per vertex reaches the path tracer, which reads a
+/// flat face's normal once per triangle and skips vertex colours where a
+/// scene has none: a flat sphere whose normals are three times too long
+/// and whose vertices are red is a red Lambertian sphere of albedo 0.8
+/// under the uniform sky, so it reflects (0.8, 0, 0) wherever it covers a
+/// pixel, green and blue exactly 0.
+#[test]
+fn flat_faces_with_long_normals_and_red_vertices_reflect_red_at_their_albedo() {
+    let mut scene = sphere(8, 5, false);
+    for vertex in &mut scene.vertices {
+        vertex.normal *= 3.0;
+        vertex.color = rtgi_math::Vec4::new(1.0, 0.0, 0.0, 1.0);
+    }
+    let albedo = render_sphere(&scene, Integrator::Albedo, 4);
+    let red = |x: u32, y: u32| (albedo.get(x, y) - Vec3::new(0.8, 0.0, 0.0)).abs().max_element() < 1e-4;
+    // Pixels inside the sphere's outline, a pixel away from it: the path
+    // tracer's samples there cannot see the sky past the silhouette.
+    let covered: Vec<(u32, u32)> = (1..SIZE - 1)
+        .flat_map(|y| (1..SIZE - 1).map(move |x| (x, y)))
+        .filter(|&(x, y)| (y - 1..=y + 1).all(|y| (x - 1..=x + 1).all(|x| red(x, y))))
+        .collect();
+    assert!(covered.len() > 1000, "the sphere covers {} pixels", covered.len());
+    let image = render_sphere(&scene, Integrator::Path, 16);
+    let mean = covered.iter().map(|&(x, y)| image.get(x, y)).sum::<Vec3>() / covered.len() as f32;
+    assert!((mean.x - 0.8).abs() < 0.01, "mean over the sphere {mean}");
+    let brightest_other = covered.iter().map(|&(x, y)| image.get(x, y).y.max(image.get(x, y).z)).fold(0.0, f32::max);
+    assert_eq!(brightest_other, 0.0, "green or blue reflected by a red sphere");
+}
