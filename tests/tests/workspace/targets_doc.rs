@@ -81,6 +81,13 @@ fn disagreements(doc: &str) -> Vec<String> {
             }
             Some(ratio)
         };
+        // A row for comparison only has no target and no verdict.
+        if target == "—" {
+            if met != "—" {
+                problems.push(format!("{id}: says '{met}' without a target"));
+            }
+            continue;
+        }
         // The verdict, from the rounded figures as the script decides it.
         let (at_least, bound) = match target.split_once(' ') {
             Some(("≥", bound)) => (true, bound),
@@ -122,19 +129,23 @@ fn a_figure_changed_by_hand_is_caught() {
 |---|---|---|---:|---:|---:|---|---|
 | a | s | m | 2.00 | 1.00 (x) | 2.00× | ≥ 1.5× | **met** |
 | b | s | m | 4.00 | — | — | ≥ 5 | no |
+| c | s | m | 1.00 | 2.00 (y) | 0.50× | — | — |
 
 ```text
 a ours: 1.9 2.0 2.1 against: 1.0 1.1 0.9
 b ours: 4.0 3.0 5.0 against: 
+c ours: 1.0 against: 2.0
 ```
 ";
     assert_eq!(disagreements(doc), Vec::<String>::new());
     for (from, to) in [
-        ("1.9 2.0 2.1", "1.9 2.2 2.1"),          // a different median
-        ("| 2.00× |", "| 2.10× |"),              // a different ratio
-        ("| **met** |", "| no |"),               // the wrong verdict
-        ("| ≥ 5 | no |", "| ≥ 3 | no |"),        // a target that is met, said not to be
-        ("b ours: 4.0 3.0 5.0 against: \n", ""), // a row without runs
+        ("1.9 2.0 2.1", "1.9 2.2 2.1"),                           // a different median
+        ("| 2.00× |", "| 2.10× |"),                               // a different ratio
+        ("| **met** |", "| no |"),                                // the wrong verdict
+        ("| ≥ 5 | no |", "| ≥ 3 | no |"),                         // a target that is met, said not to be
+        ("b ours: 4.0 3.0 5.0 against: \n", ""),                  // a row without runs
+        ("| 0.50× | — | — |", "| 0.50× | — | **met** |"),         // a verdict without a target
+        ("c ours: 1.0 against: 2.0", "c ours: 1.0 against: 2.5"), // its ratio is checked too
     ] {
         let changed = doc.replacen(from, to, 1);
         assert_ne!(changed, doc, "{from}");
