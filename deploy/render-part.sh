@@ -133,7 +133,8 @@ forward() {
 trap 'forward TERM' TERM
 trap 'forward INT' INT
 
-first_line=$(($(wc -l <"$log" 2>/dev/null || echo 0) + 1))
+# (The log does not exist before a part's first run: no lines yet.)
+first_line=$(($({ wc -l <"$log"; } 2>/dev/null || echo 0) + 1))
 echo "== $(date -u +%Y-%m-%dT%H:%M:%SZ) job $index of $count${SLURM_JOB_ID:+ (Slurm job $SLURM_JOB_ID)} on $(hostname): $what" >>"$log"
 "$rtgi" "${options[@]}" >>"$log" 2>&1 &
 child=$!

@@ -89,9 +89,25 @@ impl Cluster {
         }
     }
 
+    /// Whether job `id` is in one of Slurm's final states. Named rather than
+    /// inferred from the running states: a job being sent its `--signal`
+    /// passes through SIGNALING, which once let the test read the log
+    /// before rtgi had saved (and there are STAGE_OUT, RESIZING, ...).
     fn ended(&self, id: &str) -> bool {
-        let state = self.field(id, "JobState");
-        !state.is_empty() && !matches!(state.as_str(), "PENDING" | "RUNNING" | "CONFIGURING" | "COMPLETING")
+        matches!(
+            self.field(id, "JobState").as_str(),
+            "COMPLETED"
+                | "CANCELLED"
+                | "FAILED"
+                | "TIMEOUT"
+                | "PREEMPTED"
+                | "NODE_FAIL"
+                | "BOOT_FAIL"
+                | "DEADLINE"
+                | "OUT_OF_MEMORY"
+                | "REVOKED"
+                | "SPECIAL_EXIT"
+        )
     }
 }
 
