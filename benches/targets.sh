@@ -78,7 +78,7 @@ median() { # of the numbers given as arguments
 # list has no ratio.
 row() {
     local id="$1" scene="$2" measure="$3" label="$4" target="$5" ours=($6) against=(${7:-})
-    local m_ours m_against ratio="—" against_cell="—" goal met value op bound
+    local m_ours m_against ratio="—" against_cell="—" goal met="" value op bound
     m_ours="$(median "${ours[@]}")"
     if [[ ${#against[@]} -gt 0 ]]; then
         m_against="$(median "${against[@]}")"
@@ -89,14 +89,11 @@ row() {
         ratio\>=*) value="${ratio%×}"; op=">="; bound="${target#ratio>=}"; goal="≥ ${bound}×" ;;
         ratio\<=*) value="${ratio%×}"; op="<="; bound="${target#ratio<=}"; goal="≤ ${bound}×" ;;
         ours\>=*) value="$(two_places "$m_ours")"; op=">="; bound="${target#ours>=}"; goal="≥ $bound" ;;
-        none) goal="—" ;;
+        none) goal="—"; met="—" ;;
         *) echo "targets: unknown target '$target'" >&2; exit 1 ;;
     esac
-    if [[ "$target" == none ]]; then
-        met="—"
-    else
+    [[ -n "$met" ]] ||
         met="$(awk -v v="$value" -v b="$bound" -v op="$op" 'BEGIN { ok = op == ">=" ? v >= b : v <= b; print ok ? "**met**" : "no" }')"
-    fi
     rows+=("| $id | $scene | $measure | $(two_places "$m_ours") | $against_cell | $ratio | $goal | $met |")
     run_lines+=("$id ours: ${ours[*]} against: ${against[*]}")
 }
