@@ -50,7 +50,8 @@ command -v valgrind >/dev/null || { echo "counters: needs Valgrind (apt install 
 shared="${RTGI_SCENES:-$PWD/../shared/scenes}"
 bunny="$shared/bunny/stanford-bunny.obj"
 conference="$shared/conference/conference.obj"
-for scene in "$bunny" "$conference"; do
+cornell="$shared/cornell-box/CornellBox-Original.obj"
+for scene in "$bunny" "$conference" "$cornell"; do
     [[ -f "$scene" ]] || { echo "counters: no scene at $scene (set RTGI_SCENES)" >&2; exit 1; }
 done
 
@@ -84,6 +85,10 @@ side="$(awk -v n="$count" 'BEGIN { printf "%d", sqrt(n) }')"
 make_rays bunny-random "$bunny" --kind random --count "$count"
 make_rays bunny-camera "$bunny" --kind camera --width "$side" --height "$side"
 make_rays conference-random "$conference" --kind random --count "$count"
+# A path tracer's secondary rays in a scene of 36 triangles, where a ray
+# tests about one node and one block: what is left is each side's cost per
+# ray, not per node (the Cornell box target of issue 50).
+make_rays cornell-surface "$cornell" --kind surface --count "$count"
 # Rays that miss the bunny's bounds: every query ends at the root, so what
 # is left is rtgi trace's own per-ray work.
 python3 - "$scratch/bunny-miss.rays" "$count" <<'EOF'
